@@ -1,0 +1,137 @@
+// fdm/coupler.h -- the thin library that the fluid solver (fdmFoam) and the particle code
+// (fdmDEM, LIGGGHTS) both link. A versioned message format and two transports (TCP socket
+// between the two master ranks, or a shared directory of message files for debugging and
+// replay). Nothing else: no physics, no MPI. See docs/coupling.md for the protocol.
+//
+// Must stay C++11: OpenFOAM v1912 code includes it.
+#ifndef FDM_COUPLER_H
+#define FDM_COUPLER_H
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fdm {
+namespace coupler {
+
+// Bump when the wire format or the meaning of a record changes; a peer with another
+// version is refused at the handshake with both versions in the message.
+const uint16_t protocolVersion = 1;
+
+enum class MessageType : uint16_t {
+    Hello      = 1,  // handshake, once per connection, each side sends one
+    Step       = 2,  // DEM -> fluid: particle positions/radii/velocities, once per time step
+    Integrals  = 3,  // fluid -> DEM: per-particle integrals of Eq. (38), every inner iteration
+    Velocities = 4,  // DEM -> fluid: rigid velocities (U_p, Omega_p), every inner iteration
+    StepDone   = 5,  // fluid -> DEM: inner iterations converged, hydrodynamic force/torque
+    Finish     = 6,  // DEM -> fluid: no more steps, both sides end normally
+    Error      = 7   // either way: the sender is stopping; text says why
+};
+
+const char* messageTypeName(MessageType t);
+
+// One message: a small fixed header, an optional text (key=value metadata or an error
+// message) and `count` records of `width` doubles each (row-major).
+struct Message {
+    MessageType type = MessageType::Error;
+    uint64_t step = 0;        // DEM time step index (LIGGGHTS ntimestep)
+    uint32_t iteration = 0;   // inner iteration index within the step, from 1
+    uint32_t count = 0;       // number of records (particles)
+    uint32_t width = 0;       // doubles per record
+    std::string text;
+    std::vector<double> data; // count*width values
+
+    double& at(uint32_t record, uint32_t field) { return data[size_t(record)*width + field]; }
+    double at(uint32_t record, uint32_t field) const { return data[size_t(record)*width + field]; }
+
+    // Value of `key` in text of the form "key1=value1 key2=value2"; throws CouplerError naming
+    // the key and the message type if it is absent.
+    std::string textValue(const std::string& key) const;
+    double textNumber(const std::string& key) const;
+};
+
+Message makeMessage(MessageType type, uint64_t step, uint32_t iteration,
+                    uint32_t count, uint32_t width, const std::string& text = "");
+
+// Record layouts (field indices) -- the whole contract between the two codes.
+namespace layout {
+    // Hello from the DEM side. text: "role=dem version=<v> dt=<s> lastStep=<n>"
+    //   one record: [nParticles, xlo, xhi, ylo, yhi, zlo, zhi, periodicX, periodicY, periodicZ]
+    // Hello from the fluid side. text: "role=fluid version=<v>"
+    //   one record: [nParticlesExpected (-1 = any), alphaLambda [s], rhoFluid [kg/m3],
+    //                delta [m], xlo, xhi, ylo, yhi, zlo, zhi, periodicX, periodicY, periodicZ]
+    const uint32_t helloDemWidth = 10;
+    const uint32_t helloFluidWidth = 13;
+
+    // Step: one record per particle, ordered by tag (tags 1..N). text: "dt=<s> lastStep=<n>"
+    enum StepField { sTag, sX, sY, sZ, sRadius, sUx, sUy, sUz, sWx, sWy, sWz, stepWidth };
+
+    // Integrals: one record per particle (same order as Step), all in SI units:
+    //   Vu = int I_u dV                               -> (rho_f/rho_p) M_p = rho_f Vu
+    //   Ju = int I_u (2/3)|x-x_p|^2 dV                -> (rho_f/rho_p) J_p = rho_f Ju
+    //   F  = rho_f int (I_u u*/alpha - I_lambda lambda^n) dV               (Eq. 32)
+    //   T  = rho_f int (x-x_p) x (I_u u*/alpha - I_lambda lambda^n) dV     (Eq. 32)
+    enum IntegralField { iVu, iJu, iFx, iFy, iFz, iTx, iTy, iTz, integralsWidth };
+
+    // Velocities: one record per particle: [Ux, Uy, Uz, Wx, Wy, Wz]
+    enum VelocityField { vUx, vUy, vUz, vWx, vWy, vWz, velocitiesWidth };
+
+    // StepDone: text "iterations=<n> residual=<lambda residual> converged=<0|1>"
+    //   one record per particle: hydrodynamic force and torque of the fluid solve,
+    //   -rho_f int I_lambda lambda dV and -rho_f int (x-x_p) x I_lambda lambda dV (Eq. 7).
+    enum StepDoneField { dFx, dFy, dFz, dTx, dTy, dTz, stepDoneWidth };
+}
+
+// Any coupling failure: peer died, never connected, timed out, malformed or unexpected
+// message, or an Error message from the peer. what() is meant for the user.
+class CouplerError : public std::runtime_error {
+public:
+    explicit CouplerError(const std::string& what) : std::runtime_error(what) {}
+};
+
+struct Options {
+    std::string transport = "socket";  // "socket" or "file"
+    // socket: the fluid side listens on host:port (port 0 = any free port); if portFile is
+    // set the listening side writes the chosen port there and the connecting side reads it
+    // (waiting for the file up to connectTimeout).
+    std::string host = "127.0.0.1";
+    int port = 0;
+    std::string portFile;
+    // file: both sides use this directory; each message is one file, written atomically.
+    std::string directory;
+    double connectTimeout = 60.0;   // s: the peer never showed up
+    double receiveTimeout = 600.0;  // s: the peer is alive but silent (hung)
+    std::string recordFile;         // if set, every message sent and received is appended here
+    std::string name = "peer";      // how this side is named in error messages ("fluid", "dem")
+};
+
+// One end of a connection. send() and receive() throw CouplerError; receive() turns an Error
+// message from the peer into a CouplerError carrying its text.
+class Transport {
+public:
+    virtual ~Transport() {}
+    virtual void send(const Message& m) = 0;
+    virtual Message receive() = 0;
+    // Receive and check the type; throws CouplerError "expected X from <peer>, got Y".
+    Message receive(MessageType expected);
+    // Best effort, never throws: tell the peer why we stop.
+    void sendError(const std::string& why) noexcept;
+    virtual void close() noexcept = 0;
+    virtual std::string describe() const = 0;  // e.g. "socket 127.0.0.1:40123"
+};
+
+// The fluid side listens, the DEM side connects. Both block until the peer is there or
+// connectTimeout expires (CouplerError "no peer connected to ... within N s").
+std::unique_ptr<Transport> listen(const Options& options);
+std::unique_ptr<Transport> connect(const Options& options);
+
+// Wire format (exposed for tests and the replay tool).
+std::vector<unsigned char> encode(const Message& m);
+Message decode(const unsigned char* bytes, size_t size);  // throws CouplerError if malformed
+
+}  // namespace coupler
+}  // namespace fdm
+
+#endif

@@ -1,0 +1,221 @@
+/*---------------------------------------------------------------------------*\
+    fdmFoam: fictitious-domain Stokes solver with sub-grid corrections
+    (Orsi, Lobry & Peters, J. Comput. Phys. 474, 2023)
+
+Application
+    fdmFoam
+
+Description
+    Steady Stokes flow (Eqs. 28a-b) on a uniform Cartesian mesh with rigid
+    particles enforced by direct forcing (Eqs. 29, 33, 38), coupled every inner
+    iteration to the particle code fdmDEM (LIGGGHTS), which solves Eq. (31)
+    for the particle velocities and moves the particles.
+
+    Per time step (section 4.3): receive the particle positions (step 1),
+    truncate lambda outside the particles (2), then repeat until the lambda
+    residual is below tolLambda: PISO solve for u*, p (3); send the particle
+    integrals, receive U_p, Omega_p (4); correct lambda (5) and u (6).
+
+    The particle code drives time: fdmFoam runs until it sends Finish.
+
+Usage
+    fdmFoam [-parallel] [-case dir]   (start it before fdmDEM; see scripts/fdmRun)
+
+\*---------------------------------------------------------------------------*/
+
+#include "fvCFD.H"
+#include "pisoControl.H"
+#include "OFstream.H"
+#include "uniformCartesianMesh.H"
+#include "particleForcing.H"
+#include "fluidCoupling.H"
+#include <chrono>
+
+namespace
+{
+    double wallClock()
+    {
+        using namespace std::chrono;
+        return duration<double>(steady_clock::now().time_since_epoch()).count();
+    }
+}
+
+// * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //
+
+int main(int argc, char *argv[])
+{
+    argList::addNote
+    (
+        "Fictitious-domain Stokes solver for particle suspensions, coupled to"
+        " the particle code fdmDEM (LIGGGHTS) through the fdm coupler."
+    );
+
+    #include "setRootCaseLists.H"
+    #include "createTime.H"
+    #include "createMesh.H"
+
+    pisoControl piso(mesh);
+
+    #include "createFields.H"
+    #include "readFdmProperties.H"
+
+    particleForcing forcing
+    (
+        grid, indicatorB, indicatorC, alphaLambda, rho.value()
+    );
+
+    fluidCoupling coupling(runTime, fdmProperties.subOrEmptyDict("coupling"));
+    coupling.handshake(grid, nParticlesExpected, alphaLambda, rho.value());
+
+    #include "createOutput.H"
+
+    scalar fluidTime = 0, particleTime = 0, outputTime = 0;
+    label nStepsDone = 0, nInnerTotal = 0;
+    const double runStart = wallClock();
+    List<fdmParticle> stepParticles;
+
+    Info<< nl << "Starting time loop (driven by fdmDEM)" << nl << endl;
+
+    while (coupling.receiveStep(stepParticles))
+    {
+        const double stepStart = wallClock();
+        const scalar exchangeAtStart = coupling.exchangeTime();
+        scalar stepFluidTime = 0, stepParticleTime = 0;
+
+        // Step 1: particles moved by the DEM side
+        const string outside = forcing.checkInsideDomain(stepParticles);
+        if (!outside.empty())
+        {
+            coupling.fatal(outside + " at time step " + name(coupling.step()));
+        }
+        forcing.setParticles(stepParticles);
+        runTime.setDeltaT(coupling.dt());
+        ++runTime;
+
+        // Step 2
+        forcing.truncateLambda(lambda);
+        forcing.pseudoTimeCoefficient(rDTau, rDTauInside, rDTauOutside);
+        stepParticleTime += wallClock() - stepStart;
+
+        const bool firstStep = (nStepsDone == 0);
+        const scalar tol = firstStep ? tolLambdaFirst : tolLambda;
+        const label nMax = firstStep ? nInnerMaxFirst : nInnerMax;
+
+        label innerIteration = 0;
+        scalar residual = GREAT, bestResidual = GREAT;
+        bool converged = false;
+        List<scalar> integrals, velocities;
+
+        while (true)
+        {
+            ++innerIteration;
+
+            // Step 3: fluid sub-problem
+            double t0 = wallClock();
+            {
+                #include "UEqn.H"
+                while (piso.correct())
+                {
+                    #include "pEqn.H"
+                }
+            }
+            double t1 = wallClock();
+            stepFluidTime += t1 - t0;
+
+            // Step 4: particle velocities from the DEM side (Eq. 31)
+            integrals = forcing.integrals(U, lambda);
+            stepParticleTime += wallClock() - t1;
+            coupling.sendIntegrals(innerIteration, integrals);
+            velocities = coupling.receiveVelocities(innerIteration);
+
+            // Steps 5-6: correct lambda and u (Eq. 38)
+            t0 = wallClock();
+            residual = forcing.correct(U, lambda, velocities);
+            stepParticleTime += wallClock() - t0;
+
+            if (!std::isfinite(residual))
+            {
+                coupling.fatal
+                (
+                    "the lambda iteration produced a non-finite residual ("
+                  + name(residual) + ") at time step " + name(coupling.step())
+                  + ", inner iteration " + name(innerIteration)
+                  + ": check the time step, gradP0 and the particle forces"
+                );
+            }
+            bestResidual = min(bestResidual, residual);
+            if (innerIteration > 20 && residual > 1e4*bestResidual)
+            {
+                coupling.fatal
+                (
+                    "the lambda iteration is diverging at time step "
+                  + name(coupling.step()) + ": residual " + name(residual)
+                  + " at inner iteration " + name(innerIteration)
+                  + " after reaching " + name(bestResidual)
+                  + " (try a smaller pseudoTimeFactor in constant/fdmProperties)"
+                );
+            }
+            if (reportIterations)
+            {
+                Info<< "    inner " << innerIteration << " residual lambda "
+                    << residual << endl;
+            }
+
+            converged = innerIteration >= nInnerMin && residual <= tol;
+            if (converged || innerIteration >= nMax)
+            {
+                break;
+            }
+        }
+
+        const double tEnd = wallClock();
+        List<scalar> hydroForces = forcing.hydrodynamicForces(lambda);
+        coupling.sendStepDone(innerIteration, residual, converged, hydroForces);
+        stepParticleTime += wallClock() - tEnd;
+        const scalar stepExchangeTime = coupling.exchangeTime() - exchangeAtStart;
+
+        const double tOut = wallClock();
+        #include "writeStepOutput.H"
+        outputTime += wallClock() - tOut;
+
+        ++nStepsDone;
+        nInnerTotal += innerIteration;
+        fluidTime += stepFluidTime;
+        particleTime += stepParticleTime;
+
+        const scalar elapsed = wallClock() - runStart;
+        const label remaining = max(label(0), coupling.lastStep() - coupling.step());
+        Info<< "Step " << coupling.step() << " t = " << runTime.timeName()
+            << "  inner " << innerIteration << "  residual lambda " << residual
+            << (converged ? "" : " (NOT converged)")
+            << "  | fluid " << stepFluidTime << " s, particles "
+            << stepParticleTime << " s, exchange " << stepExchangeTime
+            << " s | ETA " << remaining*elapsed/nStepsDone << " s" << endl;
+
+        if (!converged)
+        {
+            WarningInFunction
+                << "time step " << coupling.step() << ": lambda residual "
+                << residual << " above tolLambda " << tol << " after "
+                << innerIteration << " inner iterations (nMax)" << endl;
+        }
+    }
+
+    // Final state, so that a run can be restarted from it
+    forcing.indicator(particleIndicator);
+    runTime.writeNow();
+
+    const scalar total = wallClock() - runStart;
+    const scalar exchange = coupling.exchangeTime();
+    auto pct = [total](scalar t) { return 100*t/max(total, VSMALL); };
+    Info<< nl << "fdmFoam time breakdown (" << nStepsDone << " steps, "
+        << nInnerTotal << " inner iterations, " << total << " s wall):" << nl
+        << "    fluid solve      " << fluidTime << " s (" << pct(fluidTime) << " %)" << nl
+        << "    particle forcing " << particleTime << " s (" << pct(particleTime) << " %)" << nl
+        << "    exchange + DEM   " << exchange << " s (" << pct(exchange) << " %)" << nl
+        << "    output           " << outputTime << " s (" << pct(outputTime) << " %)" << nl
+        << endl;
+
+    Info<< "End\n" << endl;
+    return 0;
+}

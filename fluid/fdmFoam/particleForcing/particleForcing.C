@@ -1,0 +1,324 @@
+#include "particleForcing.H"
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::particleForcing::particleForcing
+(
+    const uniformCartesianMesh& grid,
+    scalar b,
+    scalar c,
+    scalar alphaLambda,
+    scalar rhoFluid
+)
+:
+    grid_(grid),
+    b_(b),
+    c_(c),
+    alpha_(alphaLambda),
+    rhoFluid_(rhoFluid),
+    offset_(1, 0),
+    IuScale_(grid.mesh().nCells(), 1.0),
+    covered_(grid.mesh().nCells(), false),
+    maxCoreSlip_(0)
+{}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+Foam::string Foam::particleForcing::checkInsideDomain
+(
+    const List<fdmParticle>& particles
+) const
+{
+    const boundBox& bb = grid_.bounds();
+    const char* axis = "xyz";
+
+    for (const fdmParticle& p : particles)
+    {
+        for (direction d = 0; d < 3; ++d)
+        {
+            // Periodic: the centre must be in the box (the DEM wraps it).
+            // Bounded: the whole sphere must be inside the walls.
+            const scalar margin = grid_.periodic()[d] ? 0 : p.radius;
+            if
+            (
+                !std::isfinite(p.x[d])
+             || p.x[d] - margin < bb.min()[d] - 1e-12*grid_.delta()
+             || p.x[d] + margin > bb.max()[d] + 1e-12*grid_.delta()
+            )
+            {
+                OStringStream os;
+                os  << "particle " << p.tag << " at " << p.x
+                    << " with radius " << p.radius << " lies outside the "
+                    << "OpenFOAM mesh (constant/polyMesh) in "
+                    << axis[d] << ": the mesh spans " << bb.min()[d]
+                    << " .. " << bb.max()[d]
+                    << (grid_.periodic()[d] ? " (periodic)" : " (walls)");
+                return os.str();
+            }
+        }
+        if (!(p.radius > 0))
+        {
+            OStringStream os;
+            os  << "particle " << p.tag << " has radius " << p.radius;
+            return os.str();
+        }
+    }
+    return string::null;
+}
+
+
+void Foam::particleForcing::setParticles(const List<fdmParticle>& particles)
+{
+    particles_ = particles;
+
+    cell_.clear();
+    Iu_.clear();
+    Ilambda_.clear();
+    r_.clear();
+    offset_.setSize(particles_.size() + 1);
+
+    const scalarField& V = grid_.mesh().V();
+    scalarField IuSum(V.size(), 0.0);
+    labelField count(V.size(), 0);
+
+    const scalar delta = grid_.delta();
+    const vector L = grid_.span();
+    const point& origin = grid_.bounds().min();
+    const Vector<label>& n = grid_.nCells();
+
+    forAll(particles_, p)
+    {
+        offset_[p] = cell_.size();
+        const fdmParticle& part = particles_[p];
+        const scalar reach = part.radius + c_*delta;
+
+        // Range of global indices touched, unwrapped; periodic directions
+        // wrap the index, bounded ones clip it.
+        label lo[3], hi[3];
+        for (direction d = 0; d < 3; ++d)
+        {
+            lo[d] = label(std::floor((part.x[d] - reach - origin[d])/delta));
+            hi[d] = label(std::floor((part.x[d] + reach - origin[d])/delta));
+            if (!grid_.periodic()[d])
+            {
+                lo[d] = max(lo[d], label(0));
+                hi[d] = min(hi[d], n[d] - 1);
+            }
+        }
+
+        for (label k = lo[2]; k <= hi[2]; ++k)
+        for (label j = lo[1]; j <= hi[1]; ++j)
+        for (label i = lo[0]; i <= hi[0]; ++i)
+        {
+            // Unwrapped centre relative to the particle: nearest image
+            const point centre = origin + delta*vector(i + 0.5, j + 0.5, k + 0.5);
+            const vector r = centre - part.x;
+            const scalar dist = mag(r);
+            if (dist > reach)
+            {
+                continue;
+            }
+            const label iw = (i % n[0] + n[0]) % n[0];
+            const label jw = (j % n[1] + n[1]) % n[1];
+            const label kw = (k % n[2] + n[2]) % n[2];
+            const label celli = grid_.cellLabel(iw, jw, kw);
+            if (celli < 0)
+            {
+                continue;   // on another processor
+            }
+            const scalar s = dist - part.radius;
+            const scalar Iu = 0.5*(1 - std::tanh(b_*s/delta));     // Eq. (37)
+
+            cell_.append(celli);
+            Iu_.append(Iu);
+            Ilambda_.append(1.0);                                  // Eq. (36)
+            r_.append(r);
+            IuSum[celli] += Iu;
+            ++count[celli];
+        }
+    }
+    offset_[particles_.size()] = cell_.size();
+
+    // Overlaps: I_lambda = 1/n where n particles cover a cell
+    forAll(cell_, e)
+    {
+        Ilambda_[e] = 1.0/count[cell_[e]];
+    }
+    forAll(count, celli)
+    {
+        covered_[celli] = count[celli] > 0;
+        IuScale_[celli] = 1.0/max(scalar(1), IuSum[celli]);
+    }
+}
+
+
+void Foam::particleForcing::truncateLambda(volVectorField& lambda) const
+{
+    vectorField& l = lambda.primitiveFieldRef();
+    forAll(l, celli)
+    {
+        if (!covered_[celli])
+        {
+            l[celli] = Zero;
+        }
+    }
+    lambda.correctBoundaryConditions();
+}
+
+
+Foam::List<Foam::scalar> Foam::particleForcing::integrals
+(
+    const volVectorField& U,
+    const volVectorField& lambda
+) const
+{
+    const label width = 8;    // fdm::coupler::layout::integralsWidth
+    List<scalar> result(width*particles_.size(), 0.0);
+
+    const scalarField& V = grid_.mesh().V();
+    const vectorField& u = U.primitiveField();
+    const vectorField& l = lambda.primitiveField();
+
+    forAll(particles_, p)
+    {
+        scalar Vu = 0, Ju = 0;
+        vector F(Zero), T(Zero);
+        for (label e = offset_[p]; e < offset_[p+1]; ++e)
+        {
+            const label celli = cell_[e];
+            const vector& r = r_[e];
+            // Integrand of Eq. (32): I_u u*/alpha - I_lambda lambda^n
+            const vector g = Iu_[e]*u[celli]/alpha_ - Ilambda_[e]*l[celli];
+            Vu += Iu_[e]*V[celli];
+            Ju += Iu_[e]*(2.0/3.0)*magSqr(r)*V[celli];
+            F += g*V[celli];
+            T += (r ^ g)*V[celli];
+        }
+        scalar* rec = &result[width*p];
+        rec[0] = Vu;
+        rec[1] = Ju;
+        for (direction d = 0; d < 3; ++d)
+        {
+            rec[2 + d] = rhoFluid_*F[d];
+            rec[5 + d] = rhoFluid_*T[d];
+        }
+    }
+
+    // Particles shared by processors: sum the partial integrals
+    Pstream::listCombineGather(result, plusEqOp<scalar>());
+    Pstream::listCombineScatter(result);
+    return result;
+}
+
+
+Foam::scalar Foam::particleForcing::correct
+(
+    volVectorField& U,
+    volVectorField& lambda,
+    const List<scalar>& velocities
+)
+{
+    const scalarField& V = grid_.mesh().V();
+    vectorField& u = U.primitiveFieldRef();
+    vectorField& l = lambda.primitiveFieldRef();
+
+    // Corrections are computed from u* for every particle before any is
+    // applied, so that overlapping particles see the same u*.
+    vectorField du(u.size(), Zero);
+    scalar sumDl2 = 0, sumL2 = 0;
+    maxCoreSlip_ = 0;
+
+    forAll(particles_, p)
+    {
+        const vector Up(velocities[6*p], velocities[6*p+1], velocities[6*p+2]);
+        const vector Wp(velocities[6*p+3], velocities[6*p+4], velocities[6*p+5]);
+        for (label e = offset_[p]; e < offset_[p+1]; ++e)
+        {
+            const label celli = cell_[e];
+            const vector slip = Up + (Wp ^ r_[e]) - u[celli];
+            const vector dl = Ilambda_[e]*slip/alpha_;              // Eq. (38c)
+            l[celli] += dl;
+            du[celli] += Iu_[e]*IuScale_[celli]*slip;               // Eq. (38d)
+            sumDl2 += magSqr(dl)*V[celli];
+            if (Iu_[e] > 0.99)
+            {
+                maxCoreSlip_ = max(maxCoreSlip_, mag(slip));
+            }
+        }
+    }
+    u += du;
+
+    forAll(cell_, e)
+    {
+        // each covered cell once: weight by 1/count via Ilambda
+        sumL2 += Ilambda_[e]*magSqr(l[cell_[e]])*V[cell_[e]];
+    }
+
+    reduce(sumDl2, sumOp<scalar>());
+    reduce(sumL2, sumOp<scalar>());
+    reduce(maxCoreSlip_, maxOp<scalar>());
+
+    U.correctBoundaryConditions();
+    lambda.correctBoundaryConditions();
+
+    return Foam::sqrt(sumDl2/max(sumL2, VSMALL));
+}
+
+
+Foam::List<Foam::scalar> Foam::particleForcing::hydrodynamicForces
+(
+    const volVectorField& lambda
+) const
+{
+    List<scalar> result(6*particles_.size(), 0.0);
+    const scalarField& V = grid_.mesh().V();
+    const vectorField& l = lambda.primitiveField();
+
+    forAll(particles_, p)
+    {
+        vector F(Zero), T(Zero);
+        for (label e = offset_[p]; e < offset_[p+1]; ++e)
+        {
+            const vector f = -rhoFluid_*Ilambda_[e]*l[cell_[e]]*V[cell_[e]];
+            F += f;
+            T += r_[e] ^ f;
+        }
+        for (direction d = 0; d < 3; ++d)
+        {
+            result[6*p + d] = F[d];
+            result[6*p + 3 + d] = T[d];
+        }
+    }
+    Pstream::listCombineGather(result, plusEqOp<scalar>());
+    Pstream::listCombineScatter(result);
+    return result;
+}
+
+
+void Foam::particleForcing::indicator(volScalarField& field) const
+{
+    scalarField& f = field.primitiveFieldRef();
+    f = 0;
+    forAll(cell_, e)
+    {
+        f[cell_[e]] += Iu_[e];
+    }
+    field.correctBoundaryConditions();
+}
+
+
+void Foam::particleForcing::pseudoTimeCoefficient
+(
+    volScalarField& rDTau,
+    scalar rInside,
+    scalar rOutside
+) const
+{
+    scalarField& f = rDTau.primitiveFieldRef();
+    forAll(f, celli)
+    {
+        f[celli] = covered_[celli] ? rInside : rOutside;
+    }
+    rDTau.correctBoundaryConditions();
+}

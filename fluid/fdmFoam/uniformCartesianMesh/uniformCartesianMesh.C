@@ -1,0 +1,141 @@
+#include "uniformCartesianMesh.H"
+#include "volFields.H"
+#include "cyclicPolyPatch.H"
+#include "processorPolyPatch.H"
+
+// * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
+
+void Foam::uniformCartesianMesh::checkUniform() const
+{
+    // Every cell a cube of side delta_: the indicator functions (Eqs. 34-37)
+    // and alpha_lambda = Delta^2 rho_f/eta assume one mesh size.
+    const scalar cellVolume = pow3(delta_);
+    const scalarField& V = mesh_.V();
+
+    forAll(V, celli)
+    {
+        if (mag(V[celli] - cellVolume) > 1e-6*cellVolume)
+        {
+            FatalErrorInFunction
+                << "The mesh (constant/polyMesh) is not a uniform Cartesian "
+                << "mesh: cell " << celli << " at "
+                << mesh_.cellCentres()[celli] << " has volume " << V[celli]
+                << " but cubes of side Delta = " << delta_
+                << " have " << cellVolume << nl
+                << "    fdmFoam needs cubic cells of one size "
+                << "(blockMesh with equal spacing in x, y and z)."
+                << exit(FatalError);
+        }
+    }
+
+    const vector L = bounds_.span();
+    for (direction d = 0; d < vector::nComponents; ++d)
+    {
+        const scalar n = L[d]/delta_;
+        if (mag(n - std::round(n)) > 1e-6*n)
+        {
+            FatalErrorInFunction
+                << "The mesh extent in direction " << d << " (" << L[d]
+                << ") is not a whole number of cells of size " << delta_
+                << exit(FatalError);
+        }
+    }
+}
+
+
+void Foam::uniformCartesianMesh::findPeriodicDirections()
+{
+    periodic_ = Vector<bool>(false, false, false);
+
+    for (const polyPatch& pp : mesh_.boundaryMesh())
+    {
+        if (!isA<cyclicPolyPatch>(pp) || isA<processorPolyPatch>(pp))
+        {
+            continue;
+        }
+        // The patch normal direction is the periodic direction. A processor
+        // may hold no face of the patch, hence the reduction.
+        vector sumNormal(Zero);
+        forAll(pp, facei)
+        {
+            sumNormal += cmptMag(pp.faceNormals()[facei]);
+        }
+        reduce(sumNormal, sumOp<vector>());
+        if (mag(sumNormal) > 0)
+        {
+            const direction d =
+                findMax(List<scalar>({sumNormal.x(), sumNormal.y(), sumNormal.z()}));
+            periodic_[d] = true;
+        }
+    }
+}
+
+
+void Foam::uniformCartesianMesh::buildCellMap()
+{
+    const vectorField& C = mesh_.cellCentres();
+    const point& origin = bounds_.min();
+
+    Vector<label> lo(labelMax, labelMax, labelMax);
+    Vector<label> hi(labelMin, labelMin, labelMin);
+    List<Vector<label>> ijk(C.size());
+
+    forAll(C, celli)
+    {
+        for (direction d = 0; d < 3; ++d)
+        {
+            ijk[celli][d] = label(std::floor((C[celli][d] - origin[d])/delta_));
+            lo[d] = min(lo[d], ijk[celli][d]);
+            hi[d] = max(hi[d], ijk[celli][d]);
+        }
+    }
+
+    if (C.empty())
+    {
+        localLo_ = Vector<label>(0, 0, 0);
+        localN_ = Vector<label>(0, 0, 0);
+        cellMap_.clear();
+        return;
+    }
+
+    localLo_ = lo;
+    localN_ = Vector<label>(hi.x()-lo.x()+1, hi.y()-lo.y()+1, hi.z()-lo.z()+1);
+    cellMap_.setSize(localN_.x()*localN_.y()*localN_.z(), -1);
+
+    forAll(C, celli)
+    {
+        const label li = ijk[celli].x() - lo.x();
+        const label lj = ijk[celli].y() - lo.y();
+        const label lk = ijk[celli].z() - lo.z();
+        cellMap_[li + localN_.x()*(lj + localN_.y()*lk)] = celli;
+    }
+}
+
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::uniformCartesianMesh::uniformCartesianMesh(const fvMesh& mesh)
+:
+    mesh_(mesh),
+    bounds_(mesh.points(), true),
+    delta_(Foam::cbrt(gMax(mesh.V()))),
+    nCells_(),
+    periodic_(false, false, false)
+{
+    checkUniform();
+    const vector L = bounds_.span();
+    nCells_ = Vector<label>
+    (
+        label(std::round(L.x()/delta_)),
+        label(std::round(L.y()/delta_)),
+        label(std::round(L.z()/delta_))
+    );
+    findPeriodicDirections();
+    buildCellMap();
+
+    Info<< "Uniform Cartesian mesh: " << nCells_.x() << " x " << nCells_.y()
+        << " x " << nCells_.z() << " cells of size Delta = " << delta_
+        << ", bounds " << bounds_
+        << ", periodic (x y z) = (" << periodic_.x() << " " << periodic_.y()
+        << " " << periodic_.z() << ")" << endl;
+}

@@ -1,0 +1,230 @@
+"""Writing and running coupled cases (OpenFOAM fluid/ + LIGGGHTS dem/), see docs/cases.md."""
+import os
+import subprocess
+import time
+
+from . import PROJECT_DIR
+
+HEADER = """FoamFile
+{{
+    version     2.0;
+    format      ascii;
+    class       {cls};
+    object      {obj};
+}}
+"""
+
+
+def foam_file(path, cls, body):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write(HEADER.format(cls=cls, obj=os.path.basename(path)))
+        f.write(body)
+
+
+def foam_vector(v):
+    return "(%.17g %.17g %.17g)" % tuple(v)
+
+
+class Box:
+    """A box meshed with cubic cells of side delta. faces[axis] is 'cyclic' or a wall velocity pair
+    ((ux, uy, uz) at the low face, (ux, uy, uz) at the high face); 'slip' for slip walls."""
+
+    def __init__(self, lo, hi, delta, faces=("cyclic", "cyclic", "cyclic")):
+        self.lo, self.hi, self.delta, self.faces = tuple(lo), tuple(hi), float(delta), faces
+        self.n = []
+        for d in range(3):
+            n = (self.hi[d] - self.lo[d]) / self.delta
+            if abs(n - round(n)) > 1e-9 * n:
+                raise ValueError("box extent %g in %s is not a whole number of cells of %g"
+                                 % (self.hi[d] - self.lo[d], "xyz"[d], self.delta))
+            self.n.append(int(round(n)))
+
+    @property
+    def volume(self):
+        return (self.hi[0] - self.lo[0]) * (self.hi[1] - self.lo[1]) * (self.hi[2] - self.lo[2])
+
+    def periodic(self):
+        return [f == "cyclic" for f in self.faces]
+
+
+def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicator=(5.0, 0.3),
+                     tol_lambda=1e-4, n_max=500, n_min=1, first_step=None, tol_u=1e-6, tol_p=5e-6,
+                     pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
+                     n_correctors=2, extra_fdm=""):
+    """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/)."""
+    x0, y0, z0 = box.lo
+    x1, y1, z1 = box.hi
+    names = ("x", "y", "z")
+    # block faces by axis: (low face, high face) as vertex quadruples of the hex 0..7
+    quads = {0: ("(0 4 7 3)", "(1 2 6 5)"), 1: ("(0 1 5 4)", "(3 7 6 2)"), 2: ("(0 3 2 1)", "(4 5 6 7)")}
+    patches = []
+    u_bc, p_bc = [], []
+    for d in range(3):
+        lo_q, hi_q = quads[d]
+        face = box.faces[d]
+        if face == "cyclic":
+            patches.append("    %sLow { type cyclic; neighbourPatch %sHigh; faces (%s); }" % (names[d], names[d], lo_q))
+            patches.append("    %sHigh { type cyclic; neighbourPatch %sLow; faces (%s); }" % (names[d], names[d], hi_q))
+            for side in ("Low", "High"):
+                u_bc.append("    %s%s { type cyclic; }" % (names[d], side))
+                p_bc.append("    %s%s { type cyclic; }" % (names[d], side))
+        else:
+            for side, q, i in (("Low", lo_q, 0), ("High", hi_q, 1)):
+                patches.append("    %s%s { type wall; faces (%s); }" % (names[d], side, q))
+                if face == "slip":
+                    u_bc.append("    %s%s { type slip; }" % (names[d], side))
+                else:
+                    u_bc.append("    %s%s { type fixedValue; value uniform %s; }"
+                                % (names[d], side, foam_vector(face[i])))
+                p_bc.append("    %s%s { type fixedFluxPressure; value uniform 0; }" % (names[d], side))
+
+    foam_file(os.path.join(case_dir, "system/blockMeshDict"), "dictionary", """
+convertToMeters 1;
+vertices
+(
+    (%(x0).17g %(y0).17g %(z0).17g) (%(x1).17g %(y0).17g %(z0).17g)
+    (%(x1).17g %(y1).17g %(z0).17g) (%(x0).17g %(y1).17g %(z0).17g)
+    (%(x0).17g %(y0).17g %(z1).17g) (%(x1).17g %(y0).17g %(z1).17g)
+    (%(x1).17g %(y1).17g %(z1).17g) (%(x0).17g %(y1).17g %(z1).17g)
+);
+blocks ( hex (0 1 2 3 4 5 6 7) (%(nx)d %(ny)d %(nz)d) simpleGrading (1 1 1) );
+boundary
+(
+%(patches)s
+);
+""" % dict(x0=x0, y0=y0, z0=z0, x1=x1, y1=y1, z1=z1, nx=box.n[0], ny=box.n[1], nz=box.n[2],
+           patches="\n".join(patches)))
+
+    foam_file(os.path.join(case_dir, "system/controlDict"), "dictionary", """
+application     fdmFoam;
+startFrom       latestTime;
+startTime       0;
+stopAt          endTime;
+endTime         1e30;       // time is driven by fdmDEM
+deltaT          1;          // overridden by fdmDEM's time step
+writeControl    timeStep;
+writeInterval   %d;
+purgeWrite      0;
+writeFormat     binary;
+writePrecision  12;
+writeCompression off;
+timeFormat      general;
+timePrecision   8;
+runTimeModifiable false;
+""" % write_interval)
+
+    foam_file(os.path.join(case_dir, "system/fvSchemes"), "dictionary", """
+ddtSchemes { default none; }
+gradSchemes { default Gauss linear; }
+divSchemes { default none; }
+laplacianSchemes { default Gauss linear orthogonal; }
+interpolationSchemes { default linear; }
+snGradSchemes { default orthogonal; }
+""")
+
+    foam_file(os.path.join(case_dir, "system/fvSolution"), "dictionary", """
+solvers
+{
+    p
+    {
+        solver          GAMG;
+        smoother        GaussSeidel;
+        tolerance       %(tol_p)g;     // tol_p of the paper (4.4.5)
+        relTol          0.01;
+    }
+    pFinal
+    {
+        $p;
+        relTol          0;
+    }
+    U
+    {
+        solver          smoothSolver;
+        smoother        symGaussSeidel;
+        tolerance       %(tol_u)g;     // tol_u of the paper (4.4.5)
+        relTol          0;
+    }
+}
+PISO
+{
+    momentumPredictor yes;
+    nCorrectors     %(ncorr)d;
+    nNonOrthogonalCorrectors 0;
+    pRefCell        0;
+    pRefValue       0;
+}
+""" % dict(tol_p=tol_p, tol_u=tol_u, ncorr=n_correctors))
+
+    foam_file(os.path.join(case_dir, "system/decomposeParDict"), "dictionary", """
+numberOfSubdomains 2;
+method          hierarchical;   // scotch/metis are stubs in Debian's OpenFOAM
+coeffs { n (2 1 1); order xyz; }
+hierarchicalCoeffs { n (2 1 1); order xyz; }
+""")
+
+    foam_file(os.path.join(case_dir, "constant/transportProperties"), "dictionary", """
+nu              %.17g;   // kinematic viscosity eta/rho_f [m2/s]
+rho             %.17g;   // fluid density rho_f [kg/m3]
+""" % (nu, rho))
+
+    first = ""
+    if first_step:
+        first = "\n    firstStep { tolLambda %g; nMax %d; }" % (first_step[0], first_step[1])
+    foam_file(os.path.join(case_dir, "constant/fdmProperties"), "dictionary", """
+indicator { b %(b).17g; c %(c).17g; }     // Eqs. (34)-(37)
+gradP0          %(grad)s;   // imposed mean pressure gradient [Pa/m] (Eq. 42)
+pseudoTimeFactor %(ptf).17g;          // pseudo-time step / alpha_lambda inside the particles
+pseudoTimeFactorOutside %(ptfo).17g;   // ... outside them (0 = steady Stokes)
+nParticles      %(np)d;
+innerIterations
+{
+    tolLambda   %(tol).17g;
+    nMin        %(nmin)d;
+    nMax        %(nmax)d;%(first)s
+}
+coupling
+{
+    transport   socket;
+    host        127.0.0.1;
+    port        0;
+    portFile    "coupling.port";
+    connectTimeout 60;
+    receiveTimeout 600;
+}
+%(extra)s
+""" % dict(b=indicator[0], c=indicator[1], grad=foam_vector(grad_p0), ptf=pseudo_time_factor,
+           ptfo=pseudo_time_factor if pseudo_time_factor_outside is None else pseudo_time_factor_outside,
+           np=n_particles, tol=tol_lambda, nmin=n_min, nmax=n_max, first=first, extra=extra_fdm))
+
+    foam_file(os.path.join(case_dir, "0/U"), "volVectorField", """
+dimensions      [0 1 -1 0 0 0 0];
+internalField   uniform (0 0 0);
+boundaryField
+{
+%s
+}
+""" % "\n".join(u_bc))
+    foam_file(os.path.join(case_dir, "0/p"), "volScalarField", """
+dimensions      [0 2 -2 0 0 0 0];
+internalField   uniform 0;
+boundaryField
+{
+%s
+}
+""" % "\n".join(p_bc))
+
+
+def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
+    """Run fdmRun on case_dir; returns the wall time in seconds. Raises RuntimeError with the
+    end of fdmRun's report if the run fails."""
+    cmd = [os.path.join(PROJECT_DIR, "scripts", "fdmRun"), "-f", str(np_fluid), "-d", str(np_dem)]
+    if quiet:
+        cmd.append("--quiet")
+    cmd += list(extra) + [case_dir]
+    t0 = time.time()
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    wall = time.time() - t0
+    if proc.returncode != 0:
+        raise RuntimeError("fdmRun %s failed (exit %d):\n%s" % (case_dir, proc.returncode, proc.stdout[-4000:]))
+    return wall

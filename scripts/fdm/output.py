@@ -1,0 +1,28 @@
+"""Reading fdmFoam's per-step and per-particle records (postProcessing/fdm/*.dat)."""
+import os
+
+import numpy as np
+
+STEP_COLUMNS = ("step time innerIterations residualLambda converged meanUx meanUy meanUz "
+                "lambdaForceX lambdaForceY lambdaForceZ fluidSeconds particleSeconds exchangeSeconds maxCoreSlip").split()
+PARTICLE_COLUMNS = "step tag x y z radius Ux Uy Uz Wx Wy Wz Fx Fy Fz Tx Ty Tz Vu".split()
+
+
+def _read(path, columns):
+    if not os.path.isfile(path):
+        raise FileNotFoundError("%s not found: did fdmFoam run?" % path)
+    data = np.loadtxt(path, comments="#", ndmin=2)
+    if data.size == 0:
+        raise ValueError("%s has no records" % path)
+    if data.shape[1] != len(columns):
+        raise ValueError("%s has %d columns, expected %d (%s)" % (path, data.shape[1], len(columns),
+                                                                  " ".join(columns)))
+    return {name: data[:, i] for i, name in enumerate(columns)}
+
+
+def steps(fluid_case):
+    return _read(os.path.join(fluid_case, "postProcessing", "fdm", "steps.dat"), STEP_COLUMNS)
+
+
+def particles(fluid_case):
+    return _read(os.path.join(fluid_case, "postProcessing", "fdm", "particles.dat"), PARTICLE_COLUMNS)
