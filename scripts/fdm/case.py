@@ -186,7 +186,7 @@ innerIterations
 coupling
 {
     transport   socket;
-    host        127.0.0.1;
+    host        "127.0.0.1";
     port        0;
     portFile    "coupling.port";
     connectTimeout 60;
@@ -228,3 +228,37 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     if proc.returncode != 0:
         raise RuntimeError("fdmRun %s failed (exit %d):\n%s" % (case_dir, proc.returncode, proc.stdout[-4000:]))
     return wall
+
+
+def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",
+                    before_run="", runs=("run 1",), name="in.dem", data_file="spheres.data"):
+    """LIGGGHTS input for fdmDEM: spheres [(x, y, z, radius), ...] from a data file, no contact,
+    fix fdm/couple connected to ../fluid. Returns the input path."""
+    os.makedirs(dem_dir, exist_ok=True)
+    with open(os.path.join(dem_dir, data_file), "w") as f:
+        f.write("spheres for fdmDEM\n\n%d atoms\n1 atom types\n\n" % len(spheres))
+        for d, axis in enumerate("xyz"):
+            f.write("%.17g %.17g %slo %shi\n" % (box.lo[d], box.hi[d], axis, axis))
+        f.write("\nAtoms\n\n")
+        for i, (x, y, z, a) in enumerate(spheres):
+            # atom_style sphere: id type diameter density x y z
+            f.write("%d 1 %.17g %.17g %.17g %.17g %.17g\n" % (i + 1, 2 * a, density, x, y, z))
+    boundary = " ".join("p" if p else "f" for p in box.periodic())
+    path = os.path.join(dem_dir, name)
+    with open(path, "w") as f:
+        f.write("""atom_style      sphere
+atom_modify     map array sort 0 0.0
+boundary        %(boundary)s
+newton          off
+communicate     single vel yes
+units           si
+read_data       %(data)s
+pair_style      none
+neighbor        %(skin).17g bin
+timestep        %(dt).17g
+%(before)s
+fix             couple all fdm/couple portfile ../fluid/coupling.port %(fix)s
+%(runs)s
+""" % dict(boundary=boundary, data=data_file, skin=0.1 * min(s[3] for s in spheres) if spheres else 0.1,
+           dt=dt, before=before_run, fix=fix_options, runs="\n".join(runs)))
+    return path

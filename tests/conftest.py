@@ -1,0 +1,53 @@
+"""Shared fixtures of the coupled tests: they run the real fdmFoam (OpenFOAM) against the real
+fdmDEM (LIGGGHTS) through fdmRun, on small meshes. ./Alltest builds both first."""
+import importlib.util
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+TESTS = os.path.dirname(os.path.abspath(__file__))
+PROJECT = os.path.dirname(TESTS)
+sys.path.insert(0, os.path.join(PROJECT, "scripts"))
+
+FULL = os.environ.get("FDM_FULL") == "1"
+
+
+def load_case_module(name):
+    path = os.path.join(PROJECT, "cases", name, name + ".py")
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="session")
+def env():
+    """The project's environment (etc/bashrc) as a dict, for subprocesses."""
+    out = subprocess.run(["bash", "-c", ". '%s/etc/bashrc' && env -0" % PROJECT], check=True,
+                         stdout=subprocess.PIPE).stdout
+    environment = dict(item.split("=", 1) for item in out.decode().split("\0") if "=" in item)
+    for exe in ("fdmFoam", "fdmDEM"):
+        if shutil.which(exe, path=environment["PATH"]) is None:
+            pytest.fail("%s not built: run ./Allwmake" % exe)
+    return environment
+
+
+@pytest.fixture(scope="session")
+def periodic_array():
+    return load_case_module("periodicArray")
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "full: full-size validation, run by ./Alltest --full only")
+
+
+def pytest_collection_modifyitems(config, items):
+    if FULL:
+        return
+    skip = pytest.mark.skip(reason="full-size validation: ./Alltest --full")
+    for item in items:
+        if "full" in item.keywords:
+            item.add_marker(skip)
