@@ -35,7 +35,7 @@ def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None,
 
 def run_fdm(root, env, timeout=60):
     t0 = time.time()
-    proc = subprocess.run([FDMRUN, "--quiet", root], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    proc = subprocess.run([FDMRUN, "--quiet", root], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, errors="replace",
                           text=True, env=env, timeout=timeout)
     return proc.returncode, proc.stdout, time.time() - t0
 
@@ -114,7 +114,7 @@ def test_fluid_alone_times_out(tmp_path, env):
     subprocess.run(["blockMesh", "-case", os.path.join(root, "fluid")], env=env, check=True,
                    stdout=subprocess.DEVNULL)
     t0 = time.time()
-    proc = subprocess.run(["fdmFoam", "-case", os.path.join(root, "fluid")], env=env, text=True,
+    proc = subprocess.run(["fdmFoam", "-case", os.path.join(root, "fluid")], env=env, text=True, errors="replace",
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60)
     assert proc.returncode != 0
     assert re.search(r"no peer|never connected|within", proc.stdout), proc.stdout[-2000:]
@@ -125,7 +125,7 @@ def test_dem_alone_times_out(tmp_path, env):
     """fdmDEM waits for a fluid solver that never starts: a clear error within the timeout."""
     root = make_case(tmp_path)
     t0 = time.time()
-    proc = subprocess.run(["fdmDEM", "-in", "in.dem"], cwd=os.path.join(root, "dem"), env=env, text=True,
+    proc = subprocess.run(["fdmDEM", "-in", "in.dem"], cwd=os.path.join(root, "dem"), env=env, text=True, errors="replace",
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60)
     assert proc.returncode != 0
     assert re.search(r"coupling\.port|connect", proc.stdout), proc.stdout[-2000:]

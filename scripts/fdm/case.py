@@ -223,7 +223,7 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
         cmd.append("--quiet")
     cmd += list(extra) + [case_dir]
     t0 = time.time()
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
     wall = time.time() - t0
     if proc.returncode != 0:
         raise RuntimeError("fdmRun %s failed (exit %d):\n%s" % (case_dir, proc.returncode, proc.stdout[-4000:]))

@@ -131,6 +131,13 @@ std::unique_ptr<Transport> connect(const Options& options);
 std::vector<unsigned char> encode(const Message& m);
 Message decode(const unsigned char* bytes, size_t size);  // throws CouplerError if malformed
 
+// Every message starts with a header of this many bytes.
+const size_t headerSize = 40;
+// Total encoded size of the message whose header starts at `header` (headerSize bytes); throws
+// CouplerError if the header is malformed (bad magic, other version, unknown type, absurd sizes).
+// Lets a reader walk a record file or a stream message by message.
+size_t encodedSize(const unsigned char* header);
+
 }  // namespace coupler
 }  // namespace fdm
 

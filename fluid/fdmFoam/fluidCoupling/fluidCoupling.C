@@ -56,9 +56,9 @@ Foam::fluidCoupling::fluidCoupling(const Time& runTime, const dictionary& dict)
     fileName directory = dict.lookupOrDefault<fileName>("directory", "coupling");
     fileName record = dict.lookupOrDefault<fileName>("record", "");
     // Relative paths are relative to the case directory
-    if (!portFile.empty() && !portFile.isAbsolute()) portFile = runTime.path()/portFile;
-    if (!directory.isAbsolute()) directory = runTime.path()/directory;
-    if (!record.empty() && !record.isAbsolute()) record = runTime.path()/record;
+    if (!portFile.empty() && !portFile.isAbsolute()) portFile = runTime.globalPath()/portFile;
+    if (!directory.isAbsolute()) directory = runTime.globalPath()/directory;
+    if (!record.empty() && !record.isAbsolute()) record = runTime.globalPath()/record;
     opt.portFile = portFile;
     opt.directory = directory;
     opt.recordFile = record;

@@ -1,7 +1,7 @@
 #include "uniformCartesianMesh.H"
 #include "volFields.H"
 #include "cyclicPolyPatch.H"
-#include "processorPolyPatch.H"
+#include "processorCyclicPolyPatch.H"
 
 // * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
 
@@ -46,25 +46,43 @@ void Foam::uniformCartesianMesh::checkUniform() const
 void Foam::uniformCartesianMesh::findPeriodicDirections()
 {
     periodic_ = Vector<bool>(false, false, false);
+    const polyBoundaryMesh& patches = mesh_.boundaryMesh();
 
-    for (const polyPatch& pp : mesh_.boundaryMesh())
+    // Sum of |face normal| per global cyclic patch. On a decomposed mesh the
+    // faces of a cyclic split between processors sit on processorCyclic
+    // patches, which refer to it; a processor may hold none of its faces.
+    const label nGlobal = patches.nNonProcessor();
+    List<vector> sumNormal(nGlobal, Zero);
+    for (const polyPatch& pp : patches)
     {
-        if (!isA<cyclicPolyPatch>(pp) || isA<processorPolyPatch>(pp))
+        label owner = -1;
+        if (isA<processorCyclicPolyPatch>(pp))
+        {
+            owner = refCast<const processorCyclicPolyPatch>(pp).referPatchID();
+        }
+        else if (pp.index() < nGlobal && isA<cyclicPolyPatch>(pp))
+        {
+            owner = pp.index();
+        }
+        if (owner < 0)
         {
             continue;
         }
-        // The patch normal direction is the periodic direction. A processor
-        // may hold no face of the patch, hence the reduction.
-        vector sumNormal(Zero);
         forAll(pp, facei)
         {
-            sumNormal += cmptMag(pp.faceNormals()[facei]);
+            sumNormal[owner] += cmptMag(pp.faceNormals()[facei]);
         }
-        reduce(sumNormal, sumOp<vector>());
-        if (mag(sumNormal) > 0)
+    }
+    Pstream::listCombineGather(sumNormal, plusEqOp<vector>());
+    Pstream::listCombineScatter(sumNormal);
+
+    forAll(sumNormal, patchi)
+    {
+        const vector& n = sumNormal[patchi];
+        if (isA<cyclicPolyPatch>(patches[patchi]) && mag(n) > 0)
         {
             const direction d =
-                findMax(List<scalar>({sumNormal.x(), sumNormal.y(), sumNormal.z()}));
+                (n.x() >= n.y() && n.x() >= n.z()) ? 0 : (n.y() >= n.z() ? 1 : 2);
             periodic_[d] = true;
         }
     }
