@@ -10,7 +10,6 @@ namespace coupler {
 
 namespace {
 const char magic[4] = {'F', 'D', 'M', 'C'};
-const size_t headerSize = 40;
 // Sanity limits: a corrupted header must give an error, not a huge allocation.
 const uint64_t maxRecords = 100000000ULL;
 const uint32_t maxWidth = 1024;

@@ -20,11 +20,7 @@
 namespace fdm {
 namespace coupler {
 
-size_t encodedSize(const unsigned char* header);  // message.cpp
-
 namespace {
-
-const size_t headerSize = 40;
 
 double now()
 {
