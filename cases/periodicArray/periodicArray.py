@@ -86,6 +86,8 @@ def run_configuration(workdir, L_over_a, a_over_delta, n_positions, b=5.0, c=0.3
     grad_p0 = -F / V0
     name = "L%g_ad%g_c%g_b%g_tol%g_n%d_np%d_%s" % (L_over_a, a_over_delta, c, b, tol_lambda, n_positions, np_fluid,
                                                 "xyz"[direction])
+    if points:
+        name += "_points%d" % len(points)
     gradient = [0.0, 0.0, 0.0]
     gradient[direction] = grad_p0
     run_dir = os.path.join(workdir, name)
