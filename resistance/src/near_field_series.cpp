@@ -1,0 +1,474 @@
+// Far-field recurrences and near-field constants: see near_field_series.hpp for the sources.
+#include "fdm/resistance/near_field_series.hpp"
+
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+namespace fdm {
+namespace resistance {
+
+const char* pairFunctionName(PairFunction f)
+{
+    static const char* names[NumPairFunctions] = {"XA", "YA", "YB", "XC", "YC", "XG",
+                                                  "YG", "YH", "XM", "YM", "ZM", "XP"};
+    return names[f];
+}
+
+double NearFieldForm::operator()(double xi) const { return (*this)(xi, std::log(1.0 / xi)); }
+
+NearFieldForm NearFieldForm::scaled(double s) const
+{
+    NearFieldForm r;
+    r.inv = s * inv;
+    r.log = s * log;
+    r.c0 = s * c0;
+    r.xlog = s * xlog;
+    return r;
+}
+
+double hurwitzZeta3(double a)
+{
+    // Direct sum of the first terms, Euler-Maclaurin for the tail (next term 0.15 x^-10 at x = K + a).
+    const int K = 20;
+    double sum = 0;
+    for (int k = 0; k < K; ++k) sum += 1.0 / ((k + a) * (k + a) * (k + a));
+    const double x = K + a, x2 = x * x;
+    const double x4 = x2 * x2;
+    return sum + 1.0 / (2 * x2) + 1.0 / (2 * x2 * x) + 1.0 / (4 * x4) - 1.0 / (12 * x4 * x2) + 1.0 / (12 * x4 * x4);
+}
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// P, Q, V coefficient tables of the twin multipole expansions, indexed (n, p, q) with p + q <= N.
+// Every non-zero entry has n <= p + 2 (the recurrences only reach back through p - n + 1 >= 0, and
+// the starting values sit at p = q = 0, n <= 2), so only that triangle is stored.
+class TripleTable {
+public:
+    explicit TripleTable(int order) : order_(order), offset_((order + 1) * (order + 1), 0)
+    {
+        std::size_t size = 0;
+        for (int p = 0; p <= order; ++p)
+            for (int q = 0; p + q <= order; ++q) {
+                offset_[p * (order + 1) + q] = size;
+                size += p + 3;
+            }
+        data_.assign(size, 0.0);
+    }
+    double operator()(int n, int p, int q) const
+    {
+        if (n < 0 || p < 0 || q < 0 || p + q > order_ || n > p + 2) return 0.0;
+        return data_[offset_[p * (order_ + 1) + q] + n];
+    }
+    double& at(int n, int p, int q) { return data_[offset_[p * (order_ + 1) + q] + n]; }
+    int order() const { return order_; }
+
+private:
+    int order_;
+    std::vector<std::size_t> offset_;
+    std::vector<double> data_;
+};
+
+struct RecurrenceTables {
+    TripleTable P, Q, V;
+    explicit RecurrenceTables(int order) : P(order), Q(order), V(order) {}
+};
+
+class Binomial {
+public:
+    explicit Binomial(int nmax) : nmax_(nmax), table_((nmax + 1) * (nmax + 1), 0.0)
+    {
+        for (int n = 0; n <= nmax; ++n) {
+            table_[n * (nmax + 1)] = 1.0;
+            for (int k = 1; k <= n; ++k)
+                table_[n * (nmax + 1) + k] = table_[(n - 1) * (nmax + 1) + k - 1] +
+                                             (k <= n - 1 ? table_[(n - 1) * (nmax + 1) + k] : 0.0);
+        }
+    }
+    double operator()(int n, int k) const { return (k < 0 || k > n) ? 0.0 : table_[n * (nmax_ + 1) + k]; }
+
+private:
+    int nmax_;
+    std::vector<double> table_;
+};
+
+// Axisymmetric problems (X^A, X^G from n = 1 start; X^M from n = 2): J&O (3.9)-(3.12), T23 (5)-(8).
+std::unique_ptr<RecurrenceTables> buildAxisymmetric(int order, int startIndex)
+{
+    std::unique_ptr<RecurrenceTables> t(new RecurrenceTables(order));
+    const Binomial C(2 * order + 4);
+    TripleTable &P = t->P, &V = t->V;
+    P.at(startIndex, 0, 0) = V.at(startIndex, 0, 0) = 1.0;
+    for (int level = 1; level <= order; ++level)
+        for (int p = 0; p <= level; ++p) {
+            const int q = level - p;
+            for (int n = 1; n <= p + 2; ++n) {
+                const double nn = n;
+                double sumP = 0, sumV = 0;
+                for (int s = 1; s <= q; ++s) {
+                    const double ss = s, binom = C(n + s, n);
+                    const double viaP = nn * (2 * nn + 1) * (2 * nn * ss - nn - ss + 2) /
+                                        (2 * (nn + 1) * (2 * ss - 1) * (nn + ss)) * P(s, q - s, p - n + 1);
+                    const double viaPlower = nn * (2 * nn - 1) / (2 * (nn + 1)) * P(s, q - s, p - n - 1);
+                    const double viaV = nn * (4 * nn * nn - 1) / (2 * (nn + 1) * (2 * ss + 1)) * V(s, q - s - 2, p - n + 1);
+                    sumP += binom * (viaP - viaPlower - viaV);
+                    sumV += binom * P(s, q - s, p - n - 1);
+                }
+                P.at(n, p, q) = sumP;
+                V.at(n, p, q) = sumP - 2 * nn / ((nn + 1) * (2 * nn + 3)) * sumV;
+            }
+        }
+    return t;
+}
+
+// Asymmetric problems (Y^A, Y^B, Y^G from a translation start; Y^C, Y^H from a rotation start,
+// Q(1,0,0) = 1; Y^M from n = 2): J&O (4.6)-(4.11), (7.3)-(7.5), J92 (58).
+enum AsymmetricStart { TranslationStart1, RotationStart1, TranslationStart2 };
+
+std::unique_ptr<RecurrenceTables> buildAsymmetric(int order, AsymmetricStart start)
+{
+    std::unique_ptr<RecurrenceTables> t(new RecurrenceTables(order));
+    const Binomial C(2 * order + 4);
+    TripleTable &P = t->P, &Q = t->Q, &V = t->V;
+    if (start == RotationStart1)
+        Q.at(1, 0, 0) = 1.0;
+    else {
+        const int n0 = (start == TranslationStart1) ? 1 : 2;
+        P.at(n0, 0, 0) = V.at(n0, 0, 0) = 1.0;
+    }
+    for (int level = 1; level <= order; ++level)
+        for (int p = 0; p <= level; ++p) {
+            const int q = level - p;
+            for (int n = 1; n <= p + 2; ++n) {
+                const double nn = n;
+                double sumP = 0, sumQ = 0, sumV = 0;
+                for (int s = 1; s <= q; ++s) {
+                    const double ss = s, binom = C(n + s, n + 1);
+                    const double coefP = (2 * nn + 1) / (2 * (nn + 1)) *
+                                         (3 * (nn + ss) - (nn * ss + 1) * (2 * nn * ss - ss - nn + 2)) /
+                                         (ss * (nn + ss) * (2 * ss - 1));
+                    sumP += binom * (coefP * P(s, q - s, p - n + 1) +
+                                     nn * (2 * nn - 1) / (2 * (nn + 1)) * P(s, q - s, p - n - 1) +
+                                     nn * (4 * nn * nn - 1) / (2 * (nn + 1) * (2 * ss + 1)) * V(s, q - s - 2, p - n + 1) -
+                                     2 * (4 * nn * nn - 1) / (3 * (nn + 1)) * Q(s, q - s - 1, p - n + 1));
+                    sumQ += binom * (ss / (nn + 1) * Q(s, q - s - 1, p - n) -
+                                     3 / (2 * nn * ss * (nn + 1)) * P(s, q - s, p - n));
+                    sumV += binom * P(s, q - s, p - n - 1);
+                }
+                P.at(n, p, q) = sumP;
+                Q.at(n, p, q) = sumQ;
+                V.at(n, p, q) = sumP + 2 * nn / ((nn + 1) * (2 * nn + 3)) * sumV;
+            }
+        }
+    return t;
+}
+
+// Z^M problem: J92 (73)-(76), starting at n = 2.
+std::unique_ptr<RecurrenceTables> buildZ(int order)
+{
+    std::unique_ptr<RecurrenceTables> t(new RecurrenceTables(order));
+    const Binomial C(2 * order + 4);
+    TripleTable &P = t->P, &Q = t->Q, &V = t->V;
+    P.at(2, 0, 0) = V.at(2, 0, 0) = 1.0;
+    for (int level = 1; level <= order; ++level)
+        for (int p = 0; p <= level; ++p) {
+            const int q = level - p;
+            for (int n = 1; n <= p + 2; ++n) {
+                const double nn = n;
+                double sumP = 0, sumQ = 0, sumV = 0;
+                for (int s = 2; s <= q; ++s) {
+                    const double ss = s, binom = C(n + s, n + 2);
+                    const double coefP = (2 * nn + 1) / (nn + 1) *
+                                         (nn * ss * (nn + ss - 2 * nn * ss - 2) - 4 * (2 * nn * ss - 4 * ss - 4 * nn + 2)) /
+                                         (2 * ss * (nn + ss) * (2 * ss - 1));
+                    sumP += binom * (-2 * (2 * nn + 1) * (2 * nn - 1) / (nn + 1) * Q(s, q - s - 1, p - n + 1) +
+                                     nn * (2 * nn + 1) * (2 * nn - 1) / (2 * (nn + 1) * (2 * ss + 1)) * V(s, q - s - 2, p - n + 1) +
+                                     coefP * P(s, q - s, p - n + 1) +
+                                     nn * (2 * nn - 1) / (2 * (nn + 1)) * P(s, q - s, p - n - 1));
+                    sumQ += binom * (ss / (nn + 1) * Q(s, q - s - 1, p - n) - 2 / (nn * ss * (nn + 1)) * P(s, q - s, p - n));
+                    sumV += binom * P(s, q - s, p - n - 1);
+                }
+                P.at(n, p, q) = sumP;
+                Q.at(n, p, q) = sumQ;
+                V.at(n, p, q) = sumP + 2 * nn / ((nn + 1) * (2 * nn + 3)) * sumV;
+            }
+        }
+    return t;
+}
+
+// ---------------------------------------------------------------------------------------------
+// A far-field series f_k(lambda) = scale 2^k sum_q c[k][q] lambda^(q + shift(k)), kept as the triangle
+// c[k][q] (lambda-independent) so that per-lambda sums cost O(order^2) and no recurrence.
+struct SeriesTriangle {
+    int order = 0;
+    bool oddPowerShift = false;  // the extra lambda^(k mod 2) of the C, H and M series
+    double scale = 1;
+    std::vector<std::vector<double> > c;
+
+    SeriesTriangle() {}
+    SeriesTriangle(const TripleTable& table, int n, double scale_, bool shift) : order(table.order()), oddPowerShift(shift), scale(scale_)
+    {
+        c.resize(order + 1);
+        for (int k = 0; k <= order; ++k) {
+            c[k].resize(k + 1);
+            for (int q = 0; q <= k; ++q) c[k][q] = table(n, k - q, q);
+        }
+    }
+
+    // f_k / (2 (1 + lambda))^k, computed without forming lambda^k (no overflow for large lambda, k).
+    double normalisedTerm(int k, double lambda) const
+    {
+        const double w = lambda / (1 + lambda), u = 1 / (1 + lambda);
+        double sum = 0, wq = 1;
+        const double uk = std::pow(u, k);
+        const double ratio = w / u;  // = lambda
+        // w^q u^(k-q) = u^k lambda^q; use it while it is representable, else the safe product
+        if (uk > 1e-280) {
+            double term = uk;
+            for (int q = 0; q <= k; ++q) {
+                sum += c[k][q] * term;
+                term *= ratio;
+            }
+        } else {
+            for (int q = 0; q <= k; ++q) {
+                sum += c[k][q] * wq * std::pow(u, k - q);
+                wq *= w;
+            }
+        }
+        if (oddPowerShift && (k % 2)) sum *= lambda;
+        return scale * sum;
+    }
+};
+
+enum SeriesId { SeriesXA, SeriesXG, SeriesYA, SeriesYB, SeriesYG, SeriesYC, SeriesYH, SeriesXM, SeriesYM, SeriesZM, NumSeries };
+
+// Orders: 100 as in T23's generator for A, B, C, G, H and X^M; 130 for Y^M and 200 for Z^M, whose sums
+// converge more slowly (T23 uses 130, and 150 / 200 for the even / odd Z^M sums).
+struct SeriesStore {
+    SeriesTriangle s[NumSeries];
+    SeriesStore(bool withM)
+    {
+        {
+            std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(100, 1);
+            s[SeriesXA] = SeriesTriangle(t->P, 1, 1.0, false);      // J&O (3.15), T23 (9)
+            s[SeriesXG] = SeriesTriangle(t->P, 2, 0.75, false);     // Ichiki et al. (94)
+        }
+        {
+            std::unique_ptr<RecurrenceTables> t = buildAsymmetric(100, TranslationStart1);
+            s[SeriesYA] = SeriesTriangle(t->P, 1, 1.0, false);      // J&O (4.12)
+            s[SeriesYB] = SeriesTriangle(t->Q, 1, 2.0, false);      // J&O (5.2), T23 (21)
+            s[SeriesYG] = SeriesTriangle(t->P, 2, 0.75, false);     // Ichiki et al. (115)
+        }
+        {
+            std::unique_ptr<RecurrenceTables> t = buildAsymmetric(100, RotationStart1);
+            s[SeriesYC] = SeriesTriangle(t->Q, 1, 1.0, true);       // J&O (7.6), T23 (29)
+            s[SeriesYH] = SeriesTriangle(t->P, 2, -0.375, true);    // Ichiki et al. (120)
+        }
+        if (withM) addM();
+    }
+    void addM()
+    {
+        if (!s[SeriesZM].c.empty()) return;
+        {
+            std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(100, 2);
+            s[SeriesXM] = SeriesTriangle(t->P, 2, 1.0, true);       // Ichiki et al. (105)
+        }
+        {
+            std::unique_ptr<RecurrenceTables> t = buildAsymmetric(130, TranslationStart2);
+            s[SeriesYM] = SeriesTriangle(t->P, 2, 1.0, true);       // Ichiki et al. (125)
+        }
+        {
+            std::unique_ptr<RecurrenceTables> t = buildZ(200);
+            s[SeriesZM] = SeriesTriangle(t->P, 2, 1.0, true);       // Ichiki et al. (131)
+        }
+    }
+};
+
+const SeriesStore& seriesStore(bool withM)
+{
+    // Function-local statics are initialised once, thread-safely (C++11).
+    static SeriesStore base(false);
+    if (!withM) return base;
+    static SeriesStore full(true);
+    return full;
+}
+
+// sum over m of parity (odd: 1, 3, ..., order-1; even: 2, 4, ..., order) of
+//   f_m/(2(1+lambda))^m - g1 - 2 g2/m + 4 g3/(m(m+2))
+// (the subtractions remove the terms that make the plain sums diverge: J&O (3.20)-(3.23)).
+enum Parity { Odd, Even };
+double subtractedSum(const SeriesTriangle& series, double lambda, Parity parity, int order, double g1, double g2, double g3)
+{
+    double sum = 0;
+    const int first = (parity == Odd) ? 1 : 2;
+    const int last = (parity == Odd) ? order - 1 : order;
+    for (int m = first; m <= last; m += 2)
+        sum += series.normalisedTerm(m, lambda) - g1 - 2 * g2 / m + 4 * g3 / (double(m) * (m + 2));
+    return sum;
+}
+
+NearFieldForm form(double inv, double log, double c0, double xlog)
+{
+    NearFieldForm f;
+    f.inv = inv;
+    f.log = log;
+    f.c0 = c0;
+    f.xlog = xlog;
+    return f;
+}
+
+}  // namespace
+
+double farFieldCoefficient(PairFunction family, int k, double lambda)
+{
+    const SeriesStore& store = seriesStore(false);
+    SeriesId id;
+    switch (family) {
+    case XA: id = SeriesXA; break;
+    case YA: id = SeriesYA; break;
+    case YB: id = SeriesYB; break;
+    case YC: id = SeriesYC; break;
+    case XG: id = SeriesXG; break;
+    case YG: id = SeriesYG; break;
+    case YH: id = SeriesYH; break;
+    default: throw std::invalid_argument("farFieldCoefficient: no far-field series kept for this family");
+    }
+    return store.s[id].normalisedTerm(k, lambda) * std::pow(2 * (1 + lambda), k);
+}
+
+NearFieldConstants computeNearFieldConstants(double lam, bool withM)
+{
+    if (!(lam > 0)) throw std::invalid_argument("computeNearFieldConstants: lambda must be positive");
+    const SeriesStore& store = seriesStore(withM);
+    const double L = std::log(2.0);
+    const double l1 = 1 + lam, l2 = lam * lam, l3 = l2 * lam, l4 = l3 * lam;
+    const double l1_2 = l1 * l1, l1_3 = l1_2 * l1;
+    const int M = 100;  // truncation of the A, B, C, G, H sums (T23's generator)
+    NearFieldConstants k;
+    k.lambda = lam;
+    k.hasMFunctions = withM;
+
+    // X^A: J&O (3.17)-(3.23); singular coefficients J&O (3.16), T23 (10)-(12).
+    {
+        const double g1 = 2 * l2 / l1_3, g2 = lam * (1 + 7 * lam + l2) / (5 * l1_3);
+        const double g3 = (1 + 18 * lam - 29 * l2 + 18 * l3 + l4) / (42 * l1_3);
+        const SeriesTriangle& s = store.s[SeriesXA];
+        // the g3 * 4/(M(M+2)) term: T23's match of J&O's original summation, truncated at M
+        const double A11 = 1 - g1 / 4 - g3 - 4 * g3 / (double(M) * (M + 2)) + subtractedSum(s, lam, Even, M, g1, g2, g3);
+        const double A12 = -2 / l1 * (g1 / 4 + 2 * g2 * L - 2 * g3 + subtractedSum(s, lam, Odd, M, g1, g2, g3));
+        k.f11[XA] = form(g1, g2, A11, g3);
+        k.f12[XA] = form(-g1, -g2, 0.5 * l1 * A12, -g3);
+        // pressure moment, leading lubrication term only (see docs/resistance.md): lever arm a1 times
+        // the squeeze force, normalised by 6 pi a1^2.
+        k.f11[XP] = form(g1, 0, 0, 0);
+        k.f12[XP] = form(-g1, 0, 0, 0);
+    }
+    // Y^A: J&O (4.15)-(4.18).
+    {
+        const double g2 = 4 * lam * (2 + lam + 2 * l2) / (15 * l1_3);
+        const double g3 = 2 * (16 - 45 * lam + 58 * l2 - 45 * l3 + 16 * l4) / (375 * l1_3);
+        const SeriesTriangle& s = store.s[SeriesYA];
+        const double A11 = 1 - g3 - 4 * g3 / (double(M) * (M + 2)) + subtractedSum(s, lam, Even, M, 0, g2, g3);
+        const double A12 = -2 / l1 * (2 * g2 * L - 2 * g3 - 4 * g3 / (double(M - 1) * (M + 1)) + subtractedSum(s, lam, Odd, M, 0, g2, g3));
+        k.f11[YA] = form(0, g2, A11, g3);
+        k.f12[YA] = form(0, -g2, 0.5 * l1 * A12, -g3);
+    }
+    // Y^B: J&O (5.5)-(5.7), T23 (22)-(25).
+    {
+        const double g2 = -lam * (4 + lam) / (5 * l1_2);
+        const double g3 = -(32 - 33 * lam + 83 * l2 + 43 * l3) / (250 * l1_2);
+        const SeriesTriangle& s = store.s[SeriesYB];
+        const double B11 = 2 * g2 * L - 2 * g3 + subtractedSum(s, lam, Odd, M, 0, g2, g3);
+        const double B12 = -4 / l1_2 * (-g3 + subtractedSum(s, lam, Even, M, 0, g2, g3));
+        k.f11[YB] = form(0, g2, B11, g3);
+        k.f12[YB] = form(0, -g2, 0.25 * l1_2 * B12, -g3);
+    }
+    // X^C: J&O (6.9)-(6.10) in closed form, T23 (26)-(27).
+    {
+        const double zetaSum11 = l3 / l1_3 * hurwitzZeta3(lam / l1);
+        const double zeta3 = 1.2020569031595942854;
+        k.f11[XC] = form(0, 0, zetaSum11, -l2 / (4 * l1));
+        k.f12[XC] = form(0, 0, -l3 / l1_3 * zeta3, l2 / (4 * l1));
+    }
+    // Y^C: J&O (7.9)-(7.12), T23 (29)-(34).
+    {
+        const double g2 = 2 * lam / (5 * l1), g3 = (8 + 6 * lam + 33 * l2) / (125 * l1);
+        const double g4 = l2 / (10 * l1), g5 = lam * (43 - 24 * lam + 43 * l2) / (500 * l1);
+        const SeriesTriangle& s = store.s[SeriesYC];
+        const double C11 = 1 - g3 + subtractedSum(s, lam, Even, M, 0, g2, g3);
+        const double C12 = 8 / l1_3 * (2 * g4 * L - 2 * g5 + subtractedSum(s, lam, Odd, M, 0, g4, g5));
+        k.f11[YC] = form(0, g2, C11, g3);
+        k.f12[YC] = form(0, g4, l1_3 / 8 * C12, g5);
+    }
+    // X^G: J92 (19)-(21).
+    {
+        const double g1 = 3 * l2 / l1_3, g2 = 3 * (lam + 12 * l2 - 4 * l3) / (10 * l1_3);
+        const double g3 = (5 + 181 * lam - 453 * l2 + 566 * l3 - 65 * l4) / (140 * l1_3);
+        const SeriesTriangle& s = store.s[SeriesXG];
+        const double G11 = g1 / 4 + 2 * g2 * L - 2 * g3 + subtractedSum(s, lam, Odd, M, g1, g2, g3);
+        const double G12 = 4 / l1_2 * (g1 / 4 + g3 - subtractedSum(s, lam, Even, M, g1, g2, g3));
+        k.f11[XG] = form(g1, g2, G11, g3);
+        k.f12[XG] = form(-g1, -g2, 0.25 * l1_2 * G12, -g3);
+    }
+    // Y^G: J92 (27)-(29).
+    {
+        const double g2 = (4 * lam - l2 + 7 * l3) / (10 * l1_3);
+        const double g3 = (32 - 179 * lam + 532 * l2 - 356 * l3 + 221 * l4) / (500 * l1_3);
+        const SeriesTriangle& s = store.s[SeriesYG];
+        const double G11 = 2 * g2 * L - 2 * g3 + subtractedSum(s, lam, Odd, M, 0, g2, g3);
+        const double G12 = 4 / l1_2 * (g3 - subtractedSum(s, lam, Even, M, 0, g2, g3));
+        k.f11[YG] = form(0, g2, G11, g3);
+        k.f12[YG] = form(0, -g2, 0.25 * l1_2 * G12, -g3);
+    }
+    // Y^H: J92 (35)-(37).
+    {
+        const double g2 = (2 * lam - l2) / (10 * l1_2), g3 = (16 - 61 * lam + 180 * l2 + 2 * l3) / (500 * l1_2);
+        const double g5 = (l2 + 7 * l3) / (20 * l1_2);
+        const double g6 = (43 * lam + 147 * l2 - 185 * l3 + 221 * l4) / (1000 * l1_2);
+        const SeriesTriangle& s = store.s[SeriesYH];
+        const double H11 = -g3 + subtractedSum(s, lam, Even, M, 0, g2, g3);
+        const double H12 = 8 / l1_3 * (2 * g5 * L - 2 * g6 + subtractedSum(s, lam, Odd, M, 0, g5, g6));
+        k.f11[YH] = form(0, g2, H11, g3);
+        k.f12[YH] = form(0, g5, l1_3 / 8 * H12, g6);
+    }
+    if (!withM) return k;
+    const double l5 = l4 * lam;
+    // X^M: J92 (48)-(50).
+    {
+        const double g1 = 1.2 * l2 / l1_3, g2 = 3 * (lam + 17 * l2 - 9 * l3) / (25 * l1_3);
+        const double g3 = (5 + 272 * lam - 831 * l2 + 1322 * l3 - 415 * l4) / (350 * l1_3);
+        const double g4 = 1.2 * l3 / l1_3, g5 = 3 * (-4 * l2 + 17 * l3 - 4 * l4) / (25 * l1_3);
+        const double g6 = (-65 * lam + 832 * l2 - 1041 * l3 + 832 * l4 - 65 * l5) / (350 * l1_3);
+        const SeriesTriangle& s = store.s[SeriesXM];
+        const double M11 = 1 - g1 / 4 - g3 + subtractedSum(s, lam, Even, M, g1, g2, g3);
+        const double M12 = 8 / l1_3 * (g4 / 4 + 2 * g5 * L - 2 * g6 + subtractedSum(s, lam, Odd, M, g4, g5, g6));
+        k.f11[XM] = form(g1, g2, M11, g3);
+        k.f12[XM] = form(g4, g5, l1_3 / 8 * M12, g6);
+    }
+    // Y^M: J92 (64)-(66), sums to order 130.
+    {
+        const double g2 = 6 * (lam - l2 + 4 * l3) / (25 * l1_3);
+        const double g3 = (24 - 201 * lam + 882 * l2 - 1182 * l3 + 591 * l4) / (625 * l1_3);
+        const double g5 = 3 * (7 * l2 - 10 * l3 + 7 * l4) / (50 * l1_3);
+        const double g6 = 3 * lam * (221 - 728 * lam + 1902 * l2 - 728 * l3 + 221 * l4) / (2500 * l1_3);
+        const SeriesTriangle& s = store.s[SeriesYM];
+        const double M11 = 1 - g3 + subtractedSum(s, lam, Even, 130, 0, g2, g3);
+        const double M12 = 8 / l1_3 * (2 * g5 * L - 2 * g6 + subtractedSum(s, lam, Odd, 130, 0, g5, g6));
+        k.f11[YM] = form(0, g2, M11, g3);
+        k.f12[YM] = form(0, g5, l1_3 / 8 * M12, g6);
+    }
+    // Z^M: J92 (79)-(81), sums to order 150 (even) and 200 (odd).
+    {
+        const double g3 = -0.3 * (l2 + l4) / l1_3;
+        const SeriesTriangle& s = store.s[SeriesZM];
+        const double M11 = 1 - g3 + subtractedSum(s, lam, Even, 150, 0, 0, g3);
+        const double M12 = 8 / l1_3 * (2 * g3 - subtractedSum(s, lam, Odd, 200, 0, 0, g3));
+        k.f11[ZM] = form(0, 0, M11, g3);
+        k.f12[ZM] = form(0, 0, l1_3 / 8 * M12, -g3);
+    }
+    return k;
+}
+
+}  // namespace resistance
+}  // namespace fdm
