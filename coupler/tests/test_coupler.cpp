@@ -19,6 +19,18 @@ std::string tempPath(const std::string& name)
 {
     return "/tmp/fdmCouplerTest." + std::to_string(getpid()) + "." + name;
 }
+// Both ends of a socket connection: the listening end accepts in a thread.
+struct Connection {
+    std::unique_ptr<Transport> server, client;
+};
+Connection connectedPair(const Options& o)
+{
+    Connection c;
+    std::thread t([&] { c.server = listen(o); });
+    c.client = connect(o);
+    t.join();
+    return c;
+}
 Message sample()
 {
     Message m = makeMessage(MessageType::Integrals, 12, 3, 2, layout::integralsWidth, "dt=0.5 lastStep=9");
@@ -69,10 +81,9 @@ TEST(Socket, PingPongBetweenThreads)
     Options o;
     o.portFile = tempPath("port");
     o.connectTimeout = 10;
-    std::unique_ptr<Transport> server;
-    std::thread t([&] { server = listen(o); });
-    std::unique_ptr<Transport> client = connect(o);
-    t.join();
+    Connection c = connectedPair(o);
+    std::unique_ptr<Transport>& server = c.server;
+    std::unique_ptr<Transport>& client = c.client;
     client->send(sample());
     Message got = server->receive(MessageType::Integrals);
     EXPECT_EQ(got.data, sample().data);
@@ -105,10 +116,9 @@ TEST(Socket, PeerThatDiesIsDetectedAtOnce)
     Options o;
     o.portFile = tempPath("dies");
     o.receiveTimeout = 60;
-    std::unique_ptr<Transport> server;
-    std::thread t([&] { server = listen(o); });
-    std::unique_ptr<Transport> client = connect(o);
-    t.join();
+    Connection c = connectedPair(o);
+    std::unique_ptr<Transport>& server = c.server;
+    std::unique_ptr<Transport>& client = c.client;
     client->close();  // as when the process dies: the kernel closes the socket
     const auto t0 = std::chrono::steady_clock::now();
     try {
@@ -125,10 +135,9 @@ TEST(Socket, SilentPeerTimesOut)
     Options o;
     o.portFile = tempPath("silent");
     o.receiveTimeout = 0.5;
-    std::unique_ptr<Transport> server;
-    std::thread t([&] { server = listen(o); });
-    std::unique_ptr<Transport> client = connect(o);
-    t.join();
+    Connection c = connectedPair(o);
+    std::unique_ptr<Transport>& server = c.server;
+    std::unique_ptr<Transport>& client = c.client;
     client->send(sample());
     server->receive();  // the first receive uses connectTimeout
     EXPECT_THROW(server->receive(), CouplerError);
@@ -139,10 +148,9 @@ TEST(Socket, ErrorMessageCarriesItsText)
     Options o;
     o.portFile = tempPath("error");
     o.name = "particle code";
-    std::unique_ptr<Transport> server;
-    std::thread t([&] { server = listen(o); });
-    std::unique_ptr<Transport> client = connect(o);
-    t.join();
+    Connection c = connectedPair(o);
+    std::unique_ptr<Transport>& server = c.server;
+    std::unique_ptr<Transport>& client = c.client;
     client->sendError("particle 7 overlaps particle 9");
     try {
         server->receive();
