@@ -1,5 +1,5 @@
 // fdmDEM -- LIGGGHTS (Debian's libliggghts 3.8) with the project's styles registered at run time.
-//   fdmDEM -in input [-var name value ...] [other LIGGGHTS options]       (serial or mpirun)
+//   fdmDEM -in input [-var name value ...] [-echo screen] [other LIGGGHTS options]   (serial or mpirun)
 // The styles are added to LIGGGHTS's style maps before the input is read, so no LIGGGHTS rebuild
 // is needed (docs/dem.md). After the input script, the fluid solver is told to finish.
 #include "fix_fdm_couple.h"
@@ -14,22 +14,41 @@
 #include <cstring>
 #include <vector>
 
+namespace {
+const char usage[] =
+    "usage: fdmDEM -in INPUT [-var NAME VALUE ...] [-echo screen] [-log FILE] [other LIGGGHTS options]\n"
+    "       mpirun -np N fdmDEM -in INPUT ...\n"
+    "LIGGGHTS 3.8 with fix fdm/couple (coupling to the fluid solver fdmFoam); see docs/dem.md.\n";
+}
+
 int main(int argc, char **argv)
 {
-  // Unbuffered: an error message followed by MPI_Abort must not be lost.
+  // Unbuffered: an error message printed just before MPI_Abort must not be lost.
   setvbuf(stdout, nullptr, _IONBF, 0);
+  setvbuf(stderr, nullptr, _IONBF, 0);
+  for (int i = 1; i < argc; i++)
+    if (!std::strcmp(argv[i], "-h") || !std::strcmp(argv[i], "-help") || !std::strcmp(argv[i], "--help")) {
+      std::fputs(usage, stdout);
+      return 0;
+    }
   MPI_Init(&argc, &argv);
 
+  // LIGGGHTS writes log.liggghts unless told otherwise: off by default, -log FILE to have one
   std::vector<char *> args(argv, argv + argc);
   bool haveLog = false;
-  for (int i = 1; i < argc; i++) if (std::strcmp(argv[i], "-log") == 0) haveLog = true;
+  for (int i = 1; i < argc; i++)
+    if (!std::strcmp(argv[i], "-log") || !std::strcmp(argv[i], "-l")) haveLog = true;
   static char logFlag[] = "-log", logNone[] = "none";
-  if (!haveLog) { args.push_back(logFlag); args.push_back(logNone); }
+  if (!haveLog) {
+    args.push_back(logFlag);
+    args.push_back(logNone);
+  }
+  args.push_back(nullptr);
 
-  LAMMPS_NS::LAMMPS *lmp = new LAMMPS_NS::LAMMPS(int(args.size()), args.data(), MPI_COMM_WORLD);
+  LAMMPS_NS::LAMMPS *lmp = new LAMMPS_NS::LAMMPS(int(args.size()) - 1, args.data(), MPI_COMM_WORLD);
   fdm::registerFix<LAMMPS_NS::FixFdmCouple>(lmp, "fdm/couple");
   lmp->input->file();
-  LAMMPS_NS::FixFdmCouple::finishAll();
+  LAMMPS_NS::FixFdmCouple::finishAll(lmp);
   delete lmp;
   MPI_Finalize();
   return 0;

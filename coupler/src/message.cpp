@@ -10,9 +10,10 @@ namespace coupler {
 
 namespace {
 const char magic[4] = {'F', 'D', 'M', 'C'};
-// Sanity limits: a corrupted header must give an error, not a huge allocation.
-const uint64_t maxRecords = 100000000ULL;
-const uint32_t maxWidth = 1024;
+// Sanity limits: a corrupted header must give an error, not a huge allocation. The largest real
+// record is 13 doubles wide; 2^25 values (256 MiB) is 2.5 million particles of it.
+const uint32_t maxWidth = 64;
+const uint64_t maxValues = 1ULL << 25;
 const uint32_t maxText = 1u << 20;
 
 template <class T> void put(std::vector<unsigned char>& b, size_t at, T v)
@@ -83,6 +84,10 @@ std::vector<unsigned char> encode(const Message& m)
 {
     if (m.data.size() != size_t(m.count) * m.width)
         throw CouplerError("coupling: cannot send a message whose data size does not match count*width");
+    if (m.width > maxWidth || m.data.size() > maxValues || m.text.size() > maxText)
+        throw CouplerError(std::string("coupling: ") + messageTypeName(m.type) +
+                           " message too large for the wire format (" + std::to_string(m.count) + " records of " +
+                           std::to_string(m.width) + " values, text " + std::to_string(m.text.size()) + " bytes)");
     std::vector<unsigned char> b(headerSize + m.text.size() + 8 * m.data.size());
     std::memcpy(&b[0], magic, 4);
     put<uint16_t>(b, 4, protocolVersion);
@@ -114,12 +119,13 @@ size_t encodedSize(const unsigned char* header)
         throw CouplerError("coupling: protocol version mismatch: the peer speaks version " + std::to_string(version) +
                            ", this side speaks version " + std::to_string(protocolVersion));
     const uint16_t type = get<uint16_t>(header, 6);
-    if (type < 1 || type > 7) throw CouplerError("coupling: malformed message (unknown type " + std::to_string(type) + ")");
+    if (type < uint16_t(MessageType::Hello) || type > uint16_t(MessageType::Error))
+        throw CouplerError("coupling: malformed message (unknown type " + std::to_string(type) + ")");
     const uint32_t count = get<uint32_t>(header, 20), width = get<uint32_t>(header, 24);
     const uint32_t textLength = get<uint32_t>(header, 28);
     const uint64_t payload = get<uint64_t>(header, 32);
-    if (width > maxWidth || count > maxRecords || textLength > maxText || payload != uint64_t(count) * width)
-        throw CouplerError("coupling: malformed message (count " + std::to_string(count) + ", width " +
+    if (width > maxWidth || payload > maxValues || textLength > maxText || payload != uint64_t(count) * width)
+        throw CouplerError("coupling: malformed message (absurd or inconsistent sizes: count " + std::to_string(count) + ", width " +
                            std::to_string(width) + ", text " + std::to_string(textLength) + " bytes, payload " +
                            std::to_string(payload) + " values)");
     return headerSize + textLength + 8 * payload;
@@ -147,15 +153,6 @@ Message decode(const unsigned char* bytes, size_t size)
         std::memcpy(&x, &bits, 8);
         at += 8;
     }
-    return m;
-}
-
-Message Transport::receive(MessageType expected)
-{
-    Message m = receive();
-    if (m.type != expected)
-        throw CouplerError(std::string("coupling: expected ") + messageTypeName(expected) + " from the peer, got " +
-                           messageTypeName(m.type));
     return m;
 }
 

@@ -3,94 +3,290 @@
 
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
 
 using namespace fdm::coupler;
 
 namespace {
-double since(std::chrono::steady_clock::time_point t0)
+
+typedef std::chrono::steady_clock Clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string hostName()
 {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    char host[256] = {0};
+    gethostname(host, sizeof host - 1);
+    return host;
 }
+
 std::string tempPath(const std::string& name)
 {
     return "/tmp/fdmCouplerTest." + std::to_string(getpid()) + "." + name;
 }
-// Both ends of a socket connection: the listening end accepts in a thread.
-struct Connection {
-    std::unique_ptr<Transport> server, client;
-};
-Connection connectedPair(const Options& o)
+
+Message sample(uint64_t step = 12, uint32_t iteration = 3)
 {
-    Connection c;
-    std::thread t([&] { c.server = listen(o); });
-    c.client = connect(o);
-    t.join();
-    return c;
-}
-Message sample()
-{
-    Message m = makeMessage(MessageType::Integrals, 12, 3, 2, layout::integralsWidth, "dt=0.5 lastStep=9");
+    Message m = makeMessage(MessageType::Integrals, step, iteration, 2, layout::integralsWidth, "dt=0.5 lastStep=9");
     for (size_t i = 0; i < m.data.size(); ++i) m.data[i] = 1.0 / (i + 1) - 0.25;
     return m;
 }
+
+// Expects `f` to throw a CouplerError whose text contains every one of `needles`.
+template <class F> void expectCouplerError(F f, std::initializer_list<std::string> needles)
+{
+    try {
+        f();
+        ADD_FAILURE() << "no CouplerError";
+    } catch (const CouplerError& e) {
+        for (const std::string& n : needles)
+            EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << "'" << n << "' not in: " << e.what();
+    }
+}
+
+void put32(std::vector<unsigned char>& b, size_t at, uint32_t v)
+{
+    for (int i = 0; i < 4; ++i) b[at + i] = (v >> (8 * i)) & 0xff;
+}
+void put64(std::vector<unsigned char>& b, size_t at, uint64_t v)
+{
+    for (int i = 0; i < 8; ++i) b[at + i] = (v >> (8 * i)) & 0xff;
+}
+
+// A connected (fluid, dem) pair over a socket, the listener in a thread.
+struct SocketPair {
+    std::unique_ptr<Transport> fluid, dem;
+    explicit SocketPair(Options o = Options(), const std::string& demRecord = "")
+    {
+        if (o.portFile.empty()) o.portFile = tempPath("port");
+        Options f = o, d = o;
+        d.recordFile = demRecord;
+        f.name = "particle code";
+        d.name = "fluid solver";
+        std::thread t([&] { fluid = listen(f); });
+        dem = connect(d);
+        t.join();
+    }
+};
+
 }  // namespace
 
-TEST(Message, RoundTripIsExact)
+// ---- message format ---------------------------------------------------------------------------------
+
+TEST(Message, RoundTripIsBitExact)
 {
-    const Message m = sample();
+    Message m = sample();
+    m.data[1] = std::numeric_limits<double>::quiet_NaN();
+    m.data[2] = -0.0;
+    m.data[3] = std::numeric_limits<double>::denorm_min();
     const std::vector<unsigned char> bytes = encode(m);
+    ASSERT_EQ(bytes.size(), headerSize + m.text.size() + 8 * m.data.size());
+    EXPECT_EQ(0, std::memcmp(bytes.data(), "FDMC", 4));
+    EXPECT_EQ(encodedSize(bytes.data()), bytes.size());
     const Message back = decode(bytes.data(), bytes.size());
     EXPECT_EQ(back.type, m.type);
     EXPECT_EQ(back.step, 12u);
     EXPECT_EQ(back.iteration, 3u);
     EXPECT_EQ(back.count, 2u);
+    EXPECT_EQ(back.width, uint32_t(layout::integralsWidth));
     EXPECT_EQ(back.text, m.text);
-    EXPECT_EQ(back.data, m.data);  // bit-exact
-    EXPECT_DOUBLE_EQ(back.textNumber("dt"), 0.5);
-    EXPECT_THROW(back.textNumber("missing"), CouplerError);
+    ASSERT_EQ(back.data.size(), m.data.size());
+    EXPECT_EQ(0, std::memcmp(back.data.data(), m.data.data(), 8 * m.data.size()));
+    EXPECT_DOUBLE_EQ(back.at(1, layout::iFx), m.at(1, layout::iFx));
 }
 
-TEST(Message, MalformedInputIsRejected)
+TEST(Message, IsLittleEndianOnTheWire)
+{
+    Message m = makeMessage(MessageType::Step, 0x0102030405060708ULL, 7, 1, 1);
+    m.data[0] = 1.0;  // 0x3ff0000000000000
+    const std::vector<unsigned char> b = encode(m);
+    EXPECT_EQ(b[4], protocolVersion & 0xff);
+    EXPECT_EQ(b[6], 2);     // Step
+    EXPECT_EQ(b[8], 0x08);  // step, least significant byte first
+    EXPECT_EQ(b[15], 0x01);
+    EXPECT_EQ(b[16], 7);    // iteration
+    EXPECT_EQ(b[headerSize + 7], 0x3f);
+    EXPECT_EQ(b[headerSize + 6], 0xf0);
+}
+
+TEST(Message, EmptyMessageRoundTrips)
+{
+    const Message m = makeMessage(MessageType::Finish, 5, 0, 0, 0);
+    const std::vector<unsigned char> bytes = encode(m);
+    EXPECT_EQ(bytes.size(), headerSize);
+    const Message back = decode(bytes.data(), bytes.size());
+    EXPECT_EQ(back.type, MessageType::Finish);
+    EXPECT_TRUE(back.data.empty() && back.text.empty());
+}
+
+TEST(Message, TextValues)
+{
+    const Message m = makeMessage(MessageType::StepDone, 1, 4, 0, 0, "iterations=4 residual=1.5e-07 converged=1");
+    EXPECT_EQ(m.textValue("converged"), "1");
+    EXPECT_DOUBLE_EQ(m.textNumber("residual"), 1.5e-7);
+    expectCouplerError([&] { m.textValue("iter"); }, {"StepDone", "'iter='"});
+    const Message bad = makeMessage(MessageType::Step, 1, 0, 0, 0, "dt=abc");
+    expectCouplerError([&] { bad.textNumber("dt"); }, {"dt=abc", "not a number"});
+}
+
+TEST(Message, BadMagicIsRejected)
 {
     std::vector<unsigned char> bytes = encode(sample());
-    std::vector<unsigned char> bad = bytes;
-    bad[0] = 'X';
-    EXPECT_THROW(decode(bad.data(), bad.size()), CouplerError);
-    bad = bytes;
-    bad[4] = protocolVersion + 1;
-    try {
-        decode(bad.data(), bad.size());
-        FAIL() << "version mismatch accepted";
-    } catch (const CouplerError& e) {
-        EXPECT_NE(std::string(e.what()).find("version " + std::to_string(protocolVersion + 1)), std::string::npos);
-        EXPECT_NE(std::string(e.what()).find("version " + std::to_string(protocolVersion)), std::string::npos);
-    }
-    EXPECT_THROW(decode(bytes.data(), bytes.size() - 3), CouplerError);  // truncated
-    EXPECT_THROW(decode(bytes.data(), 10), CouplerError);
-    bad = bytes;
-    bad[23] = 0x7f;  // absurd record count
-    EXPECT_THROW(decode(bad.data(), bad.size()), CouplerError);
+    bytes[0] = 'X';
+    expectCouplerError([&] { decode(bytes.data(), bytes.size()); }, {"bad magic"});
 }
 
-TEST(Socket, PingPongBetweenThreads)
+TEST(Message, OtherProtocolVersionNamesBothVersions)
+{
+    std::vector<unsigned char> bytes = encode(sample());
+    bytes[4] = protocolVersion + 1;
+    expectCouplerError([&] { decode(bytes.data(), bytes.size()); },
+                       {"version " + std::to_string(protocolVersion + 1), "version " + std::to_string(protocolVersion)});
+}
+
+TEST(Message, UnknownTypeIsRejected)
+{
+    std::vector<unsigned char> bytes = encode(sample());
+    bytes[6] = 99;
+    expectCouplerError([&] { decode(bytes.data(), bytes.size()); }, {"unknown type 99"});
+}
+
+TEST(Message, EveryTruncationIsRejected)
+{
+    const std::vector<unsigned char> bytes = encode(sample());
+    for (size_t size = 0; size < bytes.size(); ++size)
+        EXPECT_THROW(decode(bytes.data(), size), CouplerError) << size << " bytes";
+    std::vector<unsigned char> longer = bytes;
+    longer.push_back(0);
+    EXPECT_THROW(decode(longer.data(), longer.size()), CouplerError);
+}
+
+TEST(Message, AbsurdSizesAreRejectedFromTheHeaderAlone)
+{
+    const std::vector<unsigned char> good = encode(sample());
+    std::vector<unsigned char> h(good.begin(), good.begin() + headerSize);
+    // self-consistent header announcing 2^31 records of 13 values (200 GiB)
+    put32(h, 20, 1u << 31);
+    put32(h, 24, 13);
+    put64(h, 32, (uint64_t(1) << 31) * 13);
+    expectCouplerError([&] { encodedSize(h.data()); }, {"absurd"});
+    // inconsistent payload
+    h.assign(good.begin(), good.begin() + headerSize);
+    put64(h, 32, 17);
+    EXPECT_THROW(encodedSize(h.data()), CouplerError);
+    // absurd width, absurd text
+    h.assign(good.begin(), good.begin() + headerSize);
+    put32(h, 24, 100000);
+    EXPECT_THROW(encodedSize(h.data()), CouplerError);
+    h.assign(good.begin(), good.begin() + headerSize);
+    put32(h, 28, 0xffffffffu);
+    EXPECT_THROW(encodedSize(h.data()), CouplerError);
+}
+
+TEST(Message, InconsistentMessageIsNotEncoded)
+{
+    Message m = sample();
+    m.data.pop_back();
+    EXPECT_THROW(encode(m), CouplerError);
+}
+
+// ---- socket -----------------------------------------------------------------------------------------
+
+TEST(Socket, PingPongOfAWholeTimeStep)
+{
+    SocketPair pair;
+    EXPECT_NE(pair.dem->describe().find("socket 127.0.0.1:"), std::string::npos);
+    pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=1"));
+    EXPECT_EQ(pair.fluid->receive(MessageType::Hello).text, "role=dem version=1");
+    pair.dem->send(makeMessage(MessageType::Step, 1, 0, 2, layout::stepWidth));
+    EXPECT_EQ(pair.fluid->receive(MessageType::Step).step, 1u);
+    for (uint32_t k = 1; k <= 5; ++k) {
+        pair.fluid->send(sample(1, k));
+        const Message in = pair.dem->receive(MessageType::Integrals);
+        EXPECT_EQ(in.iteration, k);
+        EXPECT_EQ(in.data, sample().data);
+        Message v = makeMessage(MessageType::Velocities, 1, k, 2, layout::velocitiesWidth);
+        v.data[0] = k;
+        pair.dem->send(v);
+        EXPECT_EQ(pair.fluid->receive(MessageType::Velocities).data[0], double(k));
+    }
+    pair.fluid->send(makeMessage(MessageType::StepDone, 1, 5, 2, layout::stepDoneWidth, "iterations=5"));
+    EXPECT_EQ(pair.dem->receive(MessageType::StepDone).iteration, 5u);
+    pair.dem->send(makeMessage(MessageType::Finish, 1, 0, 0, 0));
+    EXPECT_EQ(pair.fluid->receive().type, MessageType::Finish);
+}
+
+TEST(Socket, LargeMessageArrivesWhole)
+{
+    SocketPair pair;
+    Message m = makeMessage(MessageType::Step, 3, 0, 200000, layout::stepWidth);  // 17.6 MB, > one chunk
+    for (size_t i = 0; i < m.data.size(); ++i) m.data[i] = double(i);
+    std::thread t([&] { pair.dem->send(m); });
+    const Message got = pair.fluid->receive(MessageType::Step);
+    t.join();
+    EXPECT_EQ(got.data, m.data);
+}
+
+TEST(Socket, UnexpectedTypeNamesBothTypesAndThePeer)
+{
+    SocketPair pair;
+    pair.fluid->send(makeMessage(MessageType::StepDone, 4, 2, 0, 0));
+    expectCouplerError([&] { pair.dem->receive(MessageType::Integrals); },
+                       {"expected Integrals", "fluid solver", "got StepDone", "step 4"});
+}
+
+TEST(Socket, ConnectorWaitsForThePortFile)
 {
     Options o;
-    o.portFile = tempPath("port");
+    o.portFile = tempPath("late");
+    std::remove(o.portFile.c_str());
     o.connectTimeout = 10;
-    Connection c = connectedPair(o);
-    std::unique_ptr<Transport>& server = c.server;
-    std::unique_ptr<Transport>& client = c.client;
-    client->send(sample());
-    Message got = server->receive(MessageType::Integrals);
-    EXPECT_EQ(got.data, sample().data);
-    server->send(makeMessage(MessageType::Finish, 1, 0, 0, 0));
-    EXPECT_EQ(client->receive().type, MessageType::Finish);
-    server->close();
-    EXPECT_THROW(client->receive(MessageType::Step), CouplerError);  // the peer is gone
+    std::unique_ptr<Transport> fluid, dem;
+    std::thread t([&] { dem = connect(o); });  // starts first, polls for the port file
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    fluid = listen(o);
+    t.join();
+    dem->send(sample());
+    EXPECT_EQ(fluid->receive().data, sample().data);
+    struct stat st;
+    EXPECT_NE(0, stat(o.portFile.c_str(), &st)) << "the port file outlived the listening socket";
+}
+
+TEST(Socket, FixedPortAndReuse)
+{
+    Options o;
+    o.port = 0;
+    {
+        SocketPair first(o);
+        first.dem->send(sample());
+        first.fluid->receive();
+    }
+    // a fixed port can be listened on again at once (SO_REUSEADDR), by port number without a file
+    Options fixed;
+    fixed.port = 47000 + getpid() % 1000;
+    fixed.connectTimeout = 5;
+    for (int round = 0; round < 2; ++round) {
+        std::unique_ptr<Transport> fluid, dem;
+        std::thread t([&] { fluid = listen(fixed); });
+        dem = connect(fixed);
+        t.join();
+        dem->send(sample());
+        EXPECT_EQ(fluid->receive().step, 12u);
+        fluid->close();  // the listener closes first: the port is left in TIME_WAIT
+    }
 }
 
 TEST(Socket, PeerThatNeverConnects)
@@ -98,87 +294,339 @@ TEST(Socket, PeerThatNeverConnects)
     Options o;
     o.portFile = tempPath("never");
     o.connectTimeout = 1;
-    const auto t0 = std::chrono::steady_clock::now();
-    try {
-        listen(o);
-        FAIL();
-    } catch (const CouplerError& e) {
-        EXPECT_NE(std::string(e.what()).find("no peer connected"), std::string::npos);
-    }
-    EXPECT_LT(since(t0), 3.0);
-    const auto t1 = std::chrono::steady_clock::now();
-    EXPECT_THROW(connect(o), CouplerError);  // no port file
-    EXPECT_LT(since(t1), 3.0);
+    o.name = "particle code fdmDEM";
+    Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { listen(o); }, {"no peer connected", "within 1 s", "particle code fdmDEM"});
+    EXPECT_LT(since(t0), 2.0);
+    EXPECT_GT(since(t0), 0.9);
+    o.name = "fluid solver";
+    t0 = Clock::now();
+    expectCouplerError([&] { connect(o); }, {"could not connect to the fluid solver", "within 1 s", "port file"});
+    EXPECT_LT(since(t0), 2.0);
+    Options byPort;
+    byPort.port = 1;  // nobody listens there
+    byPort.connectTimeout = 0.5;
+    t0 = Clock::now();
+    expectCouplerError([&] { connect(byPort); }, {"127.0.0.1:1", "refused"});
+    EXPECT_LT(since(t0), 1.5);
 }
 
-TEST(Socket, PeerThatDiesIsDetectedAtOnce)
+TEST(Socket, PeerProcessThatDiesIsDetectedAtOnce)
 {
     Options o;
     o.portFile = tempPath("dies");
+    std::remove(o.portFile.c_str());
     o.receiveTimeout = 60;
-    Connection c = connectedPair(o);
-    std::unique_ptr<Transport>& server = c.server;
-    std::unique_ptr<Transport>& client = c.client;
-    client->close();  // as when the process dies: the kernel closes the socket
-    const auto t0 = std::chrono::steady_clock::now();
-    try {
-        server->receive();
-        FAIL();
-    } catch (const CouplerError& e) {
-        EXPECT_NE(std::string(e.what()).find("closed the connection"), std::string::npos);
+    o.name = "particle code";
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {  // the peer: connects, says hello, dies without closing anything
+        try {
+            std::unique_ptr<Transport> dem = connect(o);
+            dem->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=dem"));
+            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        } catch (...) {
+        }
+        ::kill(getpid(), SIGKILL);  // never returns into the test runner
     }
+    std::unique_ptr<Transport> fluid = listen(o);
+    EXPECT_EQ(fluid->receive().type, MessageType::Hello);
+    const Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { fluid->receive(); },
+                       {"the particle code closed the connection (did it crash? see its log)"});
     EXPECT_LT(since(t0), 1.0);
+    waitpid(child, nullptr, 0);
+    // sending to it fails too (EPIPE, not SIGPIPE: we are still alive to check)
+    EXPECT_THROW({ for (int i = 0; i < 100; ++i) fluid->send(sample()); }, CouplerError);
 }
 
 TEST(Socket, SilentPeerTimesOut)
 {
     Options o;
-    o.portFile = tempPath("silent");
     o.receiveTimeout = 0.5;
-    Connection c = connectedPair(o);
-    std::unique_ptr<Transport>& server = c.server;
-    std::unique_ptr<Transport>& client = c.client;
-    client->send(sample());
-    server->receive();  // the first receive uses connectTimeout
-    EXPECT_THROW(server->receive(), CouplerError);
+    SocketPair pair(o);
+    pair.dem->send(sample());
+    pair.fluid->receive();  // handshake done: from now on receiveTimeout applies
+    const Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { pair.fluid->receive(); }, {"sent nothing for 0.5 s", "hung"});
+    EXPECT_LT(since(t0), 1.5);
+}
+
+TEST(Socket, HandshakeIsBoundedByTheConnectTimeout)
+{
+    Options o;
+    o.connectTimeout = 0.5;
+    o.receiveTimeout = 100;
+    SocketPair pair(o);
+    const Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { pair.fluid->receive(); }, {"did not complete the handshake", "0.5 s"});
+    EXPECT_LT(since(t0), 1.5);
 }
 
 TEST(Socket, ErrorMessageCarriesItsText)
 {
-    Options o;
-    o.portFile = tempPath("error");
-    o.name = "particle code";
-    Connection c = connectedPair(o);
-    std::unique_ptr<Transport>& server = c.server;
-    std::unique_ptr<Transport>& client = c.client;
-    client->sendError("particle 7 overlaps particle 9");
-    try {
-        server->receive();
-        FAIL();
-    } catch (const CouplerError& e) {
-        EXPECT_NE(std::string(e.what()).find("particle 7 overlaps particle 9"), std::string::npos);
-        EXPECT_NE(std::string(e.what()).find("particle code"), std::string::npos);
-    }
+    SocketPair pair;
+    pair.dem->sendError("particle 7 overlaps particle 9");
+    expectCouplerError([&] { pair.fluid->receive(MessageType::Step); },
+                       {"the particle code stopped: particle 7 overlaps particle 9"});
 }
+
+namespace {
+// The listening side, and a raw TCP client that is not an fdm coupler: returns its socket.
+int listenWithRawClient(const std::string& portFile, std::unique_ptr<Transport>& fluid)
+{
+    Options o;
+    o.portFile = portFile;
+    o.name = "particle code";
+    std::remove(portFile.c_str());
+    std::thread t([&] { fluid = listen(o); });
+    int fd = -1;
+    for (int attempt = 0; attempt < 200 && fd < 0; ++attempt) {
+        std::ifstream in(portFile.c_str());
+        int port = 0;
+        if (in >> port) {
+            fd = socket(AF_INET, SOCK_STREAM, 0);
+            sockaddr_in a;
+            std::memset(&a, 0, sizeof a);
+            a.sin_family = AF_INET;
+            a.sin_port = htons(uint16_t(port));
+            inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+            if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) { ::close(fd); fd = -1; }
+        }
+        if (fd < 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    t.join();
+    return fd;
+}
+}  // namespace
+
+TEST(Socket, GarbageFromThePeerIsAnErrorNotACrash)
+{
+    std::unique_ptr<Transport> fluid;
+    const int fd = listenWithRawClient(tempPath("garbage"), fluid);
+    ASSERT_GE(fd, 0);
+    const char http[] = "GET / HTTP/1.1\r\nHost: localhost\r\n\r\n and some more bytes";
+    ASSERT_GT(::send(fd, http, sizeof http, 0), 0);
+    expectCouplerError([&] { fluid->receive(); }, {"bad magic"});
+    ::close(fd);
+}
+
+TEST(Socket, LyingHeaderThenDeathGivesAnErrorAtOnce)
+{
+    // A valid header announcing 2^24 values (128 MiB) of which only a few come before the peer dies:
+    // the reader must report the end of the stream at once (and not wait for, or allocate, the rest).
+    std::unique_ptr<Transport> fluid;
+    const int fd = listenWithRawClient(tempPath("lying"), fluid);
+    ASSERT_GE(fd, 0);
+    const std::vector<unsigned char> good = encode(sample());
+    std::vector<unsigned char> h(good.begin(), good.begin() + headerSize);
+    put32(h, 20, 1u << 21);
+    put32(h, 24, 8);
+    put32(h, 28, 0);
+    put64(h, 32, uint64_t(1) << 24);
+    h.resize(headerSize + 800, 0);
+    ASSERT_EQ(::send(fd, h.data(), h.size(), 0), ssize_t(h.size()));
+    ::close(fd);
+    const Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { fluid->receive(); }, {"closed the connection"});
+    EXPECT_LT(since(t0), 1.0);
+}
+
+TEST(Socket, SendAfterCloseIsAnError)
+{
+    SocketPair pair;
+    pair.dem->close();
+    EXPECT_THROW(pair.dem->send(sample()), CouplerError);
+    EXPECT_THROW(pair.dem->receive(), CouplerError);
+    pair.dem->sendError("never thrown");  // best effort, noexcept
+}
+
+// ---- file transport ---------------------------------------------------------------------------------
+
+namespace {
+struct FilePair {
+    std::unique_ptr<Transport> fluid, dem;
+    FilePair(Options o, const std::string& demRecord = "")
+    {
+        o.transport = "file";
+        Options d = o;
+        d.recordFile = demRecord;
+        std::thread t([&] { fluid = listen(o); });
+        dem = connect(d);
+        t.join();
+    }
+};
+size_t countMessages(const std::string& record)
+{
+    std::ifstream in(record.c_str(), std::ios::binary);
+    std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    size_t at = 0, n = 0;
+    while (at + headerSize <= b.size()) {
+        at += encodedSize(&b[at]);
+        ++n;
+    }
+    EXPECT_EQ(at, b.size());
+    return n;
+}
+}  // namespace
 
 TEST(File, RoundTripAndRecord)
 {
     Options o;
-    o.transport = "file";
     o.directory = tempPath("dir");
-    o.connectTimeout = 2;
-    o.receiveTimeout = 2;
+    o.connectTimeout = 5;
+    o.receiveTimeout = 0.5;
+    const std::string record = tempPath("record");
+    std::remove(record.c_str());
+    FilePair pair(o, record);
+    EXPECT_NE(pair.dem->describe().find("file"), std::string::npos);
+    pair.dem->send(sample());
+    EXPECT_EQ(pair.fluid->receive().data, sample().data);
+    for (uint32_t k = 1; k <= 3; ++k) {
+        pair.fluid->send(sample(12, k));
+        EXPECT_EQ(pair.dem->receive(MessageType::Integrals).iteration, k);
+        pair.dem->send(makeMessage(MessageType::Velocities, 12, k, 2, layout::velocitiesWidth));
+        EXPECT_EQ(pair.fluid->receive(MessageType::Velocities).iteration, k);
+    }
+    pair.fluid->send(makeMessage(MessageType::StepDone, 12, 3, 0, 0, "iterations=3"));
+    EXPECT_EQ(pair.dem->receive().text, "iterations=3");
+    const Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { pair.dem->receive(); }, {"sent nothing for 0.5 s"});
+    EXPECT_LT(since(t0), 1.5);
+    EXPECT_EQ(countMessages(record), 1u + 3 * 2 + 1);  // every message sent and received, in order
+    struct stat st;
+    EXPECT_EQ(0, stat((o.directory + "/00000004.dem.msg").c_str(), &st));  // kept on disk for replay
+}
+
+TEST(File, StaleMessagesOfAnEarlierRunAreIgnored)
+{
+    Options o;
+    o.directory = tempPath("stale");
+    o.connectTimeout = 5;
+    {
+        FilePair old(o);
+        old.dem->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=dem old"));
+        old.fluid->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=fluid old"));
+    }
+    // the processes of the earlier run are gone: their session files name a pid that has exited
+    const pid_t gone = fork();
+    if (gone == 0) _exit(0);
+    waitpid(gone, nullptr, 0);
+    for (const char* side : {"fluid", "dem"}) {
+        const std::string path = o.directory + "/" + side + ".session";
+        std::ifstream in(path.c_str());
+        std::string id;
+        in >> id;
+        std::ofstream(path.c_str()) << id << " pid=" << gone << " host=" << hostName() << "\n";
+    }
+    FilePair fresh(o);
+    fresh.dem->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=dem new"));
+    EXPECT_EQ(fresh.fluid->receive().text, "role=dem new");
+    fresh.fluid->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=fluid new"));
+    EXPECT_EQ(fresh.dem->receive().text, "role=fluid new");
+}
+
+TEST(File, ConnectorThatJoinedAStaleSessionFollowsTheNewListener)
+{
+    Options o;
+    o.directory = tempPath("late");
+    o.connectTimeout = 5;
+    o.transport = "file";
+    // a stale session file whose writer looks alive (our own pid): the connector joins it
+    ::mkdir(o.directory.c_str(), 0755);
+    std::ofstream((o.directory + "/fluid.session").c_str())
+        << "session=stale pid=" << getpid() << " host=" << hostName() << "\n";
+    std::unique_ptr<Transport> dem = connect(o), fluid;
+    dem->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=dem"));
+    std::thread t([&] {
+        fluid = listen(o);  // cleans the directory, the Hello with it
+        fluid->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=fluid"));
+    });
+    EXPECT_EQ(dem->receive(MessageType::Hello).text, "role=fluid");
+    t.join();
+    EXPECT_EQ(fluid->receive(MessageType::Hello).text, "role=dem");  // sent again in the new session
+}
+
+TEST(File, PeerProcessThatDiesIsDetected)
+{
+    Options o;
+    o.transport = "file";
+    o.directory = tempPath("dies");
+    o.connectTimeout = 5;
+    o.receiveTimeout = 60;
+    o.name = "particle code";
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        try {
+            std::unique_ptr<Transport> dem = connect(o);
+            dem->send(makeMessage(MessageType::Hello, 0, 0, 0, 0, "role=dem"));
+        } catch (...) {
+        }
+        ::kill(getpid(), SIGKILL);  // never returns into the test runner
+    }
     std::unique_ptr<Transport> fluid = listen(o);
-    Options od = o;
-    od.recordFile = tempPath("record");
-    std::remove(od.recordFile.c_str());
-    std::unique_ptr<Transport> dem = connect(od);
-    dem->send(sample());
-    EXPECT_EQ(fluid->receive().data, sample().data);
-    fluid->send(makeMessage(MessageType::StepDone, 12, 4, 0, 0, "iterations=4"));
-    EXPECT_EQ(dem->receive().text, "iterations=4");
-    EXPECT_THROW(dem->receive(), CouplerError);  // nothing more within receiveTimeout
-    FILE* f = std::fopen(od.recordFile.c_str(), "rb");
-    ASSERT_TRUE(f != nullptr);
-    std::fclose(f);
+    EXPECT_EQ(fluid->receive().type, MessageType::Hello);
+    waitpid(child, nullptr, 0);
+    const Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { fluid->receive(); }, {"particle code closed the connection"});
+    EXPECT_LT(since(t0), 1.0);
+}
+
+TEST(File, PeerThatNeverJoins)
+{
+    Options o;
+    o.transport = "file";
+    o.directory = tempPath("never");
+    o.connectTimeout = 0.5;
+    Clock::time_point t0 = Clock::now();
+    expectCouplerError([&] { listen(o); }, {"no peer joined", o.directory, "0.5 s"});
+    EXPECT_LT(since(t0), 1.5);
+    std::remove((o.directory + "/fluid.session").c_str());
+    t0 = Clock::now();
+    expectCouplerError([&] { connect(o); }, {"did not open the coupling directory"});
+    EXPECT_LT(since(t0), 1.5);
+}
+
+TEST(Transport, UnknownTransportIsNamed)
+{
+    Options o;
+    o.transport = "pigeon";
+    expectCouplerError([&] { listen(o); }, {"pigeon"});
+}
+
+// ---- replay tool ------------------------------------------------------------------------------------
+
+TEST(Dump, PrintsARecordAndRejectsACorruptOne)
+{
+    const std::string record = tempPath("dump.record");
+    std::remove(record.c_str());
+    {
+        SocketPair pair(Options(), record);
+        pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=1"));
+        pair.fluid->receive();
+        pair.fluid->send(sample(12, 3));
+        pair.dem->receive();
+    }
+    const std::string command = std::string(FDM_COUPLER_DUMP) + " " + record + " 2>&1";
+    FILE* p = popen(command.c_str(), "r");
+    ASSERT_TRUE(p != nullptr);
+    std::string out;
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    EXPECT_EQ(0, WEXITSTATUS(pclose(p))) << out;
+    EXPECT_NE(out.find("dem -> fluid Hello"), std::string::npos) << out;
+    EXPECT_NE(out.find("fluid -> dem   Integrals  step 12 iteration 3"), std::string::npos) << out;
+    EXPECT_NE(out.find("0.75"), std::string::npos) << out;  // 1/1 - 0.25, first value
+    EXPECT_NE(out.find("2 messages"), std::string::npos) << out;
+
+    {
+        std::ofstream f(record.c_str(), std::ios::app | std::ios::binary);
+        f << "FDMC garbage";
+    }
+    p = popen(command.c_str(), "r");
+    out.clear();
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    EXPECT_NE(0, WEXITSTATUS(pclose(p)));
+    EXPECT_NE(out.find("(message 3): truncated"), std::string::npos) << out;
 }

@@ -72,6 +72,8 @@ int main(int argc, char *argv[])
     scalar fluidTime = 0, particleTime = 0, outputTime = 0;
     label nStepsDone = 0, nInnerTotal = 0;
     const double runStart = wallClock();
+    // waiting for the particle code to connect is not part of the run
+    const scalar exchangeBeforeRun = coupling.exchangeTime();
     List<fdmParticle> stepParticles;
 
     Info<< nl << "Starting time loop (driven by fdmDEM)" << nl << endl;
@@ -206,7 +208,7 @@ int main(int argc, char *argv[])
     runTime.writeNow();
 
     const scalar total = wallClock() - runStart;
-    const scalar exchange = coupling.exchangeTime();
+    const scalar exchange = coupling.exchangeTime() - exchangeBeforeRun;
     auto pct = [total](scalar t) { return 100*t/max(total, VSMALL); };
     Info<< nl << "fdmFoam time breakdown (" << nStepsDone << " steps, "
         << nInnerTotal << " inner iterations, " << total << " s wall):" << nl

@@ -1,0 +1,677 @@
+// Tests of fdmDEM and fix fdm/couple: the real fdmDEM (real LIGGGHTS, real MPI) runs as a child
+// process against a scripted fluid peer that speaks the coupling protocol (a test harness, not a
+// fluid solver): it sends fixed integrals and checks that the velocities returned are the analytic
+// solution of Eq. (31) for a diagonal system, and it misbehaves on purpose to test error handling.
+#include "fdm/coupler.h"
+
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <netinet/in.h>
+#include <sstream>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace cpl = fdm::coupler;
+
+namespace {
+
+const double pi = 3.14159265358979323846;
+
+std::string workDir(const std::string& name)
+{
+    const std::string dir = "/tmp/fdmDEMTest." + std::to_string(getpid()) + "." + name;
+    ::mkdir(dir.c_str(), 0755);
+    return dir;
+}
+
+// ---- the LIGGGHTS input ---------------------------------------------------------------------------
+
+struct Sphere {
+    double x, y, z, radius, density;
+};
+
+struct Scene {
+    std::string boundary = "p p p";
+    double lo[3] = {0, 0, 0}, hi[3] = {8, 8, 8};
+    std::vector<Sphere> spheres = {{2.0, 3.0, 4.0, 0.5, 2500.0}, {6.0, 5.0, 3.5, 0.7, 1500.0},
+                                   {5.5, 1.5, 6.5, 0.4, 4000.0}};
+    double dt = 0.01;
+    std::string beforeFix;   // lines before the fix (fix addforce, dump, ...)
+    std::string fixOptions;  // extra fdm/couple keywords
+    std::string runs = "run 2";
+    std::string transport = "portfile coupling.port";
+};
+
+void writeInput(const std::string& dir, const Scene& s)
+{
+    std::ofstream in((dir + "/in.dem").c_str());
+    in.precision(17);
+    in << "atom_style      sphere\n"
+          "atom_modify     map array sort 0 0.0\n"
+          "boundary        " << s.boundary << "\n"
+          "newton          off\n"
+          "communicate     single vel yes\n"
+          "units           si\n"
+          "region          box block " << s.lo[0] << " " << s.hi[0] << " " << s.lo[1] << " " << s.hi[1] << " "
+       << s.lo[2] << " " << s.hi[2] << " units box\n"
+          "create_box      1 box\n";
+    for (const Sphere& p : s.spheres) in << "create_atoms    1 single " << p.x << " " << p.y << " " << p.z << " units box\n";
+    for (size_t i = 0; i < s.spheres.size(); ++i)
+        in << "set             atom " << i + 1 << " diameter " << 2 * s.spheres[i].radius << " density "
+           << s.spheres[i].density << "\n";
+    in << "pair_style      none\n"
+          "neighbor        0.1 bin\n"
+          "timestep        " << s.dt << "\n"
+       << s.beforeFix << "\n"
+       << "fix             couple all fdm/couple " << s.transport << " connect_timeout 5 timeout 10 " << s.fixOptions
+       << "\n" << s.runs << "\n";
+}
+
+// ---- running fdmDEM ---------------------------------------------------------------------------------
+
+struct DemRun {
+    int status;
+    std::string output;
+    double seconds;
+};
+
+DemRun runDEM(const std::string& dir, int ranks = 1)
+{
+    std::string command = "cd '" + dir + "' && timeout -k 5 60 ";
+    if (ranks > 1) command += std::string(FDM_MPIEXEC) + " -np " + std::to_string(ranks) + " --oversubscribe ";
+    command += std::string(FDM_DEM_EXE) + " -in in.dem 2>&1";
+    const auto t0 = std::chrono::steady_clock::now();
+    FILE* p = popen(command.c_str(), "r");
+    std::string out;
+    char buf[4096];
+    while (p && std::fgets(buf, sizeof buf, p)) out += buf;
+    const int status = p ? pclose(p) : -1;
+    DemRun r;
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.output = out;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+}
+
+// ---- the scripted fluid peer ------------------------------------------------------------------------
+
+struct FakeFluid {
+    enum Mode { Normal, DieAfterStep, ErrorAfterStep, WrongTypeAfterStep, ZeroVolume, NaNIntegral };
+    Mode mode = Normal;
+    cpl::Options options;
+    long nExpected = -1;
+    double alphaLambda = 0.25, rhoFluid = 1000.0, delta = 0.2;
+    double box[6] = {0, 8, 0, 8, 0, 8};
+    int periodic[3] = {1, 1, 1};
+    uint32_t iterations = 3;
+
+    // what happened
+    cpl::Message demHello;
+    std::vector<cpl::Message> steps, integrals, velocities, stepDones;
+    bool finished = false;
+    std::string error;
+    std::thread thread;
+
+    explicit FakeFluid(const std::string& dir)
+    {
+        options.portFile = dir + "/coupling.port";
+        options.name = "particle code fdmDEM";
+        options.connectTimeout = 15;
+        options.receiveTimeout = 15;
+        std::remove(options.portFile.c_str());
+    }
+    ~FakeFluid()
+    {
+        if (thread.joinable()) thread.join();
+    }
+    void start()
+    {
+        thread = std::thread([this] {
+            try {
+                run();
+            } catch (const std::exception& e) {
+                error = e.what();
+            }
+        });
+    }
+    void join() { thread.join(); }
+
+    // Deterministic, particle- and iteration-dependent integrals (all SI).
+    static double volume(double a) { return 4.0 / 3.0 * pi * a * a * a; }
+    cpl::Message makeIntegrals(const cpl::Message& step, uint32_t k) const
+    {
+        using namespace cpl::layout;
+        cpl::Message m = cpl::makeMessage(cpl::MessageType::Integrals, step.step, k, step.count, integralsWidth);
+        for (uint32_t p = 0; p < step.count; ++p) {
+            const double a = step.at(p, sRadius);
+            m.at(p, iVu) = volume(a) * (1.0 + 0.01 * k);
+            m.at(p, iJu) = 0.4 * a * a * m.at(p, iVu);
+            for (int d = 0; d < 3; ++d) {
+                m.at(p, iFx + d) = 0.1 * (p + 1) * (d + 1) * k - 0.3 + 0.01 * double(step.step);
+                m.at(p, iTx + d) = 0.02 * (p + 2) * (3 - d) - 0.05 * k;
+            }
+        }
+        if (mode == ZeroVolume && k == 2) m.at(1, iVu) = 0.0;
+        if (mode == NaNIntegral && k == 2) m.at(2, iFy) = std::nan("");
+        return m;
+    }
+    static double hydro(uint32_t p, int c, uint64_t step) { return 10.0 * (p + 1) + c + 0.5 * double(step); }
+
+    void run()
+    {
+        std::unique_ptr<cpl::Transport> t = cpl::listen(options);
+        demHello = t->receive(cpl::MessageType::Hello);
+        cpl::Message hello = cpl::makeMessage(cpl::MessageType::Hello, 0, 0, 1, cpl::layout::helloFluidWidth,
+                                              "role=fluid version=" + std::to_string(cpl::protocolVersion));
+        hello.data = {double(nExpected), alphaLambda, rhoFluid, delta, box[0], box[1], box[2], box[3], box[4], box[5],
+                      double(periodic[0]), double(periodic[1]), double(periodic[2])};
+        t->send(hello);
+        while (true) {
+            cpl::Message m = t->receive();
+            if (m.type == cpl::MessageType::Finish) {
+                finished = true;
+                return;
+            }
+            if (m.type != cpl::MessageType::Step) throw cpl::CouplerError("harness: got " + std::string(cpl::messageTypeName(m.type)));
+            steps.push_back(m);
+            if (mode == DieAfterStep) return;  // t goes out of scope: the socket closes as on a crash
+            if (mode == ErrorAfterStep) {
+                t->sendError("fdmFoam: the pressure solver diverged at step " + std::to_string(m.step));
+                return;
+            }
+            if (mode == WrongTypeAfterStep) {
+                t->send(cpl::makeMessage(cpl::MessageType::Velocities, m.step, 1, m.count, 6));
+                t->receive();  // the DEM's Error
+                return;
+            }
+            for (uint32_t k = 1; k <= iterations; ++k) {
+                integrals.push_back(makeIntegrals(m, k));
+                t->send(integrals.back());
+                velocities.push_back(t->receive(cpl::MessageType::Velocities));
+            }
+            cpl::Message done = cpl::makeMessage(cpl::MessageType::StepDone, m.step, iterations, m.count,
+                                                 cpl::layout::stepDoneWidth,
+                                                 "iterations=" + std::to_string(iterations) + " residual=1.25e-07 converged=1");
+            for (uint32_t p = 0; p < m.count; ++p)
+                for (int c = 0; c < 6; ++c) done.at(p, c) = hydro(p, c, m.step);
+            stepDones.push_back(done);
+            t->send(done);
+        }
+    }
+};
+
+// A "fluid" that is not an fdm coupler at all: accepts, then writes bytes that are no message.
+void garbageServer(const std::string& portFile, std::string& problem)
+{
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a;
+    std::memset(&a, 0, sizeof a);
+    a.sin_family = AF_INET;
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 || ::listen(fd, 1) != 0) {
+        problem = "bind";
+        return;
+    }
+    socklen_t len = sizeof a;
+    getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+    std::ofstream(portFile.c_str()) << ntohs(a.sin_port) << "\n";
+    const int c = accept(fd, nullptr, nullptr);
+    char buf[1024];
+    recv(c, buf, sizeof buf, 0);  // the DEM's Hello
+    const char junk[] = "HTTP/1.1 400 Bad Request\r\n\r\nnot a coupler";
+    send(c, junk, sizeof junk, MSG_NOSIGNAL);
+    std::this_thread::sleep_for(std::chrono::seconds(2));
+    close(c);
+    close(fd);
+}
+
+void expectContains(const std::string& text, const std::string& needle)
+{
+    EXPECT_NE(text.find(needle), std::string::npos) << "'" << needle << "' not in:\n" << text;
+}
+
+double relativeDifference(double a, double b) { return std::fabs(a - b) / std::max(1e-300, std::max(std::fabs(a), std::fabs(b))); }
+
+// U = alpha (F + (rho_p - rho_f)/rho_p m g + f_ext) / (rho_f Vu), Omega = alpha T / (rho_f Ju): Eq. (31)
+// with R^SG = 0 is diagonal, particle by particle.
+void expectAnalyticVelocities(const FakeFluid& fluid, const Scene& scene, const double g[3], const double fext[3])
+{
+    using namespace cpl::layout;
+    ASSERT_EQ(fluid.velocities.size(), fluid.integrals.size());
+    ASSERT_FALSE(fluid.velocities.empty());
+    for (size_t m = 0; m < fluid.velocities.size(); ++m) {
+        const cpl::Message& in = fluid.integrals[m];
+        const cpl::Message& out = fluid.velocities[m];
+        EXPECT_EQ(out.step, in.step);
+        EXPECT_EQ(out.iteration, in.iteration);
+        ASSERT_EQ(out.count, scene.spheres.size());
+        ASSERT_EQ(out.width, uint32_t(velocitiesWidth));
+        for (uint32_t p = 0; p < out.count; ++p) {
+            const Sphere& s = scene.spheres[p];
+            const double mass = s.density * FakeFluid::volume(s.radius);
+            const double buoyant = (s.density - fluid.rhoFluid) / s.density * mass;
+            for (int d = 0; d < 3; ++d) {
+                const double U = fluid.alphaLambda * (in.at(p, iFx + d) + buoyant * g[d] + fext[d]) /
+                                 (fluid.rhoFluid * in.at(p, iVu));
+                const double W = fluid.alphaLambda * in.at(p, iTx + d) / (fluid.rhoFluid * in.at(p, iJu));
+                EXPECT_LT(relativeDifference(out.at(p, vUx + d), U), 1e-12)
+                    << "particle " << p + 1 << " U" << "xyz"[d] << " step " << out.step << " iteration " << out.iteration
+                    << ": " << out.at(p, vUx + d) << " vs " << U;
+                EXPECT_LT(relativeDifference(out.at(p, vWx + d), W), 1e-12)
+                    << "particle " << p + 1 << " Omega" << "xyz"[d] << ": " << out.at(p, vWx + d) << " vs " << W;
+            }
+        }
+    }
+}
+
+// The whole scene of the physics tests: gravity, an external force, three particles of different
+// radius and density, moving.
+Scene physicsScene()
+{
+    Scene s;
+    s.beforeFix = "fix             pull all addforce 0.5 -0.25 0.125";
+    s.fixOptions = "gravity 0 0 -9.81";
+    s.runs = "dump            hydro all custom 1 hydro.dump id f_couple[1] f_couple[2] f_couple[3] f_couple[4] "
+             "f_couple[5] f_couple[6]\n"
+             "dump_modify     hydro sort id format \"%d %.17g %.17g %.17g %.17g %.17g %.17g\"\n"
+             "thermo_style    custom step f_couple[1] f_couple[2]\n"
+             "thermo          1\n"
+             "run             2\n"
+             "variable        it equal f_couple[1]\n"
+             "variable        res equal f_couple[2]\n"
+             "print           \"COUPLE iterations ${it} residual ${res}\"";
+    return s;
+}
+
+}  // namespace
+
+// ---- physics of the particle side -------------------------------------------------------------------
+
+TEST(FdmDEM, VelocitiesAreTheAnalyticSolutionOfEq31)
+{
+    const std::string dir = workDir("analytic");
+    const Scene scene = physicsScene();
+    writeInput(dir, scene);
+    FakeFluid fluid(dir);
+    fluid.start();
+    const DemRun run = runDEM(dir);
+    fluid.join();
+    ASSERT_EQ(run.status, 0) << run.output;
+    EXPECT_EQ(fluid.error, "");
+    EXPECT_TRUE(fluid.finished) << "no Finish after the input";
+
+    const double g[3] = {0, 0, -9.81}, fext[3] = {0.5, -0.25, 0.125};
+    expectAnalyticVelocities(fluid, scene, g, fext);
+    ASSERT_EQ(fluid.steps.size(), 2u);
+    EXPECT_EQ(fluid.velocities.size(), 6u);  // 2 steps x 3 inner iterations
+
+    // Hello: N, box, periodicity, dt
+    EXPECT_EQ(fluid.demHello.at(0, 0), 3.0);
+    EXPECT_EQ(fluid.demHello.at(0, 2), 8.0);
+    EXPECT_EQ(fluid.demHello.at(0, 7), 1.0);
+    EXPECT_DOUBLE_EQ(fluid.demHello.textNumber("dt"), 0.01);
+    EXPECT_EQ(fluid.demHello.textNumber("lastStep"), 2.0);
+
+    // Step 1: particles by tag, with their radius; step 2: moved by dt * (U of the last inner
+    // iteration of step 1), and U, Omega in the record are those velocities.
+    using namespace cpl::layout;
+    const cpl::Message &s1 = fluid.steps[0], &s2 = fluid.steps[1];
+    EXPECT_EQ(s1.step, 1u);
+    EXPECT_EQ(s2.step, 2u);
+    const cpl::Message& last1 = fluid.velocities[2];
+    for (uint32_t p = 0; p < 3; ++p) {
+        EXPECT_EQ(s1.at(p, sTag), p + 1.0);
+        EXPECT_DOUBLE_EQ(s1.at(p, sRadius), scene.spheres[p].radius);
+        const double x0[3] = {scene.spheres[p].x, scene.spheres[p].y, scene.spheres[p].z};
+        for (int d = 0; d < 3; ++d) {
+            EXPECT_DOUBLE_EQ(s1.at(p, sX + d), x0[d]) << "moved before any velocity was solved";
+            EXPECT_NEAR(s2.at(p, sX + d), x0[d] + scene.dt * last1.at(p, vUx + d), 1e-12);
+            EXPECT_EQ(s2.at(p, sUx + d), last1.at(p, vUx + d));
+            EXPECT_EQ(s2.at(p, sWx + d), last1.at(p, vWx + d));
+        }
+    }
+
+    // Per-atom output: the hydrodynamic force and torque of the last StepDone of each step
+    std::ifstream dump((dir + "/hydro.dump").c_str());
+    std::string line;
+    int timestep = -1, checked = 0;
+    while (std::getline(dump, line)) {
+        if (line == "ITEM: TIMESTEP") { dump >> timestep; continue; }
+        if (line.compare(0, 11, "ITEM: ATOMS") != 0) continue;
+        for (int p = 0; p < 3; ++p) {
+            int id;
+            double v[6];
+            dump >> id >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5];
+            for (int c = 0; c < 6; ++c)
+                EXPECT_EQ(v[c], timestep == 0 ? 0.0 : FakeFluid::hydro(id - 1, c, timestep))
+                    << "step " << timestep << " particle " << id << " column " << c + 1;
+            ++checked;
+        }
+    }
+    EXPECT_EQ(checked, 9);  // steps 0, 1, 2
+
+    // Global outputs and the timing report
+    expectContains(run.output, "COUPLE iterations 3 residual 1.25e-07");
+    expectContains(run.output, "fdm/couple timing of this run (1 run, 2 steps");
+    expectContains(run.output, "particle solve");
+    expectContains(run.output, "fdm/couple timing total (1 run, 2 steps");
+}
+
+TEST(FdmDEM, MoveNoHoldsTheParticlesAndTheConnectionOutlivesARun)
+{
+    const std::string dir = workDir("runs");
+    Scene scene;
+    scene.fixOptions = "move no";
+    scene.runs = "run 2\nset atom 1 x 3.25\nrun 1\nrun 1";
+    writeInput(dir, scene);
+    FakeFluid fluid(dir);
+    fluid.iterations = 2;
+    fluid.start();
+    const DemRun run = runDEM(dir);
+    fluid.join();
+    ASSERT_EQ(run.status, 0) << run.output;
+    ASSERT_EQ(fluid.steps.size(), 4u);  // one connection for three runs
+    EXPECT_TRUE(fluid.finished);
+    EXPECT_EQ(fluid.steps[1].at(0, cpl::layout::sX), 2.0);   // not moved although U != 0
+    EXPECT_EQ(fluid.steps[2].at(0, cpl::layout::sX), 3.25);  // where the input put it
+    EXPECT_EQ(fluid.steps[3].at(0, cpl::layout::sX), 3.25);
+    EXPECT_EQ(fluid.steps[3].step, 4u);
+    expectContains(run.output, "fdm/couple timing total (3 runs, 4 steps");
+}
+
+TEST(FdmDEM, TwoRanksGiveTheSameVelocitiesAsOne)
+{
+    const Scene scene = physicsScene();
+    std::vector<cpl::Message> results[2];
+    for (int ranks = 1; ranks <= 2; ++ranks) {
+        const std::string dir = workDir("mpi" + std::to_string(ranks));
+        writeInput(dir, scene);
+        FakeFluid fluid(dir);
+        fluid.start();
+        const DemRun run = runDEM(dir, ranks);
+        fluid.join();
+        ASSERT_EQ(run.status, 0) << run.output;
+        if (ranks == 2) expectContains(run.output, "Nlocal:    1.5 ave 2 max 1 min");  // both ranks own particles
+        results[ranks - 1] = fluid.velocities;
+        results[ranks - 1].insert(results[ranks - 1].end(), fluid.steps.begin(), fluid.steps.end());
+    }
+    ASSERT_EQ(results[0].size(), results[1].size());
+    for (size_t m = 0; m < results[0].size(); ++m) {
+        ASSERT_EQ(results[0][m].data.size(), results[1][m].data.size());
+        for (size_t k = 0; k < results[0][m].data.size(); ++k)
+            EXPECT_LE(relativeDifference(results[0][m].data[k], results[1][m].data[k]), 1e-12)
+                << cpl::messageTypeName(results[0][m].type) << " " << m << " value " << k;
+    }
+}
+
+TEST(FdmDEM, FileTransportAndRecordGiveTheSameRun)
+{
+    const std::string dir = workDir("file");
+    Scene scene = physicsScene();
+    scene.transport = "transport file directory coupling";
+    scene.fixOptions += " record coupling.record";
+    writeInput(dir, scene);
+    FakeFluid fluid(dir);
+    fluid.options.transport = "file";
+    fluid.options.directory = dir + "/coupling";
+    fluid.start();
+    const DemRun run = runDEM(dir);
+    fluid.join();
+    ASSERT_EQ(run.status, 0) << run.output;
+    const double g[3] = {0, 0, -9.81}, fext[3] = {0.5, -0.25, 0.125};
+    expectAnalyticVelocities(fluid, scene, g, fext);
+    // the record holds the whole conversation: 2 Hello, 2 Step, 6 Integrals, 6 Velocities, 2 StepDone, Finish
+    std::ifstream in((dir + "/coupling.record").c_str(), std::ios::binary);
+    std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    size_t at = 0, n = 0;
+    while (at + cpl::headerSize <= b.size()) { at += cpl::encodedSize(&b[at]); ++n; }
+    EXPECT_EQ(n, 19u);
+}
+
+// ---- bad input: a clear error naming the particle or value, a non-zero exit, within seconds ----------
+
+namespace {
+// Runs a scene expected to fail; returns the run, checks status and duration, and that the fluid
+// peer (if any) was told why.
+DemRun expectFailure(const std::string& name, const Scene& scene, std::function<void(FakeFluid&)> setup,
+                  const std::string& needle, bool withFluid = true, double within = 10.0, int ranks = 1)
+{
+    const std::string dir = workDir(name);
+    writeInput(dir, scene);
+    std::unique_ptr<FakeFluid> fluid;
+    if (withFluid) {
+        fluid.reset(new FakeFluid(dir));
+        if (setup) setup(*fluid);
+        fluid->start();
+    }
+    const DemRun run = runDEM(dir, ranks);
+    if (fluid) fluid->join();
+    EXPECT_NE(run.status, 0) << run.output;
+    EXPECT_NE(run.status, 124) << "timed out:\n" << run.output;
+    expectContains(run.output, "ERROR");
+    expectContains(run.output, needle);
+    EXPECT_LT(run.seconds, within) << run.output;
+    if (fluid && fluid->mode == FakeFluid::Normal) expectContains(fluid->error, needle);  // the peer was told
+    return run;
+}
+}  // namespace
+
+TEST(FdmDEMErrors, ParticleCrossingAWall)
+{
+    Scene scene;
+    scene.boundary = "p f p";
+    scene.spheres[1].y = 7.6;  // radius 0.7: through the wall y = 8
+    expectFailure("wall", scene, [](FakeFluid& f) { f.periodic[1] = 0; },
+                  "particle 2 at (6, 7.6, 3.5) with radius 0.7 crosses the wall y = 8");
+}
+
+TEST(FdmDEMErrors, ParticleCentreOutsideTheBox)
+{
+    Scene scene;
+    scene.boundary = "p p f";
+    scene.runs = "set atom 3 z 8.5\nrun 1";  // LIGGGHTS loses an atom beyond a non-periodic face
+    expectFailure("outside", scene, [](FakeFluid& f) { f.periodic[2] = 0; },
+                  "particle 3 is missing: LIGGGHTS lost it (was it put or moved outside a non-periodic face of the box?");
+}
+
+TEST(FdmDEMErrors, OverlappingParticles)
+{
+    Scene scene;
+    scene.spheres.push_back({6.0, 5.0, 4.6, 0.5, 1000.0});  // 1.1 above particle 2 (radius 0.7): gap -0.1
+    expectFailure("overlap", scene, nullptr,
+                  "particles 2 and 4 overlap: centres (6, 5, 3.5) and (6, 5, 4.6), radii 0.7 and 0.5, surface gap -0.1");
+}
+
+TEST(FdmDEMErrors, OverlapThroughAPeriodicFace)
+{
+    Scene scene;
+    scene.spheres[0].x = 0.2;
+    scene.spheres.push_back({7.5, 3.0, 4.0, 0.5, 1000.0});  // minimum image distance 0.7 < 1.0
+    expectFailure("overlapPeriodic", scene, nullptr, "particles 1 and 4 overlap");
+}
+
+TEST(FdmDEMErrors, ManyParticlesAreCheckedQuickly)
+{
+    // 8000 particles on a lattice (the binned check is O(N log N)), the last one placed on another
+    Scene scene;
+    scene.spheres.clear();
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j)
+            for (int k = 0; k < 20; ++k) scene.spheres.push_back({0.2 + 0.4 * i, 0.2 + 0.4 * j, 0.2 + 0.4 * k, 0.15, 1000.0});
+    scene.spheres.back().x = 7.45;  // against particle 7600 at 7.4: gap -0.25
+    const DemRun run = expectFailure("many", scene, nullptr, "particles 7600 and 8000 overlap", true, 30.0);
+    (void)run;
+}
+
+TEST(FdmDEMErrors, ParticleInsertedDuringTheSession)
+{
+    Scene scene;
+    scene.runs = "run 1\ncreate_atoms 1 single 1 7 1 units box\nrun 1";
+    expectFailure("inserted", scene, nullptr,
+                  "the particles changed since the coupling started: 4 atoms with IDs up to 4 where the fluid solver "
+                  "was told of 3");
+}
+
+TEST(FdmDEMErrors, ParticleCountMismatch)
+{
+    Scene scene;
+    scene.spheres.pop_back();
+    expectFailure("count", scene, [](FakeFluid& f) { f.nExpected = 3; },
+                  "the fluid case expects 3 particles (constant/fdmProperties nParticles) but the LIGGGHTS input has 2");
+}
+
+TEST(FdmDEMErrors, BoxMismatch)
+{
+    Scene scene;
+    expectFailure("box", scene, [](FakeFluid& f) { f.box[1] = 10; }, "x extent: LIGGGHTS box 0 .. 8 but OpenFOAM mesh 0 .. 10");
+}
+
+TEST(FdmDEMErrors, PeriodicityMismatch)
+{
+    Scene scene;
+    expectFailure("periodic", scene, [](FakeFluid& f) { f.periodic[2] = 0; },
+                  "z boundary: LIGGGHTS periodic (p) but the OpenFOAM mesh has no cyclic patches in z");
+}
+
+TEST(FdmDEMErrors, FluidNeverStarts)
+{
+    Scene scene;
+    scene.fixOptions = "connect_timeout 2";
+    const DemRun run = expectFailure("never", scene, nullptr, "could not connect to the fluid solver fdmFoam within 2 s",
+                                  false, 6.0);
+    EXPECT_GT(run.seconds, 1.9);
+}
+
+TEST(FdmDEMErrors, FluidDiesMidStep)
+{
+    Scene scene;
+    scene.runs = "run 100";
+    expectFailure("dies", scene, [](FakeFluid& f) { f.mode = FakeFluid::DieAfterStep; },
+                  "the fluid solver fdmFoam closed the connection (did it crash? see its log)", true, 5.0);
+}
+
+TEST(FdmDEMErrors, FluidDiesMidStepWithTwoRanks)
+{
+    // rank 0 alone talks to the fluid: its error must still end every rank at once
+    Scene scene;
+    scene.runs = "run 100";
+    expectFailure("dies2", scene, [](FakeFluid& f) { f.mode = FakeFluid::DieAfterStep; },
+                  "the fluid solver fdmFoam closed the connection (did it crash? see its log)", true, 8.0, 2);
+}
+
+TEST(FdmDEMErrors, OverlapWithTwoRanks)
+{
+    Scene scene;
+    scene.spheres.push_back({6.0, 5.0, 4.6, 0.5, 1000.0});
+    expectFailure("overlap2", scene, nullptr, "particles 2 and 4 overlap", true, 8.0, 2);
+}
+
+TEST(FdmDEMErrors, LiggghtsErrorAfterARunIsToldToTheFluid)
+{
+    const std::string dir = workDir("liggghtsError");
+    Scene scene;
+    scene.runs = "run 1\nthis_is_not_a_command";
+    writeInput(dir, scene);
+    FakeFluid fluid(dir);
+    fluid.start();
+    const DemRun run = runDEM(dir);
+    fluid.join();
+    EXPECT_NE(run.status, 0);
+    expectContains(run.output, "Unknown command: this_is_not_a_command");
+    expectContains(fluid.error, "fdmDEM stopped before the end of its input");
+    EXPECT_FALSE(fluid.finished);
+}
+
+TEST(FdmDEMErrors, FluidSendsError)
+{
+    Scene scene;
+    expectFailure("error", scene, [](FakeFluid& f) { f.mode = FakeFluid::ErrorAfterStep; },
+                  "the fluid solver fdmFoam stopped: fdmFoam: the pressure solver diverged at step 1");
+}
+
+TEST(FdmDEMErrors, FluidSendsAnUnexpectedMessage)
+{
+    Scene scene;
+    expectFailure("wrongType", scene, [](FakeFluid& f) { f.mode = FakeFluid::WrongTypeAfterStep; },
+                  "expected Integrals or StepDone from the fluid solver, got Velocities (step 1)");
+}
+
+TEST(FdmDEMErrors, FluidSendsGarbage)
+{
+    const std::string dir = workDir("garbage");
+    Scene scene;
+    writeInput(dir, scene);
+    std::string problem;
+    std::remove((dir + "/coupling.port").c_str());
+    std::thread server([&] { garbageServer(dir + "/coupling.port", problem); });
+    const DemRun run = runDEM(dir);
+    server.join();
+    EXPECT_NE(run.status, 0);
+    expectContains(run.output, "bad magic");
+    EXPECT_LT(run.seconds, 10.0);
+}
+
+TEST(FdmDEMErrors, ParticleWithNoFluidVolume)
+{
+    Scene scene;
+    expectFailure("zeroVolume", scene, [](FakeFluid& f) { f.mode = FakeFluid::ZeroVolume; },
+                  "particle 2 at (6, 5, 3.5) with radius 0.7: the fluid's indicator function gives it no volume (Vu 0");
+}
+
+TEST(FdmDEMErrors, NonFiniteIntegral)
+{
+    Scene scene;
+    expectFailure("nan", scene, [](FakeFluid& f) { f.mode = FakeFluid::NaNIntegral; },
+                  "non-finite integral for particle 3");
+}
+
+TEST(FdmDEMErrors, NveSphereWithTheCouplingFix)
+{
+    Scene scene;
+    scene.beforeFix = "fix             integrate all nve/sphere";
+    expectFailure("nve", scene, nullptr, "remove fix integrate (nve/sphere)", false);
+}
+
+TEST(FdmDEMErrors, MapArrayIsRequired)
+{
+    const std::string dir = workDir("map");
+    Scene scene;
+    writeInput(dir, scene);
+    // rewrite the atom_modify line
+    std::ifstream in((dir + "/in.dem").c_str());
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    s.replace(s.find("map array"), 9, "map hash");
+    std::ofstream((dir + "/in.dem").c_str()) << s;
+    const DemRun run = runDEM(dir);
+    EXPECT_NE(run.status, 0);
+    expectContains(run.output, "fix fdm/couple requires atom_modify map array");
+}
+
+TEST(FdmDEMErrors, UnknownKeyword)
+{
+    Scene scene;
+    scene.fixOptions = "gravitation 0 0 -9.81";
+    expectFailure("keyword", scene, nullptr, "fix fdm/couple: unknown keyword gravitation", false);
+}
+
+int main(int argc, char** argv)
+{
+    // mpirun refuses root unless told
+    setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+    setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    ::testing::InitGoogleTest(&argc, argv);
+    return RUN_ALL_TESTS();
+}
