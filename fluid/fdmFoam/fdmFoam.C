@@ -172,8 +172,9 @@ int main(int argc, char *argv[])
 
         const double tEnd = wallClock();
         List<scalar> hydroForces = forcing.hydrodynamicForces(lambda);
-        coupling.sendStepDone(innerIteration, residual, converged, hydroForces);
         stepParticleTime += wallClock() - tEnd;
+        // (the coupling times the send itself, as exchange)
+        coupling.sendStepDone(innerIteration, residual, converged, hydroForces);
         const scalar stepExchangeTime = coupling.exchangeTime() - exchangeAtStart;
 
         const double tOut = wallClock();
