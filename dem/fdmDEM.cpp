@@ -2,7 +2,9 @@
 //   fdmDEM -in input [-var name value ...] [-echo screen] [other LIGGGHTS options]   (serial or mpirun)
 // The styles are added to LIGGGHTS's style maps before the input is read, so no LIGGGHTS rebuild
 // is needed (docs/dem.md). After the input script, the fluid solver is told to finish.
+#include "fix_contact_history_fdm.h"
 #include "fix_fdm_couple.h"
+#include "pair_fdm_subgrid.h"
 #include "style_registry.h"
 
 #include "input.h"
@@ -18,7 +20,8 @@ namespace {
 const char usage[] =
     "usage: fdmDEM -in INPUT [-var NAME VALUE ...] [-echo screen] [-log FILE] [other LIGGGHTS options]\n"
     "       mpirun -np N fdmDEM -in INPUT ...\n"
-    "LIGGGHTS 3.8 with fix fdm/couple (coupling to the fluid solver fdmFoam); see docs/dem.md.\n";
+    "LIGGGHTS 3.8 with fix fdm/couple (coupling to the fluid solver fdmFoam) and pair_style fdm/subgrid\n"
+    "(sub-grid lubrication and frictional contact); see docs/dem.md.\n";
 }
 
 int main(int argc, char **argv)
@@ -47,6 +50,9 @@ int main(int argc, char **argv)
 
   LAMMPS_NS::LAMMPS *lmp = new LAMMPS_NS::LAMMPS(int(args.size()) - 1, args.data(), MPI_COMM_WORLD);
   fdm::registerFix<LAMMPS_NS::FixFdmCouple>(lmp, "fdm/couple");
+  fdm::registerPair<LAMMPS_NS::PairFdmSubgrid>(lmp, "fdm/subgrid");
+  // LIGGGHTS's contact history, made to serve pair fdm/subgrid too (Neighbor finds it by this name)
+  fdm::registerFix<LAMMPS_NS::FixContactHistoryFdm>(lmp, "contacthistory");
   lmp->input->file();
   LAMMPS_NS::FixFdmCouple::finishAll(lmp);
   delete lmp;

@@ -2,6 +2,8 @@
 // See fix_fdm_couple.h for what it does and docs/dem.md for its use.
 #include "fix_fdm_couple.h"
 
+#include "pair_fdm_subgrid.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
@@ -13,6 +15,7 @@
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -30,14 +33,17 @@ int FixFdmCouple::sessionParticles_ = 0;
 double FixFdmCouple::alphaLambda_ = 0.0;
 double FixFdmCouple::rhoFluid_ = 0.0;
 double FixFdmCouple::delta_ = 0.0;
+double FixFdmCouple::viscosity_ = 0.0;
+double FixFdmCouple::fluidFaces_[6][4] = {{0}};
 FixFdmCouple::Timing FixFdmCouple::total_;
 int FixFdmCouple::runs_ = 0;
 double FixFdmCouple::sessionStart_ = 0.0;
 
 namespace {
 
-// Per-atom values gathered to rank 0: tag, then the fields of Particle.
-const int gatherWidth = 19;
+// Per-atom values gathered to rank 0: tag, then the fields of Particle (the contact stresslet
+// only when stresslets are asked for).
+const int gatherWidth = 19, gatherStressWidth = 6;
 
 std::string fmt(double x)
 {
@@ -61,20 +67,41 @@ void FixFdmCouple::Timing::add(const Timing &t)
   exchange += t.exchange;
   gatherScatter += t.gatherScatter;
   steps += t.steps;
+  solves += t.solves;
+  solverIterations += t.solverIterations;
+  solverIterationsMax = std::max(solverIterationsMax, t.solverIterationsMax);
 }
 
+// Eq. (31) on rank 0 for one time step.
+struct FixFdmCouple::System {
+  Eigen::SparseMatrix<double> matrix;  // (rho_f/rho_p) J/alpha_lambda + R^SG
+  std::vector<int> diagonalIndex;      // position of entry (k, k) in matrix.valuePtr()
+  std::vector<double> subgridDiagonal; // R^SG(k, k)
+  Eigen::VectorXd wallRhs;             // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
+  Eigen::VectorXd diagonal;            // (rho_f/rho_p) J/alpha_lambda of the last inner iteration
+  std::vector<double> pairs, walls;    // the gathered blocks (stress rows used after the step)
+  int pairRecord, wallRecord;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                           Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double> > ldlt;
+  bool analysed;
+  System() : pairRecord(0), wallRecord(0), analysed(false) {}
+};
+
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
-  Fix(lmp, narg, arg), move_(true), atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
-  nmax_(0), perAtom_(nullptr)
+  Fix(lmp, narg, arg), move_(true), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(false), tolerance_(1e-10), pair_(nullptr),
+  atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
+  nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), solverIterationsMax_(0), pairBlocks_(0),
+  wallBlocks_(0), contacts_(0)
 {
   if (igroup != 0) error->all(FLERR, "fix fdm/couple must be applied to group all (every particle is in the fluid)");
   time_integrate = 1;
   vector_flag = 1;
-  size_vector = 4;
+  size_vector = 8;
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;
-  size_peratom_cols = 6;
+  size_peratom_cols = 12;
   peratom_freq = 1;
   gravity_[0] = gravity_[1] = gravity_[2] = 0.0;
   options_.name = "fluid solver fdmFoam";
@@ -87,8 +114,8 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
     };
     if (key == "transport") {
       options_.transport = value(1);
-      if (options_.transport != "socket" && options_.transport != "file")
-        error->all(FLERR, ("fix fdm/couple: transport " + options_.transport + " is not socket or file").c_str());
+      if (options_.transport != "socket" && options_.transport != "file" && options_.transport != "none")
+        error->all(FLERR, ("fix fdm/couple: transport " + options_.transport + " is not socket, file or none").c_str());
       i++;
     } else if (key == "host") { options_.host = value(1); i++; }
     else if (key == "port") { options_.port = force->inumeric(FLERR, value(1)); i++; }
@@ -105,10 +132,41 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       if (v != "yes" && v != "no") error->all(FLERR, "fix fdm/couple: move must be yes or no");
       move_ = (v == "yes");
       i++;
+    } else if (key == "viscosity") {
+      noFluidViscosity_ = force->numeric(FLERR, value(1));
+      i++;
+    } else if (key == "mesh") {
+      noFluidMesh_ = force->numeric(FLERR, value(1));
+      i++;
+    } else if (key == "fluid_density") {
+      noFluidDensity_ = force->numeric(FLERR, value(1));
+      i++;
+    } else if (key == "stresslets") {
+      const std::string v = value(1);
+      if (v != "yes" && v != "no") error->all(FLERR, "fix fdm/couple: stresslets must be yes or no");
+      stresslets_ = (v == "yes");
+      i++;
+    } else if (key == "solver") {
+      const std::string v = value(1);
+      if (v != "cg" && v != "ldlt") error->all(FLERR, "fix fdm/couple: solver must be cg or ldlt");
+      directSolver_ = (v == "ldlt");
+      i++;
+    } else if (key == "tolerance") {
+      tolerance_ = force->numeric(FLERR, value(1));
+      if (!(tolerance_ > 0 && tolerance_ < 1))
+        error->all(FLERR, "fix fdm/couple: tolerance (relative residual of Eq. 31) must be in (0, 1)");
+      i++;
     } else {
       error->all(FLERR, ("fix fdm/couple: unknown keyword " + key + " (see docs/dem.md)").c_str());
     }
   }
+  perAtomColumns_ = stresslets_ ? 25 : 12;
+  size_peratom_cols = perAtomColumns_;
+  if (options_.transport == "none" && (!(noFluidViscosity_ > 0) || !(noFluidMesh_ > 0) || !(noFluidDensity_ > 0)))
+    error->all(FLERR, "fix fdm/couple transport none (DEM only, no fluid) needs viscosity eta [Pa s] and mesh Delta [m] "
+                      "(the sub-grid model's mesh size), both positive; fluid_density (default 1000 kg/m3) too");
+  if (options_.transport == "none" && stresslets_)
+    error->all(FLERR, "fix fdm/couple: stresslets need the fluid solver (not with transport none)");
   if (options_.transport == "socket" && (options_.port <= 0 || options_.port > 65535) && options_.portFile.empty())
     error->all(FLERR, "fix fdm/couple: give the fluid solver's port (port P) or its port file (portfile F)");
   if (options_.transport == "file" && options_.directory.empty())
@@ -127,7 +185,7 @@ int FixFdmCouple::setmask()
   return FixConst::INITIAL_INTEGRATE | FixConst::FINAL_INTEGRATE;
 }
 
-void FixFdmCouple::init()
+void FixFdmCouple::checkAtoms()
 {
   if (!atom->sphere_flag || !atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag ||
       !atom->density_flag)
@@ -140,7 +198,14 @@ void FixFdmCouple::init()
     error->all(FLERR, ("fix fdm/couple requires atom IDs 1..N without gaps: there are " +
                        std::to_string((long long) atom->natoms) + " atoms but the largest ID is " +
                        std::to_string(atom->map_tag_max) + " (use reset_atom_ids or renumber the data file)").c_str());
+}
+
+void FixFdmCouple::init()
+{
+  checkAtoms();
   atomsAtInit_ = int(atom->natoms);
+  pair_ = dynamic_cast<PairFdmSubgrid *>(force->pair_match("fdm/subgrid", 1));
+  if (pair_) pair_->requestContactStress(stresslets_);
   if (force->newton_pair) error->all(FLERR, "fix fdm/couple requires newton off");
   if (std::strcmp(update->unit_style, "si") != 0)
     error->all(FLERR, (std::string("fix fdm/couple requires units si (the fluid solver works in SI), not units ") +
@@ -203,9 +268,9 @@ std::string FixFdmCouple::checkFluidHello(const cpl::Message &hello) const
   if (nExpected >= 0 && nExpected != natoms_)
     return "the fluid case expects " + std::to_string(nExpected) + " particles (constant/fdmProperties nParticles) "
            "but the LIGGGHTS input has " + std::to_string(natoms_);
-  if (!(r[1] > 0) || !(r[2] > 0) || !(r[3] > 0))
+  if (!(r[1] > 0) || !(r[2] > 0) || !(r[3] > 0) || !(r[cpl::layout::hfViscosity] > 0))
     return "the fluid solver sent a non-positive alpha_lambda (" + fmt(r[1]) + " s), rho_f (" + fmt(r[2]) +
-           " kg/m3) or mesh size (" + fmt(r[3]) + " m)";
+           " kg/m3), mesh size (" + fmt(r[3]) + " m) or viscosity (" + fmt(r[cpl::layout::hfViscosity]) + " Pa s)";
   const char *axis = "xyz";
   for (int d = 0; d < 3; d++) {
     const double lo = r[4 + 2*d], hi = r[5 + 2*d];
@@ -236,7 +301,7 @@ void FixFdmCouple::connectAndHandshake()
       std::atexit(tellPeerWeStopped);
       cpl::Message hello = cpl::makeMessage(cpl::MessageType::Hello, 0, 0, 1, cpl::layout::helloDemWidth,
           "role=dem version=" + std::to_string(cpl::protocolVersion) + " dt=" + fmt(update->dt) +
-          " lastStep=" + std::to_string((long long) update->laststep));
+          " lastStep=" + std::to_string((long long) update->laststep) + " stresslets=" + (stresslets_ ? "1" : "0"));
       double *r = &hello.data[0];
       r[0] = natoms_;
       for (int d = 0; d < 3; d++) {
@@ -251,9 +316,13 @@ void FixFdmCouple::connectAndHandshake()
         alphaLambda_ = reply.at(0, 1);
         rhoFluid_ = reply.at(0, 2);
         delta_ = reply.at(0, 3);
+        viscosity_ = reply.at(0, cpl::layout::hfViscosity);
+        for (int face = 0; face < 6; face++)
+          for (int c = 0; c < 4; c++) fluidFaces_[face][c] = reply.at(0, cpl::layout::hfFaceBase + cpl::layout::faceWidth * face + c);
         if (screen)
           fprintf(screen, "fdm/couple: connected (%s): %d particles, alpha_lambda %g s, rho_f %g kg/m3, "
-                  "mesh size %g m\n", connection_->describe().c_str(), natoms_, alphaLambda_, rhoFluid_, delta_);
+                  "viscosity %g Pa s, mesh size %g m\n", connection_->describe().c_str(), natoms_, alphaLambda_,
+                  rhoFluid_, viscosity_, delta_);
       }
     } catch (const std::exception &e) {
       problem = e.what();
@@ -263,15 +332,19 @@ void FixFdmCouple::connectAndHandshake()
   MPI_Bcast(&alphaLambda_, 1, MPI_DOUBLE, 0, world);
   MPI_Bcast(&rhoFluid_, 1, MPI_DOUBLE, 0, world);
   MPI_Bcast(&delta_, 1, MPI_DOUBLE, 0, world);
+  MPI_Bcast(&viscosity_, 1, MPI_DOUBLE, 0, world);
+  MPI_Bcast(&fluidFaces_[0][0], 24, MPI_DOUBLE, 0, world);
   sessionStart_ = MPI_Wtime();
 }
 
 void FixFdmCouple::gather(std::vector<Particle> &particles)
 {
   const int nlocal = atom->nlocal;
-  std::vector<double> buf(size_t(gatherWidth) * nlocal);
+  const bool withStress = stresslets_ && pair_;
+  const int width = gatherWidth + (withStress ? gatherStressWidth : 0);
+  std::vector<double> buf(size_t(width) * nlocal);
   for (int i = 0; i < nlocal; i++) {
-    double *b = &buf[size_t(gatherWidth) * i];
+    double *b = &buf[size_t(width) * i];
     *b++ = atom->tag[i];
     for (int d = 0; d < 3; d++) *b++ = atom->x[i][d];
     *b++ = atom->radius[i];
@@ -281,6 +354,8 @@ void FixFdmCouple::gather(std::vector<Particle> &particles)
     for (int d = 0; d < 3; d++) *b++ = atom->torque[i][d];
     *b++ = atom->rmass[i];
     *b++ = atom->density[i];
+    if (withStress)
+      for (int c = 0; c < 6; c++) *b++ = pair_->contactStress(i)[c];
   }
   const int count = int(buf.size());
   std::vector<int> counts(comm->nprocs), displs(comm->nprocs);
@@ -295,7 +370,7 @@ void FixFdmCouple::gather(std::vector<Particle> &particles)
   if (comm->me != 0) return;
   particles.assign(size_t(natoms_), Particle());
   std::vector<char> seen(size_t(natoms_), 0);
-  for (size_t k = 0; k < all.size(); k += gatherWidth) {
+  for (size_t k = 0; k < all.size(); k += width) {
     const long tag = std::lround(all[k]);
     if (tag < 1 || tag > natoms_ || seen[tag - 1])
       fail("particle ID " + std::to_string(tag) + " is out of 1.." + std::to_string(natoms_) + " or twice in the system");
@@ -310,6 +385,7 @@ void FixFdmCouple::gather(std::vector<Particle> &particles)
     for (int d = 0; d < 3; d++) p.torque[d] = *b++;
     p.mass = *b++;
     p.density = *b++;
+    for (int c = 0; c < 6; c++) p.contactStress[c] = withStress ? *b++ : 0.0;
   }
   for (int t = 0; t < natoms_; t++)
     if (!seen[t])
@@ -318,7 +394,7 @@ void FixFdmCouple::gather(std::vector<Particle> &particles)
            ")");
 }
 
-std::string FixFdmCouple::checkConfiguration(const std::vector<Particle> &particles) const
+std::string FixFdmCouple::checkConfiguration(const std::vector<Particle> &particles, bool checkOverlaps) const
 {
   // rank 0. A particle through a wall, or two overlapping, would give a wrong flow silently.
   const char *axis = "xyz";
@@ -343,7 +419,7 @@ std::string FixFdmCouple::checkConfiguration(const std::vector<Particle> &partic
       }
     }
   }
-  return findOverlap(particles);
+  return checkOverlaps ? findOverlap(particles) : std::string();
 }
 
 std::string FixFdmCouple::findOverlap(const std::vector<Particle> &p) const
@@ -414,18 +490,58 @@ std::string FixFdmCouple::findOverlap(const std::vector<Particle> &p) const
          (pairs > 1 ? " (" + std::to_string(pairs) + " overlapping pairs in all)" : std::string());
 }
 
+void FixFdmCouple::ensureConnected()
+{
+  if (connected_) return;
+  // Counted before this setup's re-partitioning (at init(), or earlier when the pair style asks):
+  // LIGGGHTS silently drops an atom put outside a non-periodic face, and gather() must name it.
+  if (atomsAtInit_ == 0) checkAtoms();  // asked by the pair style, before this fix's init()
+  sessionParticles_ = atomsAtInit_ > 0 ? atomsAtInit_ : int(atom->natoms);  // told to the fluid, for the session
+  natoms_ = sessionParticles_;
+  if (hasFluid()) {
+    connectAndHandshake();
+  } else {
+    // DEM only: Eq. (31) with each particle's isolated Stokes resistance in place of the fluid's
+    // (alpha_lambda = 1 s makes rho_f Vu / alpha_lambda = 6 pi eta a, see noFluidIntegrals)
+    viscosity_ = noFluidViscosity_;
+    delta_ = noFluidMesh_;
+    rhoFluid_ = noFluidDensity_;
+    alphaLambda_ = 1.0;
+    for (int face = 0; face < 6; face++) {
+      fluidFaces_[face][0] = domain->periodicity[face / 2] ? facePeriodic : faceNoFluid;
+      for (int d = 0; d < 3; d++) fluidFaces_[face][1 + d] = 0.0;
+    }
+    if (comm->me == 0 && screen)
+      fprintf(screen, "fdm/couple: transport none: DEM only, no fluid solver; each particle feels its isolated "
+              "Stokes drag (viscosity %g Pa s) plus the pair style's forces and sub-grid lubrication (mesh size %g m)\n",
+              viscosity_, delta_);
+    sessionStart_ = MPI_Wtime();
+  }
+  connected_ = true;
+}
+
+const char *FixFdmCouple::faceKindName(int kind)
+{
+  switch (kind) {
+    case facePeriodic: return "a periodic (cyclic) boundary";
+    case faceWall: return "a no-slip wall";
+    case faceSlip: return "a slip wall";
+  }
+  return "another kind of boundary";
+}
+
+void FixFdmCouple::fluidFace(int face, int &kind, double velocity[3]) const
+{
+  kind = int(std::lround(fluidFaces_[face][0]));
+  for (int d = 0; d < 3; d++) velocity[d] = fluidFaces_[face][1 + d];
+}
+
 void FixFdmCouple::setup(int)
 {
   // Called before every run (not with 'run N pre no'): connect once, then check the particles
   // wherever the input has put them since (set atom ... between runs).
-  if (!connected_) {
-    // Counted at init(), before this setup's re-partitioning: LIGGGHTS silently drops an atom put
-    // outside a non-periodic face, and gather() must be able to name it.
-    sessionParticles_ = atomsAtInit_;  // what the fluid is told at the handshake, for the session
-    natoms_ = sessionParticles_;
-    connectAndHandshake();
-    connected_ = true;
-  }
+  const bool firstSetup = !connected_;
+  ensureConnected();
   natoms_ = sessionParticles_;
   // fewer atoms than announced: gather() names the particle LIGGGHTS lost
   if (atom->natoms > natoms_ || atom->map_tag_max > natoms_)
@@ -435,10 +551,16 @@ void FixFdmCouple::setup(int)
   if (solution_.size() != size_t(6) * natoms_) {
     solution_.assign(size_t(6) * natoms_, 0.0);
     hydro_.assign(size_t(6) * natoms_, 0.0);
+    fluidStress_.assign(size_t(7) * natoms_, 0.0);
+    subgrid_.assign(size_t(6) * natoms_, 0.0);
+    stress_.assign(size_t(13) * natoms_, 0.0);
   }
   std::vector<Particle> particles;
   gather(particles);
-  allAgree(comm->me == 0 ? checkConfiguration(particles) : std::string());
+  // Overlaps are an input error in the configuration the input script gave (first run, or positions
+  // set between runs of fixed particles); later runs continue from where contacts (h_r > 0, finite
+  // kn) may legitimately have pressed particles a little into each other.
+  allAgree(comm->me == 0 ? checkConfiguration(particles, firstSetup || !move_) : std::string());
   fillPerAtomArray();
   runStart_ = MPI_Wtime();
   run_ = Timing();
@@ -475,17 +597,96 @@ cpl::Message FixFdmCouple::makeStep(const std::vector<Particle> &particles) cons
   return step;
 }
 
+namespace {
+// Gathers every rank's doubles on rank 0 (in rank order).
+void gatherOnRoot(const std::vector<double> &local, std::vector<double> &all, MPI_Comm world, int me, int nprocs)
+{
+  const int count = int(local.size());
+  std::vector<int> counts(nprocs), displs(nprocs);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  if (me == 0) {
+    int total = 0;
+    for (int p = 0; p < nprocs; p++) { displs[p] = total; total += counts[p]; }
+    all.assign(size_t(total), 0.0);
+  }
+  MPI_Gatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+}
+}  // namespace
+
+void FixFdmCouple::collectSubgrid()
+{
+  // Every rank builds the sub-grid blocks of its own pairs and wall gaps from its neighbour list;
+  // rank 0 collects them and assembles R^SG once for the step (paper section 4.4.2).
+  std::vector<double> pairs, walls;
+  long contacts = 0;
+  if (pair_) {
+    pair_->collectBlocks(stresslets_, pairs, walls);
+    contacts = pair_->contactsLast();
+  }
+  if (!system_) system_.reset(new System);
+  System &sys = *system_;
+  gatherOnRoot(pairs, sys.pairs, world, comm->me, comm->nprocs);
+  gatherOnRoot(walls, sys.walls, world, comm->me, comm->nprocs);
+  MPI_Reduce(&contacts, &contacts_, 1, MPI_LONG, MPI_SUM, 0, world);
+  if (comm->me != 0) return;
+
+  const int N = natoms_;
+  sys.pairRecord = PairFdmSubgrid::pairRecord + (stresslets_ ? PairFdmSubgrid::pairStressRecord : 0);
+  sys.wallRecord = PairFdmSubgrid::wallRecord + (stresslets_ ? PairFdmSubgrid::wallStressRecord : 0);
+  pairBlocks_ = long(sys.pairs.size() / sys.pairRecord);
+  wallBlocks_ = long(sys.walls.size() / sys.wallRecord);
+  std::vector<Eigen::Triplet<double> > triplets;
+  triplets.reserve(size_t(6) * N + size_t(144) * pairBlocks_ + size_t(36) * wallBlocks_);
+  for (int k = 0; k < 6 * N; k++) triplets.push_back(Eigen::Triplet<double>(k, k, 0.0));  // the diagonal, always
+  sys.wallRhs = Eigen::VectorXd::Zero(6 * N);
+  auto index = [&](double tag) {
+    const long t = std::lround(tag);
+    if (t < 1 || t > N) fail("pair fdm/subgrid sent a block for particle ID " + std::to_string(t));
+    return int(t - 1);
+  };
+  for (long b = 0; b < pairBlocks_; b++) {
+    const double *rec = &sys.pairs[size_t(b) * sys.pairRecord];
+    const int base[2] = {6 * index(rec[0]), 6 * index(rec[1])};
+    const double *R = rec + 2;
+    for (int i = 0; i < 12; i++)
+      for (int j = 0; j < 12; j++)
+        triplets.push_back(Eigen::Triplet<double>(base[i / 6] + i % 6, base[j / 6] + j % 6, R[12 * i + j]));
+  }
+  for (long b = 0; b < wallBlocks_; b++) {
+    const double *rec = &sys.walls[size_t(b) * sys.wallRecord];
+    const int base = 6 * index(rec[0]);
+    const double *R = rec + 1, *rhs = rec + 37;
+    for (int i = 0; i < 6; i++) {
+      for (int j = 0; j < 6; j++) triplets.push_back(Eigen::Triplet<double>(base + i, base + j, R[6 * i + j]));
+      sys.wallRhs(base + i) += rhs[i];  // F = -R_w (U - U_w, Omega): the wall velocity is a force
+    }
+  }
+  sys.matrix.resize(6 * N, 6 * N);
+  sys.matrix.setFromTriplets(triplets.begin(), triplets.end());
+  sys.matrix.makeCompressed();
+  sys.diagonalIndex.assign(size_t(6) * N, -1);
+  sys.subgridDiagonal.assign(size_t(6) * N, 0.0);
+  for (int k = 0; k < 6 * N; k++)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(sys.matrix, k); it; ++it)
+      if (it.row() == k) {
+        sys.diagonalIndex[k] = int(&it.valueRef() - sys.matrix.valuePtr());
+        sys.subgridDiagonal[k] = it.value();
+      }
+  sys.diagonal = Eigen::VectorXd::Zero(6 * N);
+  sys.analysed = false;
+}
+
 void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const cpl::Message &integrals)
 {
   // Eq. (31): [ (rho_f/rho_p) J / alpha_lambda + R^SG ] u = F_tot, unknowns (U, Omega) per particle
   // by tag. (rho_f/rho_p) M_p = rho_f Vu and (rho_f/rho_p) J_p = rho_f Ju come from the fluid's
   // indicator function I_u; F_tot (Eq. 32) = the fluid integral + buoyant weight + everything
-  // LIGGGHTS put in f and torque (contacts, fix addforce, ...: F^c + F^ext).
+  // LIGGGHTS put in f and torque (contacts, fix addforce, ...: F^c + F^ext) + the moving walls'
+  // term of Eq. (D.6). R^SG was assembled for this step by collectSubgrid().
   using namespace cpl::layout;
+  System &sys = *system_;
   const int N = natoms_;
-  std::vector<Eigen::Triplet<double> > triplets;
-  triplets.reserve(size_t(6) * N);
-  Eigen::VectorXd rhs(6 * N), guess(6 * N);
+  Eigen::VectorXd rhs(6 * N), guess(6 * N), diagonal(6 * N);
   for (int p = 0; p < N; p++) {
     const Particle &q = particles[p];
     const double Vu = integrals.at(p, iVu), Ju = integrals.at(p, iJu);
@@ -500,26 +701,46 @@ void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const
            "): is it smaller than a mesh cell (" + fmt(delta_) + ")?");
     const double buoyantFraction = 1.0 - rhoFluid_ / q.density;  // (rho_p - rho_f)/rho_p
     for (int d = 0; d < 3; d++) {
-      triplets.push_back(Eigen::Triplet<double>(6*p + d, 6*p + d, rhoFluid_ * Vu / alphaLambda_));
-      triplets.push_back(Eigen::Triplet<double>(6*p + 3 + d, 6*p + 3 + d, rhoFluid_ * Ju / alphaLambda_));
+      diagonal(6*p + d) = rhoFluid_ * Vu / alphaLambda_;
+      diagonal(6*p + 3 + d) = rhoFluid_ * Ju / alphaLambda_;
       rhs(6*p + d) = integrals.at(p, iFx + d) + buoyantFraction * q.mass * gravity_[d] + q.f[d];
       rhs(6*p + 3 + d) = integrals.at(p, iTx + d) + q.torque[d];
     }
   }
-  // R^SG: the sub-grid lubrication blocks (pair and wall) will be appended to `triplets` here.
-  for (int k = 0; k < 6 * N; k++) guess(k) = solution_[k];
+  rhs += sys.wallRhs;
+  const bool diagonalChanged = diagonal != sys.diagonal;
+  sys.diagonal = diagonal;
+  double *values = sys.matrix.valuePtr();
+  for (int k = 0; k < 6 * N; k++) values[sys.diagonalIndex[k]] = sys.subgridDiagonal[k] + diagonal(k);
+  for (int k = 0; k < 6 * N; k++) guess(k) = solution_[k];  // warm start: the previous inner iteration
 
-  Eigen::SparseMatrix<double> A(6 * N, 6 * N);
-  A.setFromTriplets(triplets.begin(), triplets.end());
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                           Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
-  cg.setTolerance(1e-10);
-  cg.setMaxIterations(std::max(1000, 6 * N));
-  cg.compute(A);
-  const Eigen::VectorXd u = cg.solveWithGuess(rhs, guess);  // warm start: previous inner iteration
-  if (cg.info() != Eigen::Success && !(cg.error() < 1e-6))
-    fail("the particle velocity system (Eq. 31) did not converge: relative residual " + fmt(cg.error()) + " after " +
-         std::to_string(cg.iterations()) + " conjugate-gradient iterations");
+  Eigen::VectorXd u;
+  long iterations = 1;
+  if (directSolver_) {
+    // the matrix only changes with the positions: one factorisation per step
+    if (!sys.analysed) {
+      sys.ldlt.analyzePattern(sys.matrix);
+      sys.analysed = true;
+    }
+    if (diagonalChanged) sys.ldlt.factorize(sys.matrix);
+    if (sys.ldlt.info() != Eigen::Success)
+      fail("the particle velocity system (Eq. 31) could not be factorised (LDLT): is the sub-grid matrix indefinite?");
+    u = sys.ldlt.solve(rhs);
+  } else {
+    sys.cg.setTolerance(tolerance_);
+    sys.cg.setMaxIterations(std::max(1000, 6 * N));
+    sys.cg.compute(sys.matrix);
+    u = sys.cg.solveWithGuess(rhs, guess);
+    iterations = long(sys.cg.iterations());
+    if (sys.cg.info() != Eigen::Success && !(sys.cg.error() < 1e-6))
+      fail("the particle velocity system (Eq. 31) did not converge: relative residual " + fmt(sys.cg.error()) +
+           " after " + std::to_string(sys.cg.iterations()) + " conjugate-gradient iterations (" +
+           std::to_string(pairBlocks_) + " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
+  }
+  run_.solves++;
+  run_.solverIterations += iterations;
+  run_.solverIterationsMax = std::max(run_.solverIterationsMax, iterations);
+  solverIterations_ = std::max(solverIterations_, iterations);
   for (int k = 0; k < 6 * N; k++) {
     if (!std::isfinite(u(k))) {
       const int p = k / 6;
@@ -531,13 +752,77 @@ void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const
   }
 }
 
+cpl::Message FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &particles) const
+{
+  // transport none: "integrals" of an isolated sphere in a fluid at rest, so that Eq. (31) reads
+  // [diag(6 pi eta a, 8 pi eta a^3) + R^SG] u = F^c + F^ext + buoyant weight
+  using namespace cpl::layout;
+  const double pi = 3.14159265358979323846;
+  cpl::Message m = cpl::makeMessage(cpl::MessageType::Integrals, update->ntimestep, 1, natoms_, integralsWidth);
+  for (int p = 0; p < natoms_; p++) {
+    const double a = particles[p].radius;
+    m.at(p, iVu) = 6 * pi * viscosity_ * a * alphaLambda_ / rhoFluid_;
+    m.at(p, iJu) = 8 * pi * viscosity_ * a * a * a * alphaLambda_ / rhoFluid_;
+  }
+  return m;
+}
+
+void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
+{
+  // rank 0, after the last inner iteration: the sub-grid force and torque (Eq. 21 and D.6) and,
+  // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
+  System &sys = *system_;
+  const int N = natoms_;
+  const Eigen::Map<const Eigen::VectorXd> u(solution_.data(), 6 * N);
+  const Eigen::VectorXd forces = sys.wallRhs - sys.matrix * u + sys.diagonal.cwiseProduct(u);
+  for (int k = 0; k < 6 * N; k++) subgrid_[k] = forces(k);
+  if (!stresslets_) return;
+  for (int p = 0; p < N; p++) {
+    double *out = &stress_[size_t(13) * p];
+    for (int c = 0; c < 7; c++) out[c] = fluidStress_[size_t(7) * p + c];
+    for (int c = 0; c < 6; c++) out[7 + c] = particles[p].contactStress[c];
+  }
+  for (size_t b = 0; b < sys.pairs.size() / sys.pairRecord; b++) {
+    const double *rec = &sys.pairs[b * sys.pairRecord];
+    const int p[2] = {int(std::lround(rec[0])) - 1, int(std::lround(rec[1])) - 1};
+    const double *rows = rec + PairFdmSubgrid::pairRecord;  // 14 x 12: S_1 (6), S_2 (6), s_1, s_2
+    double velocity[12];
+    for (int k = 0; k < 6; k++) {
+      velocity[k] = solution_[size_t(6) * p[0] + k];
+      velocity[6 + k] = solution_[size_t(6) * p[1] + k];
+    }
+    for (int row = 0; row < 14; row++) {
+      double value = 0;
+      for (int k = 0; k < 12; k++) value -= rows[12 * row + k] * velocity[k];
+      const int who = row < 12 ? row / 6 : row - 12;
+      const int component = row < 12 ? row % 6 : 6;
+      stress_[size_t(13) * p[who] + component] += value;
+    }
+  }
+  for (size_t b = 0; b < sys.walls.size() / sys.wallRecord; b++) {
+    const double *rec = &sys.walls[b * sys.wallRecord];
+    const int p = int(std::lround(rec[0])) - 1;
+    const double *rows = rec + PairFdmSubgrid::wallRecord, *wallTerm = rows + 42;  // 7 x 6, then 7
+    for (int row = 0; row < 7; row++) {
+      double value = wallTerm[row];
+      for (int k = 0; k < 6; k++) value -= rows[6 * row + k] * solution_[size_t(6) * p + k];
+      stress_[size_t(13) * p + row] += value;
+    }
+  }
+}
+
 void FixFdmCouple::storeStepDone(const cpl::Message &done)
 {
-  if (int(done.count) != natoms_ || done.width != cpl::layout::stepDoneWidth)
+  const uint32_t width = stresslets_ ? cpl::layout::stepDoneStressWidth : cpl::layout::stepDoneWidth;
+  if (int(done.count) != natoms_ || done.width != width)
     fail("the fluid solver ended step " + std::to_string(done.step) + " with forces for " + std::to_string(done.count) +
          " particles (" + std::to_string(done.width) + " values each) where " + std::to_string(natoms_) +
-         " particles (6 values) were expected");
-  hydro_ = done.data;
+         " particles (" + std::to_string(width) + " values) were expected");
+  for (int p = 0; p < natoms_; p++) {
+    for (int c = 0; c < 6; c++) hydro_[size_t(6) * p + c] = done.at(p, c);
+    if (stresslets_)
+      for (int c = 0; c < 7; c++) fluidStress_[size_t(7) * p + c] = done.at(p, cpl::layout::dSxx + c);
+  }
   lastIterations_ = int(std::lround(done.textNumber("iterations")));
   lastResidual_ = done.textNumber("residual");
   if (done.textValue("converged") != "1") notConverged_++;
@@ -551,8 +836,21 @@ void FixFdmCouple::final_integrate()
   std::vector<Particle> particles;
   gather(particles);
   run_.gatherScatter += MPI_Wtime() - t0;
+  t0 = MPI_Wtime();
+  solverIterations_ = 0;
+  collectSubgrid();
+  run_.solve += MPI_Wtime() - t0;
 
-  if (comm->me == 0) {
+  if (comm->me == 0 && !hasFluid()) {
+    t0 = MPI_Wtime();
+    const cpl::Message integrals = noFluidIntegrals(particles);
+    solveVelocities(particles, integrals);
+    for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
+      hydro_[k] = -system_->diagonal(k) * solution_[k];
+    subgridResults(particles);
+    lastIterations_ = 1;
+    run_.solve += MPI_Wtime() - t0;
+  } else if (comm->me == 0) {
     if (!connection_) fail("the connection to the fluid solver is closed");
     const bigint step = update->ntimestep;
     try {
@@ -570,6 +868,8 @@ void FixFdmCouple::final_integrate()
                std::to_string(m.step) + " during step " + std::to_string((long long) step));
         if (m.type == cpl::MessageType::StepDone) {
           storeStepDone(m);
+          subgridResults(particles);
+          run_.solve += MPI_Wtime() - t1;
           break;
         }
         if (int(m.count) != natoms_ || m.width != cpl::layout::integralsWidth)
@@ -598,6 +898,14 @@ void FixFdmCouple::scatter()
 {
   MPI_Bcast(solution_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
   MPI_Bcast(hydro_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
+  MPI_Bcast(subgrid_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
+  if (stresslets_) MPI_Bcast(stress_.data(), 13 * natoms_, MPI_DOUBLE, 0, world);
+  long counters[4] = {solverIterations_, pairBlocks_, wallBlocks_, contacts_};
+  MPI_Bcast(counters, 4, MPI_LONG, 0, world);
+  solverIterations_ = counters[0];
+  pairBlocks_ = counters[1];
+  wallBlocks_ = counters[2];
+  contacts_ = counters[3];
   MPI_Bcast(&lastIterations_, 1, MPI_INT, 0, world);
   MPI_Bcast(&lastResidual_, 1, MPI_DOUBLE, 0, world);
   // the velocities of the converged inner iteration are the particles' velocities of this step
@@ -616,12 +924,18 @@ void FixFdmCouple::fillPerAtomArray()
   if (atom->nmax > nmax_) {
     nmax_ = atom->nmax;
     memory->destroy(perAtom_);
-    memory->create(perAtom_, nmax_, 6, "fdm/couple:hydrodynamic");
+    memory->create(perAtom_, nmax_, perAtomColumns_, "fdm/couple:hydrodynamic");
     array_atom = perAtom_;
   }
   for (int i = 0; i < atom->nlocal; i++) {
     const long t = atom->tag[i] - 1;
-    for (int c = 0; c < 6; c++) perAtom_[i][c] = (t >= 0 && t < natoms_) ? hydro_[size_t(6) * t + c] : 0.0;
+    const bool known = t >= 0 && t < natoms_ && hydro_.size() == size_t(6) * natoms_;
+    for (int c = 0; c < 6; c++) {
+      perAtom_[i][c] = known ? hydro_[size_t(6) * t + c] : 0.0;
+      perAtom_[i][6 + c] = known ? subgrid_[size_t(6) * t + c] : 0.0;
+    }
+    if (stresslets_)
+      for (int c = 0; c < 13; c++) perAtom_[i][12 + c] = known ? stress_[size_t(13) * t + c] : 0.0;
   }
 }
 
@@ -629,12 +943,15 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
 {
   if (comm->me != 0) return;
   const double percent = wall > 0 ? 100.0 / wall : 0.0;
-  char line[512];
+  char line[1024];
   std::snprintf(line, sizeof line,
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
-                "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%)%s\n",
+                "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
+                "%s iterations mean %.1f max %ld; last step %ld sub-grid pair blocks, %ld wall blocks, %ld contacts%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
-                t.exchange * percent, t.gatherScatter, t.gatherScatter * percent,
+                t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
+                directSolver_ ? "LDLT" : "CG", t.solves ? double(t.solverIterations) / t.solves : 0.0,
+                t.solverIterationsMax, pairBlocks_, wallBlocks_, contacts_,
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");
   if (screen) fputs(line, screen);
   if (logfile) fputs(line, logfile);
@@ -659,13 +976,17 @@ double FixFdmCouple::compute_vector(int n)
     case 1: return lastResidual_;
     case 2: return total_.solve + run_.solve;
     case 3: return total_.exchange + run_.exchange;
+    case 4: return solverIterations_;
+    case 5: return pairBlocks_;
+    case 6: return wallBlocks_;
+    case 7: return contacts_;
   }
   return 0.0;
 }
 
 double FixFdmCouple::memory_usage()
 {
-  return double(nmax_) * 6 * sizeof(double) + double(solution_.size() + hydro_.size()) * sizeof(double);
+  return double(nmax_) * perAtomColumns_ * sizeof(double) + double(solution_.size() + hydro_.size()) * sizeof(double);
 }
 
 void FixFdmCouple::finishAll(LAMMPS *lmp)

@@ -3,15 +3,20 @@
    Syntax (docs/dem.md):
      fix ID all fdm/couple [transport socket|file] [host H] [port P] [portfile F] [directory D]
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
+                           [stresslets yes|no] [solver cg|ldlt] [tolerance t]
+     fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
    then (final_integrate, after every pair and fix force is in f and torque) sends the particles
    to fdmFoam and, every inner iteration, solves Eq. (31) for all particle velocities with Eigen
    from the integrals it receives, until fdmFoam reports convergence. Replaces fix nve/sphere.
+   With pair_style fdm/subgrid, the sub-grid lubrication blocks R^SG (pairs and walls) are gathered
+   on rank 0 once per time step and enter the matrix of Eq. (31) (paper section 4.4.2).
 
-   Outputs: global vector [inner iterations of the last step, last lambda residual, particle-solve
-   seconds, exchange seconds]; per-atom array [Fx Fy Fz Tx Ty Tz] = hydrodynamic force and torque
-   of the last StepDone. */
+   Outputs (docs/dem.md): global vector [inner iterations, lambda residual, particle-solve seconds,
+   exchange seconds, linear-solver iterations, sub-grid pair blocks, wall blocks, contacts] of the
+   last step; per-atom array [F^FDM, T^FDM, F^SG, T^SG] (12 columns), and with stresslets yes
+   [S^h (6), s^h, S^c (6)] after them (25 columns). */
 
 #ifndef FDM_FIX_FDM_COUPLE_H
 #define FDM_FIX_FDM_COUPLE_H
@@ -44,26 +49,42 @@ class FixFdmCouple : public Fix {
   // Best effort, at exit after an error: sends Error(why) to the fluid solver if still connected.
   static void abandon(const std::string &why);
 
+  // Connects and shakes hands with the fluid solver if not yet done (every rank calls it): the
+  // pair style needs the fluid's viscosity and mesh size before LIGGGHTS builds neighbour lists.
+  void ensureConnected();
+  double viscosity() const { return viscosity_; }
+  double meshSize() const { return delta_; }
+  // Boundary of the fluid case on box face 0..5 (xlo xhi ylo yhi zlo zhi), from its Hello.
+  enum FaceKind { facePeriodic = 0, faceWall = 1, faceSlip = 2, faceOther = 3, faceNoFluid = -1 };
+  bool hasFluid() const { return options_.transport != "none"; }
+  static const char *faceKindName(int kind);
+  void fluidFace(int face, int &kind, double velocity[3]) const;
+
  private:
   // One particle as gathered on rank 0, stored by tag (index tag-1).
   struct Particle {
     double x[3], radius, v[3], omega[3], f[3], torque[3], mass, density;
+    double contactStress[6];  // S^c of Eq. (52), when stresslets are asked for
   };
   // Wall-clock seconds spent in the three parts of the particle side's work.
   struct Timing {
     double solve, exchange, gatherScatter;
-    long steps;
-    Timing() : solve(0), exchange(0), gatherScatter(0), steps(0) {}
+    long steps, solves, solverIterations, solverIterationsMax;
+    Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0) {}
     void add(const Timing &t);
   };
 
+  void checkAtoms();
   void connectAndHandshake();
   std::string checkFluidHello(const fdm::coupler::Message &hello) const;
   void gather(std::vector<Particle> &particles);
-  std::string checkConfiguration(const std::vector<Particle> &particles) const;
+  std::string checkConfiguration(const std::vector<Particle> &particles, bool checkOverlaps) const;
   std::string findOverlap(const std::vector<Particle> &particles) const;
   fdm::coupler::Message makeStep(const std::vector<Particle> &particles) const;
+  void collectSubgrid();
   void solveVelocities(const std::vector<Particle> &particles, const fdm::coupler::Message &integrals);
+  void subgridResults(const std::vector<Particle> &particles);
+  fdm::coupler::Message noFluidIntegrals(const std::vector<Particle> &particles) const;
   void storeStepDone(const fdm::coupler::Message &done);
   void scatter();
   void fillPerAtomArray();
@@ -74,13 +95,19 @@ class FixFdmCouple : public Fix {
   fdm::coupler::Options options_;
   double gravity_[3];
   bool move_;
+  double noFluidViscosity_, noFluidMesh_, noFluidDensity_;  // transport none (DEM only)
+  bool stresslets_;          // per-particle stresslets asked for (fluid, sub-grid, contact)
+  bool directSolver_;        // Eq. (31) by sparse LDLT instead of conjugate gradients
+  double tolerance_;         // relative residual of the conjugate-gradient solve
+  class PairFdmSubgrid *pair_;  // the sub-grid / contact pair style, if that is the pair style
 
   // The connection and what the fluid said at the handshake live as long as the process: an input
   // may run many times (and even unfix / fix again) over one coupled session.
   static std::unique_ptr<fdm::coupler::Transport> connection_;  // rank 0 only
   static bool connected_;                                          // every rank: handshake done
   static int sessionParticles_;                                    // N told to the fluid at the handshake
-  static double alphaLambda_, rhoFluid_, delta_;
+  static double alphaLambda_, rhoFluid_, delta_, viscosity_;
+  static double fluidFaces_[6][4];                                 // kind, wall velocity
   static Timing total_;
   static int runs_;
   static double sessionStart_;
@@ -89,6 +116,7 @@ class FixFdmCouple : public Fix {
   int natoms_;                     // N, particles are tags 1..N
   std::vector<double> solution_;   // 6N: (U, Omega) per particle by tag; warm start of the next solve
   std::vector<double> hydro_;      // 6N: hydrodynamic force and torque of the last StepDone, by tag
+  std::vector<double> fluidStress_; // 7N: S^FDM (6), s^FDM of the last StepDone (Eq. 12), by tag
   int lastIterations_;
   double lastResidual_;
   long notConverged_;              // steps where the fluid reported converged=0
@@ -96,6 +124,16 @@ class FixFdmCouple : public Fix {
   double runStart_;
   int nmax_;                       // rows allocated in array_atom
   double **perAtom_;
+  int perAtomColumns_;
+
+  // Eq. (31) on rank 0, for the current time step: the matrix is assembled once per step (the
+  // positions do not move during the inner iterations); only its diagonal and the right-hand
+  // side change from one inner iteration to the next.
+  struct System;
+  std::unique_ptr<System> system_;
+  std::vector<double> subgrid_;    // 6N: F^SG, T^SG of the last step, by tag
+  std::vector<double> stress_;     // 13N: S^h (6), s^h, S^c (6) of the last step, by tag
+  long solverIterations_, solverIterationsMax_, pairBlocks_, wallBlocks_, contacts_;
 };
 
 }  // namespace LAMMPS_NS

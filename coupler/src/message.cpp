@@ -11,7 +11,8 @@ namespace coupler {
 namespace {
 const char magic[4] = {'F', 'D', 'M', 'C'};
 // Sanity limits: a corrupted header must give an error, not a huge allocation. The largest real
-// record is 13 doubles wide; 2^25 values (256 MiB) is 2.5 million particles of it.
+// record is the fluid Hello's 38 doubles (per particle: 13, StepDone with stresslets); 2^25 values
+// (256 MiB) is 2.5 million particles of 13.
 const uint32_t maxWidth = 64;
 const uint64_t maxValues = 1ULL << 25;
 const uint32_t maxText = 1u << 20;

@@ -142,6 +142,70 @@ TEST(Message, TextValues)
     expectCouplerError([&] { bad.textNumber("dt"); }, {"dt=abc", "not a number"});
 }
 
+TEST(Message, LayoutOfProtocol2)
+{
+    EXPECT_EQ(protocolVersion, 2);
+    EXPECT_EQ(layout::helloDemWidth, 10u);
+    EXPECT_EQ(layout::helloFluidWidth, 38u);
+    EXPECT_EQ(layout::hfViscosity, 13);
+    EXPECT_EQ(layout::hfFaceBase, 14);
+    EXPECT_EQ(layout::faceWidth, 4u);
+    EXPECT_EQ(layout::hfFaceBase + layout::nFaces * layout::faceWidth, layout::helloFluidWidth);
+    EXPECT_EQ(layout::stepDoneWidth, 6);
+    EXPECT_EQ(layout::dSxx, 6);
+    EXPECT_EQ(layout::dSzz, 11);
+    EXPECT_EQ(layout::dTrace, 12);
+    EXPECT_EQ(layout::stepDoneStressWidth, 13);
+}
+
+TEST(Message, FluidHelloOfProtocol2RoundTrips)
+{
+    // Shear cell: cyclic in x and z, walls moving along x at ylo and yhi
+    Message m = makeMessage(MessageType::Hello, 0, 0, 1, layout::helloFluidWidth,
+                            "role=fluid version=" + std::to_string(protocolVersion));
+    const double head[13] = {2, 0.0625, 1000, 0.25, 0, 6, 0, 4, 0, 4, 1, 0, 1};
+    for (int i = 0; i < 13; ++i) m.data[i] = head[i];
+    m.at(0, layout::hfViscosity) = 1e-3;
+    const double wall[6][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {1, -0.5, 0, 0},
+                               {1, 0.5, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+    for (uint32_t f = 0; f < layout::nFaces; ++f)
+        for (uint32_t k = 0; k < layout::faceWidth; ++k)
+            m.at(0, layout::hfFaceBase + layout::faceWidth * f + k) = wall[f][k];
+
+    const std::vector<unsigned char> bytes = encode(m);
+    ASSERT_EQ(bytes.size(), headerSize + m.text.size() + 8 * 38);
+    EXPECT_EQ(bytes[24], 38);  // width, little-endian
+    const Message back = decode(bytes.data(), bytes.size());
+    EXPECT_EQ(back.type, MessageType::Hello);
+    EXPECT_EQ(back.count, 1u);
+    EXPECT_EQ(back.width, 38u);
+    EXPECT_EQ(back.textNumber("version"), 2);
+    EXPECT_EQ(back.data, m.data);
+    EXPECT_EQ(back.at(0, 2), 1000);                      // the first 13 fields unchanged
+    EXPECT_EQ(back.at(0, 12), 1);
+    EXPECT_EQ(back.at(0, layout::hfViscosity), 1e-3);
+    const uint32_t ylo = layout::hfFaceBase + 2 * layout::faceWidth;
+    const uint32_t yhi = layout::hfFaceBase + 3 * layout::faceWidth;
+    EXPECT_EQ(back.at(0, layout::hfFaceBase + layout::fKind), layout::bPeriodic);
+    EXPECT_EQ(back.at(0, ylo + layout::fKind), layout::bWall);
+    EXPECT_EQ(back.at(0, ylo + layout::fUx), -0.5);
+    EXPECT_EQ(back.at(0, yhi + layout::fUx), 0.5);
+    EXPECT_EQ(back.at(0, 37), 0);                        // zhi Uz, the last field
+}
+
+TEST(Message, StepDoneWithStressletsRoundTrips)
+{
+    Message m = makeMessage(MessageType::StepDone, 7, 12, 3, layout::stepDoneStressWidth,
+                            "iterations=12 residual=1e-05 converged=1");
+    for (size_t i = 0; i < m.data.size(); ++i) m.data[i] = 0.5 * i - 3;
+    const std::vector<unsigned char> bytes = encode(m);
+    const Message back = decode(bytes.data(), bytes.size());
+    EXPECT_EQ(back.width, 13u);
+    EXPECT_EQ(back.data, m.data);
+    EXPECT_EQ(back.at(2, layout::dFx), 0.5 * 26 - 3);
+    EXPECT_EQ(back.at(2, layout::dTrace), 0.5 * 38 - 3);
+}
+
 TEST(Message, BadMagicIsRejected)
 {
     std::vector<unsigned char> bytes = encode(sample());
@@ -209,8 +273,8 @@ TEST(Socket, PingPongOfAWholeTimeStep)
 {
     SocketPair pair;
     EXPECT_NE(pair.dem->describe().find("socket 127.0.0.1:"), std::string::npos);
-    pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=1"));
-    EXPECT_EQ(pair.fluid->receive(MessageType::Hello).text, "role=dem version=1");
+    pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=2 stresslets=1"));
+    EXPECT_EQ(pair.fluid->receive(MessageType::Hello).text, "role=dem version=2 stresslets=1");
     pair.dem->send(makeMessage(MessageType::Step, 1, 0, 2, layout::stepWidth));
     EXPECT_EQ(pair.fluid->receive(MessageType::Step).step, 1u);
     for (uint32_t k = 1; k <= 5; ++k) {
@@ -223,8 +287,10 @@ TEST(Socket, PingPongOfAWholeTimeStep)
         pair.dem->send(v);
         EXPECT_EQ(pair.fluid->receive(MessageType::Velocities).data[0], double(k));
     }
-    pair.fluid->send(makeMessage(MessageType::StepDone, 1, 5, 2, layout::stepDoneWidth, "iterations=5"));
-    EXPECT_EQ(pair.dem->receive(MessageType::StepDone).iteration, 5u);
+    pair.fluid->send(makeMessage(MessageType::StepDone, 1, 5, 2, layout::stepDoneStressWidth, "iterations=5"));
+    const Message done = pair.dem->receive(MessageType::StepDone);
+    EXPECT_EQ(done.iteration, 5u);
+    EXPECT_EQ(done.width, 13u);
     pair.dem->send(makeMessage(MessageType::Finish, 1, 0, 0, 0));
     EXPECT_EQ(pair.fluid->receive().type, MessageType::Finish);
 }
@@ -603,7 +669,7 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     std::remove(record.c_str());
     {
         SocketPair pair(Options(), record);
-        pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=1"));
+        pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=2 stresslets=1"));
         pair.fluid->receive();
         pair.fluid->send(sample(12, 3));
         pair.dem->receive();

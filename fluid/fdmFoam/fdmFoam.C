@@ -65,7 +65,11 @@ int main(int argc, char *argv[])
     );
 
     fluidCoupling coupling(runTime, fdmProperties.subOrEmptyDict("coupling"));
-    coupling.handshake(grid, nParticlesExpected, alphaLambda, rho.value());
+    coupling.handshake
+    (
+        grid, U, nParticlesExpected, alphaLambda, rho.value(),
+        rho.value()*nu.value()      // eta
+    );
 
     #include "createOutput.H"
 
@@ -172,9 +176,18 @@ int main(int argc, char *argv[])
 
         const double tEnd = wallClock();
         List<scalar> hydroForces = forcing.hydrodynamicForces(lambda);
+        List<scalar> stresslets;
+        if (coupling.stresslets())
+        {
+            // Eq. (12) from the last lambda and p, only when fdmDEM asks
+            stresslets = forcing.stresslets(lambda, p);
+        }
         stepParticleTime += wallClock() - tEnd;
         // (the coupling times the send itself, as exchange)
-        coupling.sendStepDone(innerIteration, residual, converged, hydroForces);
+        coupling.sendStepDone
+        (
+            innerIteration, residual, converged, hydroForces, stresslets
+        );
         const scalar stepExchangeTime = coupling.exchangeTime() - exchangeAtStart;
 
         const double tOut = wallClock();

@@ -231,9 +231,10 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
 
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",
-                    before_run="", runs=("run 1",), name="in.dem", data_file="spheres.data"):
-    """LIGGGHTS input for fdmDEM: spheres [(x, y, z, radius), ...] from a data file, no contact,
-    fix fdm/couple connected to ../fluid. Returns the input path."""
+                    before_run="", runs=("run 1",), name="in.dem", data_file="spheres.data", pair_style="none"):
+    """LIGGGHTS input for fdmDEM: spheres [(x, y, z, radius), ...] from a data file, fix fdm/couple
+    connected to ../fluid; pair_style e.g. "fdm/subgrid contact ..." (docs/dem.md), default none.
+    Returns the input path."""
     os.makedirs(dem_dir, exist_ok=True)
     with open(os.path.join(dem_dir, data_file), "w") as f:
         f.write("spheres for fdmDEM\n\n%d atoms\n1 atom types\n\n" % len(spheres))
@@ -253,12 +254,13 @@ newton          off
 communicate     single vel yes
 units           si
 read_data       %(data)s
-pair_style      none
-neighbor        %(skin).17g bin
+pair_style      %(pair)s
+%(coeff)sneighbor        %(skin).17g bin
 timestep        %(dt).17g
 %(before)s
 fix             couple all fdm/couple portfile ../fluid/coupling.port %(fix)s
 %(runs)s
-""" % dict(boundary=boundary, data=data_file, skin=0.1 * min(s[3] for s in spheres) if spheres else 0.1,
+""" % dict(boundary=boundary, data=data_file, pair=pair_style,
+           coeff="" if pair_style == "none" else "pair_coeff      * *\n", skin=0.1 * min(s[3] for s in spheres) if spheres else 0.1,
            dt=dt, before=before_run, fix=fix_options, runs="\n".join(runs)))
     return path

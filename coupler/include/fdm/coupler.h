@@ -18,7 +18,9 @@ namespace coupler {
 
 // Bump when the wire format or the meaning of a record changes; a peer with another
 // version is refused at the handshake with both versions in the message.
-const uint16_t protocolVersion = 1;
+// 2: fluid Hello gains the viscosity and the box faces' boundaries; DEM Hello asks for
+//    stresslets; StepDone may carry them (for the sub-grid lubrication pair style).
+const uint16_t protocolVersion = 2;
 
 enum class MessageType : uint16_t {
     Hello      = 1,  // handshake, once per connection, each side sends one
@@ -57,13 +59,41 @@ Message makeMessage(MessageType type, uint64_t step, uint32_t iteration,
 
 // Record layouts (field indices) -- the whole contract between the two codes.
 namespace layout {
-    // Hello from the DEM side. text: "role=dem version=<v> dt=<s> lastStep=<n>"
+    // Hello from the DEM side.
+    //   text: "role=dem version=<v> dt=<s> lastStep=<n> stresslets=<0|1>"
+    //   (stresslets=1: the DEM side wants the FDM stresslets in StepDone)
     //   one record: [nParticles, xlo, xhi, ylo, yhi, zlo, zhi, periodicX, periodicY, periodicZ]
     // Hello from the fluid side. text: "role=fluid version=<v>"
-    //   one record: [nParticlesExpected (-1 = any), alphaLambda [s], rhoFluid [kg/m3],
-    //                delta [m], xlo, xhi, ylo, yhi, zlo, zhi, periodicX, periodicY, periodicZ]
+    //   one record, 38 values:
+    //    0      nParticlesExpected (-1 = any)
+    //    1      alphaLambda [s]
+    //    2      rhoFluid [kg/m3]
+    //    3      delta [m]
+    //    4..9   xlo, xhi, ylo, yhi, zlo, zhi [m]
+    //    10..12 periodicX, periodicY, periodicZ (0|1)
+    //    13     eta: dynamic viscosity rho_f nu [Pa s]                          (hfViscosity)
+    //    14..37 per box face f = 0..5 in the order xlo, xhi, ylo, yhi, zlo, zhi, the 4 values
+    //           at hfFaceBase + faceWidth*f + [fKind, fUx, fUy, fUz]:
+    //           kind (BoundaryKind: 0 periodic, 1 no-slip wall, 2 slip, 3 other) and the
+    //           wall velocity [m/s] (the uniform fixedValue of U; 0 unless kind 1)
+    enum HelloFluidField {
+        hfNParticles = 0, hfAlphaLambda = 1, hfRhoFluid = 2, hfDelta = 3,
+        hfXlo = 4,        // xlo, xhi, ylo, yhi, zlo, zhi at hfXlo + 2d, hfXlo + 2d + 1
+        hfPeriodic = 10,  // periodic in direction d at hfPeriodic + d
+        hfViscosity = 13,
+        hfFaceBase = 14
+    };
+    const uint32_t nFaces = 6;
+    const uint32_t faceWidth = 4;
+    enum FaceField { fKind, fUx, fUy, fUz };
+    enum BoundaryKind {
+        bPeriodic = 0,  // cyclic patch pair
+        bWall = 1,      // no-slip wall: fixedValue velocity (moving or not)
+        bSlip = 2,      // slip
+        bOther = 3      // anything else
+    };
     const uint32_t helloDemWidth = 10;
-    const uint32_t helloFluidWidth = 13;
+    const uint32_t helloFluidWidth = hfFaceBase + nFaces*faceWidth;  // 38
 
     // Step: one record per particle, ordered by tag (tags 1..N). text: "dt=<s> lastStep=<n>"
     enum StepField { sTag, sX, sY, sZ, sRadius, sUx, sUy, sUz, sWx, sWy, sWz, stepWidth };
@@ -80,8 +110,18 @@ namespace layout {
 
     // StepDone: text "iterations=<n> residual=<lambda residual> converged=<0|1>"
     //   one record per particle: hydrodynamic force and torque of the fluid solve,
-    //   -rho_f int I_lambda lambda dV and -rho_f int (x-x_p) x I_lambda lambda dV (Eq. 7).
-    enum StepDoneField { dFx, dFy, dFz, dTx, dTy, dTz, stepDoneWidth };
+    //   -rho_f int I_lambda lambda dV and -rho_f int (x-x_p) x I_lambda lambda dV (Eq. 7);
+    //   stepDoneWidth (6) wide, or stepDoneStressWidth (13) if the DEM Hello said
+    //   stresslets=1: then also the FDM stresslet of Eq. (12) [N m], with r = x - x_p,
+    //   S = -rho_f int I_lambda [sym(lambda r) - (lambda.r/3) delta] dV (traceless,
+    //   Sxx Sxy Sxz Syy Syz Szz) and its trace s = -int I_lambda [rho_f lambda.r + 3 p] dV
+    //   (p: the solver's pressure, whose reference level s depends on: docs/fluid.md).
+    enum StepDoneField {
+        dFx, dFy, dFz, dTx, dTy, dTz,
+        stepDoneWidth,
+        dSxx = stepDoneWidth, dSxy, dSxz, dSyy, dSyz, dSzz, dTrace,
+        stepDoneStressWidth
+    };
 }
 
 // Any coupling failure: peer died, never connected, timed out, malformed or unexpected

@@ -1,8 +1,10 @@
 #include "fluidCoupling.H"
 #include "Pstream.H"
 #include "OSspecific.H"
+#include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 
 namespace cpl = fdm::coupler;
 
@@ -27,6 +29,29 @@ namespace
         forAll(l, i) { l[i] = v[i]; }
         return l;
     }
+
+    // A 0|1 flag of a peer's text, read tolerantly: any number equal to 0 or
+    // 1, or true/false, yes/no, on/off in any case. False if it is none.
+    bool readFlag(std::string v, bool& flag)
+    {
+        for (char& c : v)
+        {
+            c = char(std::tolower(static_cast<unsigned char>(c)));
+        }
+        if (v == "true" || v == "yes" || v == "on") { flag = true; return true; }
+        if (v == "false" || v == "no" || v == "off") { flag = false; return true; }
+        char* end = nullptr;
+        const double x = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end != '\0' || (x != 0 && x != 1))
+        {
+            return false;
+        }
+        flag = (x == 1);
+        return true;
+    }
+
+    const char* boxFaceName[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
+    const char* boundaryKindName[4] = {"cyclic", "wall", "slip", "other"};
 }
 
 
@@ -40,7 +65,8 @@ Foam::fluidCoupling::fluidCoupling(const Time& runTime, const dictionary& dict)
     step_(-1),
     lastStep_(-1),
     dt_(0),
-    nParticles_(0)
+    nParticles_(0),
+    stresslets_(false)
 {
     if (!Pstream::master())
     {
@@ -115,15 +141,145 @@ void Foam::fluidCoupling::fatal(const string& message)
 }
 
 
+Foam::List<Foam::scalar> Foam::fluidCoupling::boxFaces
+(
+    const uniformCartesianMesh& grid,
+    const volVectorField& U,
+    string& problem
+)
+{
+    namespace layout = cpl::layout;
+    const polyBoundaryMesh& patches = grid.mesh().boundaryMesh();
+    const label nGlobal = patches.nNonProcessor();
+
+    // Per patch: kind from U's condition and, for walls, the velocity. A
+    // patch may have no face on this processor: the range of its values is
+    // reduced over processors (every processor has every non-processor patch,
+    // with the same condition type).
+    labelList kind(nGlobal, layout::bOther);
+    List<vector> wallU(nGlobal, Zero);
+    for (label patchi = 0; patchi < nGlobal; ++patchi)
+    {
+        const fvPatchVectorField& Up = U.boundaryField()[patchi];
+        const word& type = Up.type();
+        if (type == "cyclic")
+        {
+            kind[patchi] = layout::bPeriodic;
+        }
+        else if
+        (
+            type == "fixedValue" || type == "noSlip"
+         || type == "movingWallVelocity"
+        )
+        {
+            kind[patchi] = layout::bWall;
+        }
+        else if (type == "slip")
+        {
+            kind[patchi] = layout::bSlip;
+        }
+        if (kind[patchi] != layout::bWall)
+        {
+            continue;
+        }
+
+        vector lo(GREAT, GREAT, GREAT), hi(-GREAT, -GREAT, -GREAT);
+        forAll(Up, facei)
+        {
+            lo = min(lo, Up[facei]);
+            hi = max(hi, Up[facei]);
+        }
+        reduce(lo, minOp<vector>());
+        reduce(hi, maxOp<vector>());
+        if (lo.x() > hi.x())
+        {
+            continue;   // no face anywhere
+        }
+        // One velocity per wall: the sub-grid wall corrections (Appendix D)
+        // see a plane moving rigidly
+        const scalar scale = max(cmptMax(cmptMag(lo)), cmptMax(cmptMag(hi)));
+        if (cmptMax(hi - lo) > 1e-9*scale && problem.empty())
+        {
+            OStringStream os;
+            os  << "the velocity U on patch " << patches[patchi].name()
+                << " (" << type << ") is not uniform: it ranges from " << lo
+                << " to " << hi << " (" << U.time().timeName()
+                << "/U). fdmFoam tells the particle code "
+                << "one velocity per wall (coupling protocol "
+                << label(cpl::protocolVersion) << ")";
+            problem = os.str();
+        }
+        wallU[patchi] = 0.5*(lo + hi);
+    }
+
+    // Per box face: the kind its patches share (other if they differ), and
+    // the wall velocity
+    const List<labelList> facePatches = grid.boxFacePatches();
+    List<scalar> result(layout::nFaces*layout::faceWidth, 0.0);
+    forAll(facePatches, f)
+    {
+        const labelList& onFace = facePatches[f];
+        label k = onFace.empty() ? label(layout::bOther) : kind[onFace[0]];
+        for (const label patchi : onFace)
+        {
+            if (kind[patchi] != k)
+            {
+                k = layout::bOther;
+            }
+        }
+        vector Uw(Zero);
+        if (k == layout::bWall)
+        {
+            Uw = wallU[onFace[0]];
+            for (const label patchi : onFace)
+            {
+                const vector& Ui = wallU[patchi];
+                if
+                (
+                    mag(Ui - Uw) > 1e-9*max(mag(Ui), mag(Uw))
+                 && problem.empty()
+                )
+                {
+                    OStringStream os;
+                    os  << "the walls on the " << boxFaceName[f]
+                        << " face of the box move with different velocities: "
+                        << "patch " << patches[onFace[0]].name() << " U = "
+                        << Uw << ", patch " << patches[patchi].name()
+                        << " U = " << Ui << " (" << U.time().timeName()
+                        << "/U). fdmFoam tells the "
+                        << "particle code one velocity per face of the box";
+                    problem = os.str();
+                }
+            }
+        }
+        scalar* rec = &result[layout::faceWidth*f];
+        rec[layout::fKind] = k;
+        rec[layout::fUx] = Uw.x();
+        rec[layout::fUy] = Uw.y();
+        rec[layout::fUz] = Uw.z();
+    }
+    return result;
+}
+
+
 void Foam::fluidCoupling::handshake
 (
     const uniformCartesianMesh& grid,
+    const volVectorField& U,
     label nParticlesExpected,
     scalar alphaLambda,
-    scalar rhoFluid
+    scalar rhoFluid,
+    scalar eta
 )
 {
+    namespace layout = cpl::layout;
+
+    // Collective: every processor, before the master talks
+    string boundaryProblem;
+    const List<scalar> faces = boxFaces(grid, U, boundaryProblem);
+
     string problem;
+    label stresslets = 0;
     if (Pstream::master())
     {
         const double t0 = wallClock();
@@ -137,7 +293,7 @@ void Foam::fluidCoupling::handshake
                     + Foam::name(version) + ", fdmFoam speaks "
                     + Foam::name(label(cpl::protocolVersion));
             }
-            else if (hello.count != 1 || hello.width < cpl::layout::helloDemWidth)
+            else if (hello.count != 1 || hello.width < layout::helloDemWidth)
             {
                 problem = "malformed Hello from fdmDEM";
             }
@@ -185,6 +341,35 @@ void Foam::fluidCoupling::handshake
                         "but the LIGGGHTS input has "
                         + Foam::name(nParticles_);
                 }
+
+                // Protocol 2 always says whether StepDone carries stresslets
+                std::string value;
+                bool found = true, flag = false;
+                try
+                {
+                    value = hello.textValue("stresslets");
+                }
+                catch (const cpl::CouplerError&)
+                {
+                    found = false;
+                }
+                if (problem.empty() && !found)
+                {
+                    problem = "the Hello of fdmDEM has no stresslets= entry"
+                        " (text: \"" + hello.text + "\"), which coupling"
+                        " protocol " + Foam::name(label(cpl::protocolVersion))
+                      + " requires";
+                }
+                else if (problem.empty() && !readFlag(value, flag))
+                {
+                    problem = "the Hello of fdmDEM says stresslets=" + value
+                      + ", which is not 0 or 1";
+                }
+                stresslets = flag ? 1 : 0;
+            }
+            if (problem.empty())
+            {
+                problem = boundaryProblem;
             }
 
             if (problem.empty())
@@ -192,21 +377,26 @@ void Foam::fluidCoupling::handshake
                 cpl::Message reply = cpl::makeMessage
                 (
                     cpl::MessageType::Hello, 0, 0, 1,
-                    cpl::layout::helloFluidWidth,
+                    layout::helloFluidWidth,
                     "role=fluid version="
                   + std::to_string(cpl::protocolVersion)
                 );
                 const boundBox& bb = grid.bounds();
                 double* r = &reply.data[0];
-                r[0] = nParticlesExpected;
-                r[1] = alphaLambda;
-                r[2] = rhoFluid;
-                r[3] = grid.delta();
+                r[layout::hfNParticles] = nParticlesExpected;
+                r[layout::hfAlphaLambda] = alphaLambda;
+                r[layout::hfRhoFluid] = rhoFluid;
+                r[layout::hfDelta] = grid.delta();
                 for (direction d = 0; d < 3; ++d)
                 {
-                    r[4 + 2*d] = bb.min()[d];
-                    r[5 + 2*d] = bb.max()[d];
-                    r[10 + d] = grid.periodic()[d] ? 1 : 0;
+                    r[layout::hfXlo + 2*d] = bb.min()[d];
+                    r[layout::hfXlo + 2*d + 1] = bb.max()[d];
+                    r[layout::hfPeriodic + d] = grid.periodic()[d] ? 1 : 0;
+                }
+                r[layout::hfViscosity] = eta;
+                forAll(faces, i)
+                {
+                    r[layout::hfFaceBase + i] = faces[i];
                 }
                 transport_->send(reply);
             }
@@ -224,7 +414,24 @@ void Foam::fluidCoupling::handshake
         fatal(problem);
     }
     Pstream::scatter(nParticles_);
-    Info<< "Coupled with fdmDEM: " << nParticles_ << " particles" << endl;
+    Pstream::scatter(stresslets);
+    stresslets_ = stresslets != 0;
+
+    Info<< "Coupled with fdmDEM: " << nParticles_ << " particles, "
+        << (stresslets_ ? "with" : "without") << " stresslets" << nl
+        << "    box faces (for the particle code):";
+    for (label f = 0; f < label(layout::nFaces); ++f)
+    {
+        const scalar* rec = &faces[layout::faceWidth*f];
+        const label k = label(rec[layout::fKind]);
+        Info<< ' ' << boxFaceName[f] << ' ' << boundaryKindName[k];
+        if (k == layout::bWall)
+        {
+            Info<< ' '
+                << vector(rec[layout::fUx], rec[layout::fUy], rec[layout::fUz]);
+        }
+    }
+    Info<< endl;
 }
 
 
@@ -406,24 +613,46 @@ void Foam::fluidCoupling::sendStepDone
     label iterations,
     scalar residual,
     bool converged,
-    const List<scalar>& forces
+    const List<scalar>& forces,
+    const List<scalar>& stresslets
 )
 {
     if (!Pstream::master())
     {
         return;
     }
+    namespace layout = cpl::layout;
+    const label nf = layout::stepDoneWidth;                         // F, T
+    const label ns = layout::stepDoneStressWidth - layout::stepDoneWidth; // S, s
+    const label n = forces.size()/nf;
+    if (stresslets_ && stresslets.size() != ns*n)
+    {
+        FatalErrorInFunction
+            << "stresslets of " << stresslets.size()/ns << " particles for "
+            << n << " forces" << abort(FatalError);
+    }
+
     const double t0 = wallClock();
+    const label width =
+        stresslets_ ? layout::stepDoneStressWidth : layout::stepDoneWidth;
     cpl::Message m = cpl::makeMessage
     (
-        cpl::MessageType::StepDone, step_, iterations,
-        forces.size()/cpl::layout::stepDoneWidth,
-        cpl::layout::stepDoneWidth,
+        cpl::MessageType::StepDone, step_, iterations, n, width,
         "iterations=" + std::to_string(iterations)
       + " residual=" + number(residual)
       + " converged=" + std::string(converged ? "1" : "0")
     );
-    forAll(forces, i) { m.data[i] = forces[i]; }
+    for (label p = 0; p < n; ++p)
+    {
+        for (label k = 0; k < nf; ++k)
+        {
+            m.at(p, layout::dFx + k) = forces[nf*p + k];
+        }
+        for (label k = 0; stresslets_ && k < ns; ++k)
+        {
+            m.at(p, layout::dSxx + k) = stresslets[ns*p + k];
+        }
+    }
     try
     {
         transport_->send(m);

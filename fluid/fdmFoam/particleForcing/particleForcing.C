@@ -83,7 +83,6 @@ void Foam::particleForcing::setParticles(const List<fdmParticle>& particles)
     labelField count(V.size(), 0);
 
     const scalar delta = grid_.delta();
-    const vector L = grid_.span();
     const point& origin = grid_.bounds().min();
     const Vector<label>& n = grid_.nCells();
 
@@ -290,6 +289,49 @@ Foam::List<Foam::scalar> Foam::particleForcing::hydrodynamicForces
             result[6*p + 3 + d] = T[d];
         }
     }
+    Pstream::listCombineGather(result, plusEqOp<scalar>());
+    Pstream::listCombineScatter(result);
+    return result;
+}
+
+
+Foam::List<Foam::scalar> Foam::particleForcing::stresslets
+(
+    const volVectorField& lambda,
+    const volScalarField& p
+) const
+{
+    const label width = 7;    // S(6), s: fdm::coupler::layout dSxx..dTrace
+    List<scalar> result(width*particles_.size(), 0.0);
+    const scalarField& V = grid_.mesh().V();
+    const vectorField& l = lambda.primitiveField();
+    const scalarField& pk = p.primitiveField();
+
+    forAll(particles_, pi)
+    {
+        // Eq. (12): inside the particle the strain rate vanishes, so the
+        // stress of Eq. (11) is the pressure alone. Same indicator and cells
+        // as the force (hydrodynamicForces), so that overlaps split alike.
+        symmTensor S(Zero);
+        scalar s = 0;
+        for (label e = offset_[pi]; e < offset_[pi+1]; ++e)
+        {
+            const label celli = cell_[e];
+            const scalar w = rhoFluid_*Ilambda_[e]*V[celli];
+            S -= w*dev(symm(l[celli]*r_[e]));
+            s -= w*((l[celli] & r_[e]) + 3*pk[celli]);
+        }
+        scalar* rec = &result[width*pi];
+        rec[0] = S.xx();
+        rec[1] = S.xy();
+        rec[2] = S.xz();
+        rec[3] = S.yy();
+        rec[4] = S.yz();
+        rec[5] = S.zz();
+        rec[6] = s;
+    }
+
+    // Particles shared by processors: sum the partial integrals
     Pstream::listCombineGather(result, plusEqOp<scalar>());
     Pstream::listCombineScatter(result);
     return result;

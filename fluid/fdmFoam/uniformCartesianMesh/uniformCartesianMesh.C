@@ -2,6 +2,7 @@
 #include "volFields.H"
 #include "cyclicPolyPatch.H"
 #include "processorCyclicPolyPatch.H"
+#include "DynamicList.H"
 
 // * * * * * * * * * * * * Private Member Functions  * * * * * * * * * * * //
 
@@ -156,4 +157,67 @@ Foam::uniformCartesianMesh::uniformCartesianMesh(const fvMesh& mesh)
         << ", bounds " << bounds_
         << ", periodic (x y z) = (" << periodic_.x() << " " << periodic_.y()
         << " " << periodic_.z() << ")" << endl;
+}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+Foam::List<Foam::labelList> Foam::uniformCartesianMesh::boxFacePatches() const
+{
+    const polyBoundaryMesh& patches = mesh_.boundaryMesh();
+
+    // onFace[6*patchi + f]: patch patchi has a face on box face f. A patch
+    // may hold no face on a processor, and a cyclic split by the
+    // decomposition lives on processorCyclic patches: gather over processors.
+    const label nGlobal = patches.nNonProcessor();
+    labelList onFace(6*nGlobal, 0);
+    const scalar tol = 1e-6*delta_;
+
+    for (const polyPatch& pp : patches)
+    {
+        label owner = -1;
+        if (pp.index() < nGlobal)
+        {
+            owner = pp.index();
+        }
+        else if (isA<processorCyclicPolyPatch>(pp))
+        {
+            owner = refCast<const processorCyclicPolyPatch>(pp).referPatchID();
+        }
+        if (owner < 0)
+        {
+            continue;   // processor boundary: not a face of the box
+        }
+        for (const point& c : pp.faceCentres())
+        {
+            for (direction d = 0; d < 3; ++d)
+            {
+                if (mag(c[d] - bounds_.min()[d]) < tol)
+                {
+                    onFace[6*owner + 2*d] = 1;
+                }
+                else if (mag(c[d] - bounds_.max()[d]) < tol)
+                {
+                    onFace[6*owner + 2*d + 1] = 1;
+                }
+            }
+        }
+    }
+    Pstream::listCombineGather(onFace, maxEqOp<label>());
+    Pstream::listCombineScatter(onFace);
+
+    List<labelList> result(6);
+    for (label f = 0; f < 6; ++f)
+    {
+        DynamicList<label> onThis;
+        for (label patchi = 0; patchi < nGlobal; ++patchi)
+        {
+            if (onFace[6*patchi + f])
+            {
+                onThis.append(patchi);
+            }
+        }
+        result[f].transfer(onThis);
+    }
+    return result;
 }

@@ -1,0 +1,496 @@
+// pair_style fdm/subgrid: sub-grid lubrication blocks and frictional contact (see pair_fdm_subgrid.h,
+// docs/dem.md).
+#include "pair_fdm_subgrid.h"
+
+#include "fix_contact_history_fdm.h"
+#include "fix_fdm_couple.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "fix_property_atom.h"
+#include "force.h"
+#include "memory.h"
+#include "modify.h"
+#include "neigh_list.h"
+#include "neigh_request.h"
+#include "neighbor.h"
+#include "update.h"
+
+#include "fdm/resistance/blocks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+using namespace LAMMPS_NS;
+namespace res = fdm::resistance;
+
+namespace {
+const char *faceNames[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
+
+std::string fmt(double x)
+{
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+}  // namespace
+
+PairFdmSubgrid::PairFdmSubgrid(LAMMPS *lmp) :
+  Pair(lmp), computeflag(0), lubrication_(true), cutoffCells_(0.5), kn_(0), kt_(0), mu_(0), hr_(0), viscosity_(0),
+  meshSize_(0), rangeGap_(0), rmin_(0), rmax_(0), distanceFactor_(1.0), history_(nullptr), wallHistory_(nullptr),
+  contactStressRequested_(false), nmaxStress_(0), contactStress_(nullptr), contactsLast_(0), reported_(false)
+{
+  single_enable = 0;
+  no_virial_fdotr_compute = 1;
+}
+
+PairFdmSubgrid::~PairFdmSubgrid()
+{
+  if (history_) modify->delete_fix("contacthistory");
+  if (wallHistory_) modify->delete_fix("fdm_wall_history");
+  memory->destroy(contactStress_);
+  if (allocated) {
+    memory->destroy(setflag);
+    memory->destroy(cutsq);
+  }
+}
+
+void PairFdmSubgrid::allocate()
+{
+  allocated = 1;
+  const int n = atom->ntypes;
+  memory->create(setflag, n + 1, n + 1, "pair:setflag");
+  for (int i = 1; i <= n; i++)
+    for (int j = i; j <= n; j++) setflag[i][j] = 0;
+  memory->create(cutsq, n + 1, n + 1, "pair:cutsq");
+}
+
+void PairFdmSubgrid::settings(int narg, char **arg)
+{
+  auto need = [&](int i, int n, const char *what) {
+    if (i + n >= narg) error->all(FLERR, (std::string("pair_style fdm/subgrid: ") + what).c_str());
+  };
+  walls_.clear();
+  for (int i = 0; i < narg; i++) {
+    const std::string key = arg[i];
+    if (key == "lubrication") {
+      need(i, 1, "lubrication yes|no");
+      const std::string v = arg[++i];
+      if (v != "yes" && v != "no") error->all(FLERR, "pair_style fdm/subgrid: lubrication yes|no");
+      lubrication_ = (v == "yes");
+    } else if (key == "cutoff") {
+      need(i, 1, "cutoff k (the cut-off gap in mesh cells)");
+      cutoffCells_ = force->numeric(FLERR, arg[++i]);
+      if (!(cutoffCells_ > 0)) error->all(FLERR, ("pair_style fdm/subgrid: cutoff " + fmt(cutoffCells_) +
+                                                  " must be positive (mesh cells)").c_str());
+    } else if (key == "contact") {
+      need(i, 4, "contact kn kt mu_s h_r (N/m, N/m, -, m)");
+      kn_ = force->numeric(FLERR, arg[i + 1]);
+      kt_ = force->numeric(FLERR, arg[i + 2]);
+      mu_ = force->numeric(FLERR, arg[i + 3]);
+      hr_ = force->numeric(FLERR, arg[i + 4]);
+      i += 4;
+      if (!(kn_ > 0) || !(kt_ >= 0) || !(mu_ >= 0) || !(hr_ >= 0))
+        error->all(FLERR, ("pair_style fdm/subgrid: contact kn " + fmt(kn_) + " kt " + fmt(kt_) + " mu_s " + fmt(mu_) +
+                           " h_r " + fmt(hr_) + ": kn must be positive, kt, mu_s and h_r non-negative").c_str());
+    } else if (key == "wall") {
+      need(i, 4, "wall FACE ux uy uz (FACE = xlo xhi ylo yhi zlo zhi)");
+      const std::string face = arg[i + 1];
+      int k = 0;
+      while (k < 6 && face != faceNames[k]) k++;
+      if (k == 6) error->all(FLERR, ("pair_style fdm/subgrid: wall " + face + ": the face must be one of xlo xhi ylo "
+                                     "yhi zlo zhi").c_str());
+      Wall w;
+      w.axis = k / 2;
+      w.side = k % 2;
+      for (int d = 0; d < 3; d++) w.velocity[d] = force->numeric(FLERR, arg[i + 2 + d]);
+      if (w.velocity[w.axis] != 0)
+        error->all(FLERR, ("pair_style fdm/subgrid: wall " + face + " moves through itself (velocity component " +
+                           fmt(w.velocity[w.axis]) + " along its normal): a wall moves in its own plane").c_str());
+      for (const Wall &o : walls_)
+        if (o.axis == w.axis && o.side == w.side)
+          error->all(FLERR, ("pair_style fdm/subgrid: wall " + face + " is declared twice").c_str());
+      walls_.push_back(w);
+      i += 4;
+    } else {
+      error->all(FLERR, ("pair_style fdm/subgrid: unknown keyword " + key + " (see docs/dem.md)").c_str());
+    }
+  }
+}
+
+void PairFdmSubgrid::coeff(int narg, char **arg)
+{
+  if (narg != 2) error->all(FLERR, "pair_coeff for fdm/subgrid: pair_coeff * * (the parameters are in pair_style)");
+  if (!allocated) allocate();
+  int ilo, ihi, jlo, jhi;
+  force->bounds(arg[0], atom->ntypes, ilo, ihi);
+  force->bounds(arg[1], atom->ntypes, jlo, jhi);
+  for (int i = ilo; i <= ihi; i++)
+    for (int j = std::max(jlo, i); j <= jhi; j++) setflag[i][j] = 1;
+}
+
+std::string PairFdmSubgrid::wallName(const Wall &w) const { return faceNames[2 * w.axis + w.side]; }
+
+void PairFdmSubgrid::fluidParameters()
+{
+  // The viscosity and the mesh size are the fluid case's: fix fdm/couple has them from the handshake
+  // (it connects now if this is the first run). Without the fix there is no fluid: contact only.
+  FixFdmCouple *couple = nullptr;
+  for (int i = 0; i < modify->nfix; i++)
+    if (std::strcmp(modify->fix[i]->style, "fdm/couple") == 0) couple = dynamic_cast<FixFdmCouple *>(modify->fix[i]);
+  if (!couple) {
+    model_.reset();
+    return;
+  }
+  couple->ensureConnected();
+  viscosity_ = couple->viscosity();
+  meshSize_ = couple->meshSize();
+  if (!model_) model_.reset(new res::CutoffSubgridModel(meshSize_, cutoffCells_));
+
+  // The walls declared here are the fluid case's no-slip walls, with the same velocities.
+  std::string problem;
+  if (!couple->hasFluid()) return;  // transport none: the walls are the ones declared here
+  for (int face = 0; face < 6 && problem.empty(); face++) {
+    int kind;
+    double velocity[3];
+    couple->fluidFace(face, kind, velocity);
+    const Wall *declared = nullptr;
+    for (const Wall &w : walls_)
+      if (2 * w.axis + w.side == face) declared = &w;
+    const std::string u = "(" + fmt(velocity[0]) + " " + fmt(velocity[1]) + " " + fmt(velocity[2]) + ")";
+    if (kind == FixFdmCouple::faceWall && !declared) {
+      problem = std::string("the fluid case has a no-slip wall on ") + faceNames[face] + " moving at " + u +
+                " m/s, not declared to pair_style fdm/subgrid: add 'wall " + faceNames[face] + " " + fmt(velocity[0]) +
+                " " + fmt(velocity[1]) + " " + fmt(velocity[2]) + "'";
+    } else if (declared && kind != FixFdmCouple::faceWall) {
+      problem = std::string("pair_style fdm/subgrid declares a wall on ") + faceNames[face] +
+                " but the fluid case has " + FixFdmCouple::faceKindName(kind) + " there";
+    } else if (declared) {
+      double scale = 0, diff = 0;
+      for (int d = 0; d < 3; d++) {
+        scale = std::max(scale, std::max(std::fabs(velocity[d]), std::fabs(declared->velocity[d])));
+        diff = std::max(diff, std::fabs(velocity[d] - declared->velocity[d]));
+      }
+      if (diff > 1e-9 * scale)
+        problem = std::string("wall ") + faceNames[face] + ": pair_style fdm/subgrid says it moves at (" +
+                  fmt(declared->velocity[0]) + " " + fmt(declared->velocity[1]) + " " + fmt(declared->velocity[2]) +
+                  ") m/s but the fluid case (0/U) at " + u + " m/s";
+    }
+  }
+  if (!problem.empty()) error->all(FLERR, ("pair fdm/subgrid: " + problem).c_str());
+}
+
+void PairFdmSubgrid::init_style()
+{
+  if (!atom->sphere_flag) error->all(FLERR, "pair_style fdm/subgrid requires atom_style sphere");
+  if (force->newton_pair) error->all(FLERR, "pair_style fdm/subgrid requires newton off");
+  if (hr_ > 0 && !comm->ghost_velocity)
+    error->all(FLERR, "pair_style fdm/subgrid with contact needs ghost velocities: 'communicate single vel yes'");
+  for (const Wall &w : walls_)
+    if (domain->periodicity[w.axis])
+      error->all(FLERR, ("pair_style fdm/subgrid: wall " + wallName(w) + " on a periodic boundary: make the " +
+                         std::string(1, "xyz"[w.axis]) + " boundary fixed (boundary ... f ...)").c_str());
+
+  fluidParameters();
+
+  double rmin = 1e300, rmax = 0;
+  for (int i = 0; i < atom->nlocal; i++) {
+    rmin = std::min(rmin, atom->radius[i]);
+    rmax = std::max(rmax, atom->radius[i]);
+  }
+  MPI_Allreduce(&rmin, &rmin_, 1, MPI_DOUBLE, MPI_MIN, world);
+  MPI_Allreduce(&rmax, &rmax_, 1, MPI_DOUBLE, MPI_MAX, world);
+  if (!(rmax_ > 0)) error->all(FLERR, "pair_style fdm/subgrid: no particles (or no positive radius) to interact");
+
+  // Pairs up to this surface gap must be in the neighbour list, and keep their contact history:
+  // LIGGGHTS's granular list includes r < (r_i + r_j) * contact_distance_factor (+ skin).
+  rangeGap_ = std::max(hr_, lubricationActive() ? cutoffCells_ * meshSize_ : 0.0);
+  distanceFactor_ = 1.0 + 1.000001 * rangeGap_ / (2.0 * rmin_);
+  if (rangeGap_ > 0) neighbor->register_contact_dist_factor(distanceFactor_);
+
+  if (contactActive() && !history_) {
+    const char *args[] = {"contacthistory", "all", "contacthistory", "3", "shearx", "1", "sheary", "1", "shearz", "1"};
+    modify->add_fix(10, const_cast<char **>(args));
+    history_ = dynamic_cast<FixContactHistoryFdm *>(modify->fix[modify->find_fix("contacthistory")]);
+    if (!history_) error->all(FLERR, "pair fdm/subgrid: fix contacthistory is not the fdmDEM one (FixContactHistoryFdm)");
+  }
+  if (contactActive() && !walls_.empty() && !wallHistory_) {
+    // tangential spring elongation against each wall, per atom: migrates with the atom
+    std::vector<std::string> args = {"fdm_wall_history", "all", "property/atom", "fdmWallShear", "vector", "yes", "no", "no"};
+    for (size_t k = 0; k < 3 * walls_.size(); k++) args.push_back("0");
+    std::vector<char *> argv;
+    for (std::string &s : args) argv.push_back(&s[0]);
+    wallHistory_ = modify->add_fix_property_atom(int(argv.size()), argv.data(), "pair fdm/subgrid");
+  }
+
+  int request = neighbor->request(this);
+  neighbor->requests[request]->half = 0;
+  neighbor->requests[request]->gran = 1;
+  if (contactActive()) {
+    request = neighbor->request(this);
+    neighbor->requests[request]->id = 1;
+    neighbor->requests[request]->half = 0;
+    neighbor->requests[request]->granhistory = 1;
+    neighbor->requests[request]->dnum = 3;
+  }
+
+  if (comm->me == 0 && !reported_) {
+    // Say what is active in this scene: a correction nobody can see is a correction nobody trusts.
+    std::string line = "pair fdm/subgrid: ";
+    if (lubricationActive())
+      line += "sub-grid lubrication ON (pairs and walls within a surface gap of " + fmt(cutoffCells_) +
+              " mesh cells = " + fmt(cutoffCells_ * meshSize_) + " m; viscosity " + fmt(viscosity_) + " Pa s; " +
+              model_->describe() + ")";
+    else
+      line += std::string("sub-grid lubrication OFF (") + (model_ || !lubrication_ ? "lubrication no" :
+              "no fix fdm/couple: no fluid") + ")";
+    if (walls_.empty()) line += "; no walls (no wall search)";
+    for (const Wall &w : walls_)
+      line += "; wall " + wallName(w) + " at velocity (" + fmt(w.velocity[0]) + " " + fmt(w.velocity[1]) + " " +
+              fmt(w.velocity[2]) + ")";
+    if (contactActive())
+      line += "; contact ON (kn " + fmt(kn_) + " N/m, kt " + fmt(kt_) + " N/m, mu_s " + fmt(mu_) + ", h_r " + fmt(hr_) +
+              " m" + (walls_.empty() ? "" : ", also with the walls") + ")";
+    else
+      line += "; contact OFF (h_r = 0: no contact search)";
+    line += "\n";
+    if (screen) fputs(line.c_str(), screen);
+    if (logfile) fputs(line.c_str(), logfile);
+    reported_ = true;
+  }
+}
+
+void PairFdmSubgrid::init_list(int id, NeighList *ptr)
+{
+  if (id == 0) list = ptr;
+  else if (id == 1) listgranhistory = ptr;
+}
+
+double PairFdmSubgrid::init_one(int, int)
+{
+  // the ghost cut-off: the largest centre distance at which two particles interact
+  return 2.0 * rmax_ * distanceFactor_;
+}
+
+void *PairFdmSubgrid::extract(const char *name, int &dim)
+{
+  dim = 0;
+  if (std::strcmp(name, "computeflag") == 0) return &computeflag;
+  return nullptr;
+}
+
+void PairFdmSubgrid::compute(int eflag, int vflag)
+{
+  if (eflag || vflag) ev_setup(eflag, vflag);
+  else evflag = vflag_fdotr = 0;
+  computeflag = 1;
+  contactsLast_ = 0;
+  if (contactStressRequested_) {
+    if (atom->nmax > nmaxStress_) {
+      nmaxStress_ = atom->nmax;
+      memory->destroy(contactStress_);
+      memory->create(contactStress_, nmaxStress_, 6, "pair:fdm/subgrid:contactStress");
+    }
+    for (int i = 0; i < atom->nlocal; i++)
+      for (int c = 0; c < 6; c++) contactStress_[i][c] = 0.0;
+  }
+  if (!contactActive()) return;  // lubrication is no force here: it is R^SG in Eq. (31)
+  contactForces();
+  if (!walls_.empty()) wallContactForces();
+}
+
+void PairFdmSubgrid::addContactStress(int i, const double force[3], const double branch[3], double weight)
+{
+  // Eq. (52): S^c_p += 1/2 a_p/(a_p + a_p') (F ⊗ x + x ⊗ F), x from p to the partner
+  static const int comp[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  for (int c = 0; c < 6; c++) {
+    const int a = comp[c][0], b = comp[c][1];
+    contactStress_[i][c] += 0.5 * weight * (force[a] * branch[b] + branch[a] * force[b]);
+  }
+}
+
+void PairFdmSubgrid::contactForces()
+{
+  // Section 6 (Gallier et al. 2014): contact once the surface gap is below h_r; linear normal
+  // spring kn (h_r - gap); tangential spring kt on the elongation accumulated during the contact
+  // (kept by LIGGGHTS's contact history), capped at mu_s |F_n| (no static/dynamic distinction).
+  double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius;
+  const int nlocal = atom->nlocal;
+  const bool updateHistory = !update->setupflag;  // setup force evaluations do not advance time
+  const double dt = update->dt;
+  int **firstTouch = listgranhistory->firstneigh;
+  double **firstShear = listgranhistory->firstdouble;
+
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    int *touch = firstTouch[i];
+    double *allShear = firstShear[i];
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      double *shear = &allShear[3 * jj];
+      const double del[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
+      const double rsq = del[0] * del[0] + del[1] * del[1] + del[2] * del[2];
+      const double reach = radius[i] + radius[j] + hr_;
+      if (rsq >= reach * reach) {  // apart: the contact and its history end now
+        touch[jj] = 0;
+        shear[0] = shear[1] = shear[2] = 0.0;
+        continue;
+      }
+      touch[jj] = 1;
+      const double r = std::sqrt(rsq);
+      const double n[3] = {del[0] / r, del[1] / r, del[2] / r};  // from j to i
+      const double normalForce = kn_ * (reach - r);
+      // relative velocity of the contact points: v_i - v_j - (a_i w_i + a_j w_j) x n
+      double w[3], vr[3];
+      for (int d = 0; d < 3; d++) w[d] = radius[i] * omega[i][d] + radius[j] * omega[j][d];
+      const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
+      for (int d = 0; d < 3; d++) vr[d] = v[i][d] - v[j][d] - wxn[d];
+      const double vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
+      if (updateHistory)
+        for (int d = 0; d < 3; d++) shear[d] += (vr[d] - vn * n[d]) * dt;
+      const double sn = shear[0] * n[0] + shear[1] * n[1] + shear[2] * n[2];  // stay in the tangent plane
+      for (int d = 0; d < 3; d++) shear[d] -= sn * n[d];
+      double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
+      const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
+      const double ftMax = mu_ * normalForce;
+      if (ftNorm > ftMax) {  // sliding: Coulomb, and the spring is reset to the cap
+        const double scale = ftMax / ftNorm;
+        for (int d = 0; d < 3; d++) {
+          ft[d] *= scale;
+          if (kt_ > 0) shear[d] = -ft[d] / kt_;
+        }
+      }
+      const double force[3] = {normalForce * n[0] + ft[0], normalForce * n[1] + ft[1], normalForce * n[2] + ft[2]};
+      const double nxft[3] = {n[1] * ft[2] - n[2] * ft[1], n[2] * ft[0] - n[0] * ft[2], n[0] * ft[1] - n[1] * ft[0]};
+      for (int d = 0; d < 3; d++) {
+        f[i][d] += force[d];
+        torque[i][d] -= radius[i] * nxft[d];
+      }
+      const double weightI = radius[i] / (radius[i] + radius[j]);
+      if (contactStressRequested_) {
+        const double branch[3] = {-del[0], -del[1], -del[2]};  // x_j - x_i
+        addContactStress(i, force, branch, weightI);
+      }
+      if (j < nlocal) {  // newton off: a ghost's owner adds its share itself
+        const double minus[3] = {-force[0], -force[1], -force[2]};
+        for (int d = 0; d < 3; d++) {
+          f[j][d] -= force[d];
+          torque[j][d] -= radius[j] * nxft[d];
+        }
+        if (contactStressRequested_) addContactStress(j, minus, del, 1.0 - weightI);
+      }
+      contactsLast_++;
+    }
+  }
+}
+
+void PairFdmSubgrid::wallContactForces()
+{
+  // The same contact law against each declared wall (the wall has no radius: the branch vector of
+  // Eq. 52 is the particle's, from its centre to the wall).
+  double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius;
+  const bool updateHistory = !update->setupflag;
+  const double dt = update->dt;
+  double **history = wallHistory_->array_atom;
+  for (int i = 0; i < atom->nlocal; i++) {
+    for (size_t k = 0; k < walls_.size(); k++) {
+      const Wall &wall = walls_[k];
+      double *shear = &history[i][3 * k];
+      // n: from the wall into the fluid; h: centre-to-wall distance
+      const double h = wall.side == 0 ? x[i][wall.axis] - domain->boxlo[wall.axis] :
+                                        domain->boxhi[wall.axis] - x[i][wall.axis];
+      const double gap = h - radius[i];
+      if (gap >= hr_) {
+        shear[0] = shear[1] = shear[2] = 0.0;
+        continue;
+      }
+      double n[3] = {0, 0, 0};
+      n[wall.axis] = wall.side == 0 ? 1.0 : -1.0;
+      const double normalForce = kn_ * (hr_ - gap);
+      double vr[3];
+      const double aw[3] = {radius[i] * omega[i][0], radius[i] * omega[i][1], radius[i] * omega[i][2]};
+      const double wxn[3] = {aw[1] * n[2] - aw[2] * n[1], aw[2] * n[0] - aw[0] * n[2], aw[0] * n[1] - aw[1] * n[0]};
+      for (int d = 0; d < 3; d++) vr[d] = v[i][d] - wall.velocity[d] - wxn[d];
+      const double vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
+      if (updateHistory)
+        for (int d = 0; d < 3; d++) shear[d] += (vr[d] - vn * n[d]) * dt;
+      const double sn = shear[0] * n[0] + shear[1] * n[1] + shear[2] * n[2];
+      for (int d = 0; d < 3; d++) shear[d] -= sn * n[d];
+      double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
+      const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
+      const double ftMax = mu_ * normalForce;
+      if (ftNorm > ftMax) {
+        const double scale = ftMax / ftNorm;
+        for (int d = 0; d < 3; d++) {
+          ft[d] *= scale;
+          if (kt_ > 0) shear[d] = -ft[d] / kt_;
+        }
+      }
+      const double force[3] = {normalForce * n[0] + ft[0], normalForce * n[1] + ft[1], normalForce * n[2] + ft[2]};
+      const double nxft[3] = {n[1] * ft[2] - n[2] * ft[1], n[2] * ft[0] - n[0] * ft[2], n[0] * ft[1] - n[1] * ft[0]};
+      for (int d = 0; d < 3; d++) {
+        f[i][d] += force[d];
+        torque[i][d] -= radius[i] * nxft[d];
+      }
+      if (contactStressRequested_) {
+        const double branch[3] = {-h * n[0], -h * n[1], -h * n[2]};
+        addContactStress(i, force, branch, 1.0);
+      }
+      contactsLast_++;
+    }
+  }
+}
+
+void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls)
+{
+  pairs.clear();
+  walls.clear();
+  if (!lubricationActive()) return;
+  double **x = atom->x;
+  const double *radius = atom->radius;
+  const int *tag = atom->tag;
+  const int nlocal = atom->nlocal;
+  res::PairBlock block;
+  for (int ii = 0; ii < list->inum; ii++) {
+    const int i = list->ilist[ii];
+    const int *jlist = list->firstneigh[i];
+    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+      const int j = jlist[jj] & NEIGHMASK;
+      // newton off: a pair across ranks (or through a periodic face) is listed from both sides;
+      // the side of the lower tag keeps it. A particle next to its own image is skipped.
+      if (j >= nlocal && tag[i] >= tag[j]) continue;
+      // the same symmetric gap the resistance library uses: xi = 2r/(a1+a2) - 2
+      if (!res::subgridPairBlock(*model_, x[i], x[j], radius[i], radius[j], viscosity_, block)) continue;
+      pairs.push_back(tag[i]);
+      pairs.push_back(tag[j]);
+      pairs.insert(pairs.end(), &block.R[0][0], &block.R[0][0] + 144);
+      if (withStress) pairs.insert(pairs.end(), &block.stress[0][0], &block.stress[0][0] + pairStressRecord);
+    }
+  }
+  res::WallBlock wallBlock;
+  for (const Wall &w : walls_) {
+    double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};  // normal into the wall (Appendix A.2)
+    point[w.axis] = w.side == 0 ? domain->boxlo[w.axis] : domain->boxhi[w.axis];
+    normal[w.axis] = w.side == 0 ? -1.0 : 1.0;
+    for (int i = 0; i < nlocal; i++) {
+      if (!res::subgridWallBlock(*model_, x[i], radius[i], point, normal, viscosity_, wallBlock)) continue;
+      double rhs[6], stressRhs[7];
+      res::wallVelocityTerm(wallBlock, w.velocity, rhs, stressRhs);
+      walls.push_back(tag[i]);
+      walls.insert(walls.end(), &wallBlock.R[0][0], &wallBlock.R[0][0] + 36);
+      walls.insert(walls.end(), rhs, rhs + 6);
+      if (withStress) {
+        walls.insert(walls.end(), &wallBlock.stress[0][0], &wallBlock.stress[0][0] + 42);
+        walls.insert(walls.end(), stressRhs, stressRhs + 7);
+      }
+    }
+  }
+}

@@ -1,0 +1,105 @@
+/* pair_style fdm/subgrid -- close interactions of the FDM suspension model (Orsi, Lobry & Peters 2023):
+   the frame-invariant sub-grid lubrication blocks (Eq. 21 with Appendix C.2 for pairs, Eq. D.6 for
+   walls) and the frictional contact of section 6 (roughness height h_r, Coulomb friction mu_s).
+
+   Syntax (docs/dem.md):
+     pair_style fdm/subgrid [lubrication yes|no] [cutoff k] [contact kn kt mu_s h_r]
+                            [wall FACE ux uy uz] ...
+     pair_coeff * *
+
+   The contact forces go into f and torque at every force evaluation, like any LIGGGHTS pair style
+   (they enter F^c of Eq. 32). The sub-grid blocks are not forces: they are the matrix R^SG of
+   Eq. (31), which fix fdm/couple solves implicitly. The fix asks for them once per time step
+   (collectBlocks) with the viscosity and mesh size the fluid solver announced at the handshake;
+   the resistance functions come from the project's resistance library (resistance/). */
+
+#ifndef FDM_PAIR_FDM_SUBGRID_H
+#define FDM_PAIR_FDM_SUBGRID_H
+
+#include "pair.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fdm {
+namespace resistance {
+class SubgridModel;
+}
+}
+
+namespace LAMMPS_NS {
+
+class PairFdmSubgrid : public Pair {
+ public:
+  PairFdmSubgrid(class LAMMPS *);
+  ~PairFdmSubgrid();
+  void compute(int, int);
+  void settings(int, char **);
+  void coeff(int, char **);
+  void init_style();
+  void init_list(int, class NeighList *);
+  double init_one(int, int);
+  void *extract(const char *, int &);
+
+  // A planar wall on a non-periodic face of the box, moving in its own plane.
+  struct Wall {
+    int axis, side;       // face = 2*axis + side (xlo, xhi, ylo, yhi, zlo, zhi)
+    double velocity[3];
+  };
+
+  // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0.
+  // Pair record: [tag1, tag2, R (12x12, row-major, unknowns U1 W1 U2 W2)] + stress rows (14x12) if
+  // withStress. Wall record: [tag, R (6x6), rhs R[:,0:3] U_w (6)] + stress rows (7x6) and their
+  // wall-velocity term (7) if withStress. R already contains the viscosity (F = -R u).
+  static const int pairRecord = 2 + 144, pairStressRecord = 14 * 12;
+  static const int wallRecord = 1 + 36 + 6, wallStressRecord = 7 * 6 + 7;
+  void collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls);
+
+  bool lubricationActive() const { return lubrication_ && model_; }
+  bool contactActive() const { return hr_ > 0; }
+  const std::vector<Wall> &walls() const { return walls_; }
+  // Per-atom contact stresslet S^c (Eq. 52: xx xy xz yy yz zz) of the last compute, if requested.
+  void requestContactStress(bool on) { contactStressRequested_ = on; }
+  const double *contactStress(int i) const
+  {
+    static const double none[6] = {0, 0, 0, 0, 0, 0};
+    return contactStress_ && i < nmaxStress_ ? contactStress_[i] : none;
+  }
+  // Contacts (pair and wall) found by this rank in the last compute.
+  long contactsLast() const { return contactsLast_; }
+
+  int computeflag;   // read and reset by fix contacthistory (pre_exchange)
+
+ private:
+  void allocate();
+  void fluidParameters();
+  void contactForces();
+  void wallContactForces();
+  void addContactStress(int i, const double force[3], const double branch[3], double weight);
+  std::string wallName(const Wall &w) const;
+
+  // settings
+  bool lubrication_;
+  double cutoffCells_;
+  double kn_, kt_, mu_, hr_;
+  std::vector<Wall> walls_;
+
+  // from the fluid solver (via fix fdm/couple) at the handshake
+  double viscosity_, meshSize_;
+  std::unique_ptr<fdm::resistance::SubgridModel> model_;
+
+  double rangeGap_;            // largest surface gap with any interaction (contact or lubrication)
+  double rmin_, rmax_, distanceFactor_;
+  class FixContactHistory *history_;
+  class FixPropertyAtom *wallHistory_;
+  bool contactStressRequested_;
+  int nmaxStress_;
+  double **contactStress_;
+  long contactsLast_;
+  bool reported_;
+};
+
+}  // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,236 @@
+// The test harness of the particle side: writes a LIGGGHTS input, runs the real fdmDEM (serial or
+// mpirun) as a child process, and plays the fluid solver's part of the coupling protocol with
+// scripted integrals (a harness for the particle side, not a fluid solver).
+#ifndef FDM_DEM_TEST_HARNESS_H
+#define FDM_DEM_TEST_HARNESS_H
+
+#include "fdm/coupler.h"
+
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <netinet/in.h>
+#include <sstream>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace cpl = fdm::coupler;
+
+namespace {
+
+
+const double pi = 3.14159265358979323846;
+
+std::string workDir(const std::string& name)
+{
+    const std::string dir = "/tmp/fdmDEMTest." + std::to_string(getpid()) + "." + name;
+    ::mkdir(dir.c_str(), 0755);
+    return dir;
+}
+
+// ---- the LIGGGHTS input ---------------------------------------------------------------------------
+
+struct Sphere {
+    double x, y, z, radius, density;
+};
+
+struct Scene {
+    std::string boundary = "p p p";
+    double lo[3] = {0, 0, 0}, hi[3] = {8, 8, 8};
+    std::vector<Sphere> spheres = {{2.0, 3.0, 4.0, 0.5, 2500.0}, {6.0, 5.0, 3.5, 0.7, 1500.0},
+                                   {5.5, 1.5, 6.5, 0.4, 4000.0}};
+    double dt = 0.01;
+    std::string beforeFix;   // lines before the fix (fix addforce, dump, ...)
+    std::string fixOptions;  // extra fdm/couple keywords
+    std::string runs = "run 2";
+    std::string pairStyle = "none";  // e.g. "fdm/subgrid contact 100 80 0.5 0.01"
+    std::string transport = "portfile coupling.port";
+};
+
+void writeInput(const std::string& dir, const Scene& s)
+{
+    std::ofstream in((dir + "/in.dem").c_str());
+    in.precision(17);
+    in << "atom_style      sphere\n"
+          "atom_modify     map array sort 0 0.0\n"
+          "boundary        " << s.boundary << "\n"
+          "newton          off\n"
+          "communicate     single vel yes\n"
+          "units           si\n"
+          "region          box block " << s.lo[0] << " " << s.hi[0] << " " << s.lo[1] << " " << s.hi[1] << " "
+       << s.lo[2] << " " << s.hi[2] << " units box\n"
+          "create_box      1 box\n";
+    for (const Sphere& p : s.spheres) in << "create_atoms    1 single " << p.x << " " << p.y << " " << p.z << " units box\n";
+    for (size_t i = 0; i < s.spheres.size(); ++i)
+        in << "set             atom " << i + 1 << " diameter " << 2 * s.spheres[i].radius << " density "
+           << s.spheres[i].density << "\n";
+    in << "pair_style      " << s.pairStyle << "\n"
+       << (s.pairStyle == "none" ? "" : "pair_coeff      * *\n")
+       << "neighbor        0.1 bin\n"
+          "timestep        " << s.dt << "\n"
+       << s.beforeFix << "\n"
+       << "fix             couple all fdm/couple " << s.transport << " connect_timeout 5 timeout 10 " << s.fixOptions
+       << "\n" << s.runs << "\n";
+}
+
+// ---- running fdmDEM ---------------------------------------------------------------------------------
+
+struct DemRun {
+    int status;
+    std::string output;
+    double seconds;
+};
+
+DemRun runDEM(const std::string& dir, int ranks = 1)
+{
+    std::string command = "cd '" + dir + "' && timeout -k 5 60 ";
+    if (ranks > 1) command += std::string(FDM_MPIEXEC) + " -np " + std::to_string(ranks) + " --oversubscribe ";
+    command += std::string(FDM_DEM_EXE) + " -in in.dem 2>&1";
+    const auto t0 = std::chrono::steady_clock::now();
+    FILE* p = popen(command.c_str(), "r");
+    std::string out;
+    char buf[4096];
+    while (p && std::fgets(buf, sizeof buf, p)) out += buf;
+    const int status = p ? pclose(p) : -1;
+    DemRun r;
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.output = out;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+}
+
+// ---- the scripted fluid peer ------------------------------------------------------------------------
+
+struct FakeFluid {
+    enum Mode { Normal, DieAfterStep, ErrorAfterStep, WrongTypeAfterStep, ZeroVolume, NaNIntegral };
+    Mode mode = Normal;
+    cpl::Options options;
+    long nExpected = -1;
+    double alphaLambda = 0.25, rhoFluid = 1000.0, delta = 0.2, viscosity = 0.16;
+    double box[6] = {0, 8, 0, 8, 0, 8};
+    int periodic[3] = {1, 1, 1};
+    // Each non-periodic face: kind (1 = no-slip wall, 2 = slip, 3 = other) and wall velocity.
+    int faceKind[6] = {1, 1, 1, 1, 1, 1};
+    double faceVelocity[6][3] = {{0}};
+    uint32_t iterations = 3;
+
+    // what happened
+    cpl::Message demHello;
+    std::vector<cpl::Message> steps, integrals, velocities, stepDones;
+    bool finished = false;
+    std::string error;
+    std::thread thread;
+
+    explicit FakeFluid(const std::string& dir)
+    {
+        options.portFile = dir + "/coupling.port";
+        options.name = "particle code fdmDEM";
+        options.connectTimeout = 15;
+        options.receiveTimeout = 15;
+        std::remove(options.portFile.c_str());
+    }
+    ~FakeFluid()
+    {
+        if (thread.joinable()) thread.join();
+    }
+    void start()
+    {
+        thread = std::thread([this] {
+            try {
+                run();
+            } catch (const std::exception& e) {
+                error = e.what();
+            }
+        });
+    }
+    void join() { thread.join(); }
+
+    // Deterministic, particle- and iteration-dependent integrals (all SI).
+    static double volume(double a) { return 4.0 / 3.0 * pi * a * a * a; }
+    cpl::Message makeIntegrals(const cpl::Message& step, uint32_t k) const
+    {
+        using namespace cpl::layout;
+        cpl::Message m = cpl::makeMessage(cpl::MessageType::Integrals, step.step, k, step.count, integralsWidth);
+        for (uint32_t p = 0; p < step.count; ++p) {
+            const double a = step.at(p, sRadius);
+            m.at(p, iVu) = volume(a) * (1.0 + 0.01 * k);
+            m.at(p, iJu) = 0.4 * a * a * m.at(p, iVu);
+            for (int d = 0; d < 3; ++d) {
+                m.at(p, iFx + d) = 0.1 * (p + 1) * (d + 1) * k - 0.3 + 0.01 * double(step.step);
+                m.at(p, iTx + d) = 0.02 * (p + 2) * (3 - d) - 0.05 * k;
+            }
+        }
+        if (mode == ZeroVolume && k == 2) m.at(1, iVu) = 0.0;
+        if (mode == NaNIntegral && k == 2) m.at(2, iFy) = std::nan("");
+        return m;
+    }
+    static double hydro(uint32_t p, int c, uint64_t step) { return 10.0 * (p + 1) + c + 0.5 * double(step); }
+
+    void run()
+    {
+        std::unique_ptr<cpl::Transport> t = cpl::listen(options);
+        demHello = t->receive(cpl::MessageType::Hello);
+        cpl::Message hello = cpl::makeMessage(cpl::MessageType::Hello, 0, 0, 1, cpl::layout::helloFluidWidth,
+                                              "role=fluid version=" + std::to_string(cpl::protocolVersion));
+        hello.data = {double(nExpected), alphaLambda, rhoFluid, delta, box[0], box[1], box[2], box[3], box[4], box[5],
+                      double(periodic[0]), double(periodic[1]), double(periodic[2]), viscosity};
+        for (int f = 0; f < 6; ++f) {
+            hello.data.push_back(periodic[f / 2] ? 0.0 : double(faceKind[f]));
+            for (int d = 0; d < 3; ++d) hello.data.push_back(periodic[f / 2] ? 0.0 : faceVelocity[f][d]);
+        }
+        t->send(hello);
+        while (true) {
+            cpl::Message m = t->receive();
+            if (m.type == cpl::MessageType::Finish) {
+                finished = true;
+                return;
+            }
+            if (m.type != cpl::MessageType::Step) throw cpl::CouplerError("harness: got " + std::string(cpl::messageTypeName(m.type)));
+            steps.push_back(m);
+            if (mode == DieAfterStep) return;  // t goes out of scope: the socket closes as on a crash
+            if (mode == ErrorAfterStep) {
+                t->sendError("fdmFoam: the pressure solver diverged at step " + std::to_string(m.step));
+                return;
+            }
+            if (mode == WrongTypeAfterStep) {
+                t->send(cpl::makeMessage(cpl::MessageType::Velocities, m.step, 1, m.count, 6));
+                t->receive();  // the DEM's Error
+                return;
+            }
+            for (uint32_t k = 1; k <= iterations; ++k) {
+                integrals.push_back(makeIntegrals(m, k));
+                t->send(integrals.back());
+                velocities.push_back(t->receive(cpl::MessageType::Velocities));
+            }
+            const bool stresslets = demHello.textValue("stresslets") == "1";
+            const uint32_t width = stresslets ? cpl::layout::stepDoneStressWidth : cpl::layout::stepDoneWidth;
+            cpl::Message done = cpl::makeMessage(cpl::MessageType::StepDone, m.step, iterations, m.count, width,
+                                                 "iterations=" + std::to_string(iterations) + " residual=1.25e-07 converged=1");
+            for (uint32_t p = 0; p < m.count; ++p)
+                for (uint32_t c = 0; c < width; ++c) done.at(p, c) = hydro(p, c, m.step);
+            stepDones.push_back(done);
+            t->send(done);
+        }
+    }
+};
+
+void expectContains(const std::string& text, const std::string& needle)
+{
+    EXPECT_NE(text.find(needle), std::string::npos) << "'" << needle << "' not in:\n" << text;
+}
+
+double relativeDifference(double a, double b) { return std::fabs(a - b) / std::max(1e-300, std::max(std::fabs(a), std::fabs(b))); }
+
+}  // namespace
+
+#endif
