@@ -1,7 +1,9 @@
 // fdmResistance: prints resistance functions and blocks as JSON (docs/resistance.md, "Command line").
-//   fdmResistance pair   --a1 A --a2 B --xi X [--theory|--subgrid] [--delta D] [--cutoff K]
-//   fdmResistance matrix --x1 x y z --x2 x y z --a1 A --a2 B [--delta D] [--eta E] [--cutoff K]
-//   fdmResistance wall   --a A --eps E [--delta D] [--cutoff K]
+//   fdmResistance pair    --a1 A --a2 B --xi X [--theory [--full [--order N]]|--subgrid] [--delta D] [--cutoff K]
+//   fdmResistance matrix  --x1 x y z --x2 x y z --a1 A --a2 B [--delta D] [--eta E] [--cutoff K]
+//   fdmResistance wall    --a A --eps E [--delta D] [--cutoff K]
+//   fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]
+//   fdmResistance squeeze --a A --eps E --wall
 #include "fdm/resistance/resistance.hpp"
 
 #include <cmath>
@@ -18,10 +20,15 @@ namespace {
 
 const char* usage =
     "usage:\n"
-    "  fdmResistance pair   --a1 A --a2 B --xi X [--theory|--subgrid] [--delta D] [--cutoff K]\n"
-    "  fdmResistance matrix --x1 x y z --x2 x y z --a1 A --a2 B [--delta D] [--eta E] [--cutoff K]\n"
-    "  fdmResistance wall   --a A --eps E [--delta D] [--cutoff K]\n"
-    "xi = 2r/(a1+a2) - 2; eps = h/a - 1; --delta: mesh size (sub-grid output); --cutoff: k in xi_c = k*delta/a_mean\n";
+    "  fdmResistance pair    --a1 A --a2 B --xi X [--theory [--full [--order N]]|--subgrid] [--delta D] [--cutoff K]\n"
+    "  fdmResistance matrix  --x1 x y z --x2 x y z --a1 A --a2 B [--delta D] [--eta E] [--cutoff K]\n"
+    "  fdmResistance wall    --a A --eps E [--delta D] [--cutoff K]\n"
+    "  fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]\n"
+    "  fdmResistance squeeze --a A --eps E --wall\n"
+    "xi = 2r/(a1+a2) - 2; eps = h/a - 1; --delta: mesh size (sub-grid output); --cutoff: k in xi_c = k*delta/a_mean\n"
+    "--full: full-range X^A, Y^A, Y^B, X^C, Y^C (matched forms, every gap); --order: far-field powers kept (default 100)\n"
+    "squeeze: closing velocity under equal and opposite forces F along the line of centres, in units of F/(6 pi eta a1)\n"
+    "  (full-range theory; --near: near-field forms); --wall: sphere pushed toward a plane wall, 1/X^A_wall\n";
 
 struct Arguments {
     std::string command;
@@ -62,7 +69,7 @@ Arguments parse(int argc, char** argv)
         std::string key = argv[i];
         if (key.compare(0, 2, "--") != 0) throw std::runtime_error("unexpected argument '" + key + "'");
         key = key.substr(2);
-        if (key == "theory" || key == "subgrid") {
+        if (key == "theory" || key == "subgrid" || key == "full" || key == "near" || key == "wall") {
             a.flags[key] = true;
             continue;
         }
@@ -120,21 +127,53 @@ void printPairValues(const char* name, const PairFunctionValues& v, const PairFo
     std::printf("\n  }%s\n", last ? "" : ",");
 }
 
+const char* pairNormalisation =
+    "kim_karrila: Kim & Karrila scalars; 11 and 12 divided by eta times 6 pi a1 (A), 4 pi a1^2 (B, G), 8 pi a1^3 (C, H), "
+    "20/3 pi a1^3 (M), 6 pi a1^2 (P); 21 and 22 by the same with a2 (so that X21(lambda) = X12(1/lambda), paper Eq. A.4). "
+    "dimensional_over_eta: the dimensional function divided by the viscosity. XP: leading lubrication term only.";
+
+int fullRangeOrder(const Arguments& args)
+{
+    const double order = args.number("order", fullRangeDefaultOrder);
+    if (!(order >= 10 && order <= 250) || order != std::floor(order)) throw std::runtime_error("--order must be an integer in [10, 250]");
+    return int(order);
+}
+
+// The full-range forms are converged (< 5e-4 at order 100) for 0.1 <= lambda <= 10 (docs/resistance.md).
+void printSizeRatioWarning(double lambda, int order)
+{
+    if (lambda >= 0.1 - 1e-12 && lambda <= 10 + 1e-12) return;
+    std::printf("  \"warning\": \"size ratio outside 0.1..10: the far-field series to order %d are not converged near contact "
+                "(at lambda = 100, order 100: errors up to 5 %% in YB, more in YC12); see docs/resistance.md\",\n", order);
+}
+
 int pairCommand(const Arguments& args)
 {
     const double a1 = args.number("a1"), a2 = args.number("a2"), xi = args.number("xi");
     positive(a1, "--a1");
     positive(a2, "--a2");
-    const bool subgrid = args.flags.count("subgrid") > 0;
+    const bool subgrid = args.flags.count("subgrid") > 0, full = args.flags.count("full") > 0;
     if (subgrid && args.flags.count("theory")) throw std::runtime_error("choose one of --theory and --subgrid");
+    if (subgrid && full) throw std::runtime_error("--full belongs to --theory, not --subgrid");
+    if (args.has("order") && !full) throw std::runtime_error("--order needs --full");
+    const int order = fullRangeOrder(args);
     std::printf("{\n  \"command\": \"pair\",\n  \"a1\": %s, \"a2\": %s, \"lambda\": %s, \"xi\": %s, \"xi_used\": %s,\n",
                 number(a1).c_str(), number(a2).c_str(), number(a2 / a1).c_str(), number(xi).c_str(),
                 number(xi > minimumGap ? xi : minimumGap).c_str());
-    if (!subgrid) {
+    if (!subgrid && full) {
+        const PairFullRangeForms forms = makeFullRangeForms(a1, a2, true, order);
+        const PairFunctionValues v = fullRange(forms, xi);
+        std::printf("  \"kind\": \"theory, full range: XA, YA, YB, YC matched forms of Jeffrey & Onishi 1984 (near-field singular terms plus the far-field series to order %d with their expansion subtracted; Townsend 2023 constants), XC exact series (Jeffery 1915); XG, YG, YH, XM, YM, ZM, XP near-field forms\",\n", order);
+        std::printf("  \"full_range_functions\": [\"XA\", \"YA\", \"YB\", \"XC\", \"YC\"], \"order\": %d,\n", order);
+        printSizeRatioWarning(a2 / a1, order);
+        std::printf("  \"normalisation\": \"%s\",\n", pairNormalisation);
+        printPairValues("kim_karrila", v, &forms.nearField, true, false);
+        printPairValues("dimensional_over_eta", v, nullptr, true, true);
+    } else if (!subgrid) {
         const PairForms forms = makePairForms(a1, a2, true);
         const PairFunctionValues v = evaluate(forms, xi);
         std::printf("  \"kind\": \"theory (near-field forms of Jeffrey & Onishi 1984, Jeffrey 1992, Townsend 2023)\",\n");
-        std::printf("  \"normalisation\": \"kim_karrila: Kim & Karrila scalars; 11 and 12 divided by eta times 6 pi a1 (A), 4 pi a1^2 (B, G), 8 pi a1^3 (C, H), 20/3 pi a1^3 (M), 6 pi a1^2 (P); 21 and 22 by the same with a2 (so that X21(lambda) = X12(1/lambda), paper Eq. A.4). dimensional_over_eta: the dimensional function divided by the viscosity. XP: leading lubrication term only.\",\n");
+        std::printf("  \"normalisation\": \"%s\",\n", pairNormalisation);
         printPairValues("kim_karrila", v, &forms, true, false);
         printPairValues("dimensional_over_eta", v, nullptr, true, true);
     } else {
@@ -222,6 +261,60 @@ int wallCommand(const Arguments& args)
     return 0;
 }
 
+// Squeeze mobility.  Pair: forces +F d on sphere 1 and -F d on sphere 2 (pushing them together); the
+// axisymmetric resistance system [X11A X12A; X21A X22A] (U1, U2) = (F, -F) (dimensional, F = -R U for the
+// hydrodynamic forces, so R U balances the applied ones) gives the velocities along d, and the closing
+// velocity V = -(U2 - U1).d = U1 - U2, printed in units of F/(6 pi eta a1).  Wall: V = F/(6 pi eta a X^A_wall).
+int squeezeCommand(const Arguments& args)
+{
+    if (args.flags.count("wall")) {
+        if (args.has("a1") || args.has("a2") || args.has("xi") || args.flags.count("near") || args.has("order"))
+            throw std::runtime_error("squeeze --wall takes --a and --eps");
+        const double a = args.number("a"), eps = args.number("eps");
+        positive(a, "--a");
+        const double xa = wallNormalTranslation(eps);
+        std::printf("{\n  \"command\": \"squeeze\",\n  \"geometry\": \"wall\",\n  \"a\": %s, \"eps\": %s, \"eps_used\": %s,\n",
+                    number(a).c_str(), number(eps).c_str(), number(eps > minimumGap ? eps : minimumGap).c_str());
+        std::printf("  \"kind\": \"X^A_wall: Brenner (1961) exact series, Cox & Brenner (1967) lubrication form below eps = 1e-3\",\n");
+        std::printf("  \"normalisation\": \"sphere pushed toward the wall by a force F along the normal: approach velocity V divided by F/(6 pi eta a), i.e. 1/X^A_wall (Kim-Karrila X^A_wall = XA_kim_karrila)\",\n");
+        std::printf("  \"XA_kim_karrila\": %s,\n", number(xa).c_str());
+        std::printf("  \"closing_velocity_normalised\": %s\n}\n", number(1 / xa).c_str());
+        return 0;
+    }
+    if (args.has("a") || args.has("eps")) throw std::runtime_error("--a and --eps belong to squeeze --wall");
+    const double a1 = args.number("a1"), a2 = args.number("a2"), xi = args.number("xi");
+    positive(a1, "--a1");
+    positive(a2, "--a2");
+    const bool near = args.flags.count("near") > 0;
+    if (near && args.has("order")) throw std::runtime_error("--order belongs to the full-range forms, not --near");
+    const int order = fullRangeOrder(args);
+    const PairFunctionValues v = near ? evaluate(makePairForms(a1, a2, false), xi) : fullRange(makeFullRangeForms(a1, a2, false, order), xi);
+    const double pi = 3.14159265358979323846;
+    const double F = 6 * pi * a1;  // so that the velocities come out in units of F/(6 pi eta a1), eta = 1
+    const double A = v.f[XA][0][0], B = v.f[XA][0][1], Bt = v.f[XA][1][0], D = v.f[XA][1][1];
+    // det = A D - B Bt = A (B + D) - B (A + Bt); the column sums are the regular rigid-pair parts
+    const double det = A * D - B * Bt;
+    const double U1 = F * (D + B) / det, U2 = -F * (A + Bt) / det;
+    const double lambda = a2 / a1, l1 = 1 + lambda;
+    const double xiUsed = xi > minimumGap ? xi : minimumGap;
+    std::printf("{\n  \"command\": \"squeeze\",\n  \"geometry\": \"pair\",\n");
+    std::printf("  \"a1\": %s, \"a2\": %s, \"lambda\": %s, \"xi\": %s, \"xi_used\": %s,\n", number(a1).c_str(),
+                number(a2).c_str(), number(lambda).c_str(), number(xi).c_str(), number(xiUsed).c_str());
+    if (near)
+        std::printf("  \"kind\": \"near-field forms of X^A (Jeffrey & Onishi 1984, Townsend 2023): lubrication only, not valid far from contact\",\n");
+    else {
+        std::printf("  \"kind\": \"full-range X^A: matched forms of Jeffrey & Onishi 1984, far-field series to order %d\",\n", order);
+        printSizeRatioWarning(lambda, order);
+    }
+    std::printf("  \"normalisation\": \"forces +F d on sphere 1 and -F d on sphere 2 (d = (x2 - x1)/|x2 - x1|, pushing them together), no torques: "
+                "closing velocity V = -(U2 - U1).d and the velocities U1.d, U2.d divided by F/(6 pi eta a1); from [X11A X12A; X21A X22A] (U1, U2) = (F, -F), "
+                "dimensional. lubrication_leading_order = xi (1+lambda)^3 / (2 lambda^2), the limit of V at xi -> 0\",\n");
+    std::printf("  \"U1_normalised\": %s, \"U2_normalised\": %s,\n", number(U1).c_str(), number(U2).c_str());
+    std::printf("  \"lubrication_leading_order\": %s,\n", number(xiUsed * l1 * l1 * l1 / (2 * lambda * lambda)).c_str());
+    std::printf("  \"closing_velocity_normalised\": %s\n}\n", number(U1 - U2).c_str());
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -231,6 +324,7 @@ int main(int argc, char** argv)
         if (args.command == "pair") return pairCommand(args);
         if (args.command == "matrix") return matrixCommand(args);
         if (args.command == "wall") return wallCommand(args);
+        if (args.command == "squeeze") return squeezeCommand(args);
         if (args.command == "-h" || args.command == "--help") {
             std::fputs(usage, stdout);
             return 0;

@@ -56,6 +56,52 @@ PairFunctionValues evaluate(const PairForms& forms, double xi)
     return v;
 }
 
+PairFullRangeForms makeFullRangeForms(double a1, double a2, bool withM, int order)
+{
+    PairFullRangeForms p;
+    p.nearField = makePairForms(a1, a2, withM);  // checks the radii
+    const double lambda = a2 / a1;
+    p.k = computeFullRangeConstants(lambda, order);
+    p.kSwapped = (lambda == 1.0) ? p.k : computeFullRangeConstants(1.0 / lambda, order);
+    return p;
+}
+
+PairFunctionValues fullRange(const PairFullRangeForms& forms, double xi)
+{
+    xi = std::max(xi, minimumGap);
+    PairFunctionValues v = evaluate(forms.nearField, xi);
+    const double a1 = forms.nearField.a1, a2 = forms.nearField.a2;
+    for (int i = 0; i < NumPairFunctions; ++i) {
+        const PairFunction f = PairFunction(i);
+        if (!hasFullRangeForm(f)) continue;
+        // 11 and 12 at lambda with a1; 21 and 22 = 12 and 11 at 1/lambda with a2, Eq. (A.4)
+        const double s1 = kimKarrilaFactor(f, a1), s2 = swapSign(f) * kimKarrilaFactor(f, a2);
+        v.f[f][0][0] = s1 * fullRangeScalar(forms.k, f, false, xi);
+        v.f[f][0][1] = s1 * fullRangeScalar(forms.k, f, true, xi);
+        v.f[f][1][0] = s2 * fullRangeScalar(forms.kSwapped, f, true, xi);
+        v.f[f][1][1] = s2 * fullRangeScalar(forms.kSwapped, f, false, xi);
+    }
+    return v;
+}
+
+PairFunctionValues fullRange(const PairForms& forms, double xi)
+{
+    PairFullRangeForms p;
+    p.nearField = forms;
+    const double lambda = forms.a2 / forms.a1;
+    p.k = computeFullRangeConstants(lambda);
+    p.kSwapped = (lambda == 1.0) ? p.k : computeFullRangeConstants(1.0 / lambda);
+    return fullRange(p, xi);
+}
+
+const PairFullRangeForms& TwoSphereTheory::fullRangeForms(double a1, double a2)
+{
+    const std::pair<double, double> key(a1, a2);
+    std::map<std::pair<double, double>, PairFullRangeForms>::iterator it = fullCache_.find(key);
+    if (it == fullCache_.end()) it = fullCache_.insert(std::make_pair(key, makeFullRangeForms(a1, a2, withM_))).first;
+    return it->second;
+}
+
 const PairForms& TwoSphereTheory::forms(double a1, double a2)
 {
     if (last_ && last_->a1 == a1 && last_->a2 == a2) return *last_;

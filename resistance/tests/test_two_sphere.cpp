@@ -258,3 +258,250 @@ TEST(TwoSphereTheory, NearFieldFormsAgainstMidFieldTable)
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Full-range forms (two_sphere.hpp fullRange, docs/resistance.md "Full-range forms").
+
+namespace {
+
+const PairFunction fullRangeFamilies[] = {XA, YA, YB, XC, YC};
+
+// Gap over the smaller radius, h / min(a1, a2), for a1 = 1, a2 = lambda: the scale of the O(xi) terms
+// that the near-field asymptotic forms leave out.
+double gapOverSmallerRadius(double lambda, double xi) { return 0.5 * (1 + lambda) * xi / std::min(1.0, lambda); }
+
+// Bound against Townsend's table: 1e-3 (relative, absolute below 1) where the table is exact (Lamb's
+// method, s' >= 2.025); at s' <= 2.02 the table holds the near-field asymptotic forms, which omit O(xi)
+// terms: there the bound is max(1e-3, h/min(a1, a2)).
+double tableBound(double lambda, double sDash)
+{
+    return sDash > 2.02 + 1e-12 ? 1e-3 : std::max(1e-3, gapOverSmallerRadius(lambda, sDash - 2));
+}
+
+}  // namespace
+
+// Every tabulated s' (2.00001 .. 4.5) for lambda = 0.1, 1, 10: X^A, Y^A, Y^B, X^C, Y^C, 11 and 12.
+TEST(TwoSphereTheory, FullRangeMatchesTownsendTable)
+{
+    const std::vector<std::vector<double> > rows =
+        reference::readTable("two_sphere_townsend/scalars_general_resistance.txt", 2);
+    const double lambdas[] = {0.1, 1, 10};
+    int compared = 0;
+    for (int l = 0; l < 3; ++l) {
+        const FullRangeConstants k = computeFullRangeConstants(lambdas[l]);
+        double worstLamb[NumPairFunctions] = {0}, worstNear[NumPairFunctions] = {0}, worstNearScaled[NumPairFunctions] = {0};
+        int nearAbove = 0;
+        for (std::size_t r = 0; r < rows.size(); ++r) {
+            const std::vector<double>& row = rows[r];
+            if (std::fabs(row[1] - lambdas[l]) > 1e-12) continue;
+            const double sDash = row[0], xi = sDash - 2;
+            const bool twelve = int(row[2]) == 1;
+            for (int i = 0; i < 5; ++i) {
+                const PairFunction f = fullRangeFamilies[i];
+                const double mine = fullRangeScalar(k, f, twelve, xi), ref = row[3 + f];
+                const double error = std::fabs(mine - ref) / std::max(std::fabs(ref), 1.0);
+                EXPECT_LT(error, tableBound(lambdas[l], sDash)) << pairFunctionName(f) << (twelve ? "12" : "11") << " lambda "
+                                                                << lambdas[l] << " s' " << sDash << ": " << mine << " vs " << ref;
+                if (sDash > 2.02 + 1e-12)
+                    worstLamb[f] = std::max(worstLamb[f], error);
+                else {
+                    worstNear[f] = std::max(worstNear[f], error);
+                    worstNearScaled[f] = std::max(worstNearScaled[f], error / gapOverSmallerRadius(lambdas[l], xi));
+                    if (error > 1e-3) ++nearAbove;
+                }
+                ++compared;
+            }
+        }
+        std::printf("[worst] full range vs Townsend, lambda %g, s' >= 2.025 (Lamb):", lambdas[l]);
+        for (int i = 0; i < 5; ++i) std::printf(" %s %.1e", pairFunctionName(fullRangeFamilies[i]), worstLamb[fullRangeFamilies[i]]);
+        std::printf("\n[worst] full range vs Townsend, lambda %g, s' <= 2.02 (asymptotic forms):", lambdas[l]);
+        for (int i = 0; i < 5; ++i)
+            std::printf(" %s %.1e (%.2f h/a_min)", pairFunctionName(fullRangeFamilies[i]), worstNear[fullRangeFamilies[i]],
+                        worstNearScaled[fullRangeFamilies[i]]);
+        std::printf("; %d of 110 above 1e-3\n", nearAbove);
+    }
+    EXPECT_EQ(compared, 3 * 38 * 2 * 5);
+}
+
+// Eq. (A.4) through the pair machinery: the 21 and 22 functions of (1, 10) are Townsend's 12 and 11 at
+// lambda = 0.1 (in a2 units, minus sign for Y^B), and those of (1, 0.1) his lambda = 10 rows.
+TEST(TwoSphereTheory, FullRangeSwappedFunctionsMatchTownsendAtInverseLambda)
+{
+    const std::vector<std::vector<double> > rows =
+        reference::readTable("two_sphere_townsend/scalars_general_resistance.txt", 2);
+    const double radii[][2] = {{1, 10}, {1, 0.1}};
+    int compared = 0;
+    double worstLamb = 0;
+    for (int c = 0; c < 2; ++c) {
+        const double a1 = radii[c][0], a2 = radii[c][1], inverse = a1 / a2;
+        const PairFullRangeForms forms = makeFullRangeForms(a1, a2);
+        for (std::size_t r = 0; r < rows.size(); ++r) {
+            const std::vector<double>& row = rows[r];
+            if (std::fabs(row[1] - inverse) > 1e-12) continue;
+            const double xi = row[0] - 2;
+            const int gamma = int(row[2]);
+            const PairFunctionValues v = fullRange(forms, xi);
+            for (int i = 0; i < 5; ++i) {
+                const PairFunction f = fullRangeFamilies[i];
+                const double sign = (f == YB) ? -1 : 1;
+                const double mine = sign * v.f[f][1][gamma == 0 ? 1 : 0] / kimKarrilaFactor(f, a2);
+                const double error = std::fabs(mine - row[3 + f]) / std::max(std::fabs(row[3 + f]), 1.0);
+                EXPECT_LT(error, tableBound(inverse, row[0])) << pairFunctionName(f) << " gamma " << gamma << " a2 " << a2 << " xi " << xi;
+                if (row[0] > 2.02 + 1e-12) worstLamb = std::max(worstLamb, error);
+                ++compared;
+            }
+        }
+    }
+    EXPECT_EQ(compared, 2 * 38 * 2 * 5);
+    std::printf("[worst] full range 21, 22 vs Townsend at 1/lambda, s' >= 2.025: %.1e\n", worstLamb);
+}
+
+// Eq. (A.3): the dimensional 12 and 21 functions come from different series (lambda and 1/lambda) and
+// must agree; Eq. (A.4): swapping the spheres swaps 11 <-> 22 and 12 <-> 21 (minus sign for Y^B).
+TEST(TwoSphereTheory, FullRangeReciprocityAndSizeRatioInversion)
+{
+    const double radii[][2] = {{1, 1.4}, {1.4, 1}, {1, 0.1}, {0.5, 2}, {1, 7.3}};
+    const PairFunction symmetric[] = {XA, YA, XC, YC};
+    double worst = 0;
+    for (int c = 0; c < 5; ++c) {
+        const double a1 = radii[c][0], a2 = radii[c][1];
+        const PairFullRangeForms p = makeFullRangeForms(a1, a2), q = makeFullRangeForms(a2, a1);
+        for (double xi = 1e-5; xi < 20; xi *= 3) {
+            const PairFunctionValues v = fullRange(p, xi), w = fullRange(q, xi);
+            for (int i = 0; i < 4; ++i) {
+                const PairFunction f = symmetric[i];
+                const double v12 = v.f[f][0][1], v21 = v.f[f][1][0];
+                const double scale = std::max(std::fabs(v12), 1e-3 * kimKarrilaFactor(f, std::min(a1, a2)));
+                worst = std::max(worst, std::fabs(v12 - v21) / scale);
+                EXPECT_NEAR(v12, v21, 1e-10 * scale) << pairFunctionName(f) << " a1 " << a1 << " a2 " << a2 << " xi " << xi;
+            }
+            for (int i = 0; i < 5; ++i) {
+                const PairFunction f = fullRangeFamilies[i];
+                const double sign = (f == YB) ? -1 : 1;
+                for (int a = 0; a < 2; ++a)
+                    for (int b = 0; b < 2; ++b)
+                        EXPECT_NEAR(v.f[f][a][b], sign * w.f[f][1 - a][1 - b], 1e-12 * std::max(1.0, std::fabs(v.f[f][a][b])))
+                            << pairFunctionName(f) << a << b << " xi " << xi;
+            }
+        }
+    }
+    std::printf("[worst] full range reciprocity |f12 - f21| (A.3): %.1e relative\n", worst);
+}
+
+// The two limits of the matched forms.  Near contact: the full-range form minus the near-field form is
+// the O(xi) part the latter omits (plus the truncation of the sums, the same at order 100 as in the
+// near-field constants).  Far away (s' >= 10): the subtracted singular functions S1-S3 cancel exactly and
+// what remains is the plain far-field series (J&O (3.13)-(3.14) and analogues), summed here from
+// farFieldCoefficient.  The other families are untouched (near-field forms).
+TEST(TwoSphereTheory, FullRangeTendsToNearFieldAndFarFieldForms)
+{
+    const double lambdas[] = {1, 1.4, 1 / 1.4, 0.1, 10};
+    double worstNear = 0, worstFar = 0;
+    for (int l = 0; l < 5; ++l) {
+        const double lambda = lambdas[l];
+        const FullRangeConstants k = computeFullRangeConstants(lambda);
+        const NearFieldConstants n = computeNearFieldConstants(lambda, false);
+        for (double xi = 1e-5; xi <= 1e-3; xi *= 10)
+            for (int i = 0; i < 5; ++i)
+                for (int g = 0; g < 2; ++g) {
+                    const PairFunction f = fullRangeFamilies[i];
+                    const double full = fullRangeScalar(k, f, g == 1, xi), near = g ? n.f12[f](xi) : n.f11[f](xi);
+                    const double error = std::fabs(full - near) / std::max(std::fabs(near), 1.0);
+                    worstNear = std::max(worstNear, error);
+                    EXPECT_LT(error, 1e-5 + 2 * gapOverSmallerRadius(lambda, xi)) << pairFunctionName(f) << g << " lambda " << lambda << " xi " << xi;
+                }
+        // far field: X11A = sum_even a_m t^m, X12A = -sum_odd, Y^A likewise, Y11B = sum_odd, Y12B = -sum_even,
+        // Y11C = sum_even, Y12C = +sum_odd, a_m = f_m / (2 (1 + lambda))^m, t = 2/s'
+        const PairFunction series[] = {XA, YA, YB, YC};
+        const bool oddFor11[] = {false, false, true, false};
+        const double signFor12[] = {-1, -1, -1, 1};
+        for (double sDash = 10; sDash < 1000; sDash *= 3) {
+            const double t = 2 / sDash;
+            for (int i = 0; i < 4; ++i) {
+                double even = 0, odd = 0;
+                for (int m = 0; m <= 60; ++m) {
+                    const double term = farFieldCoefficient(series[i], m, lambda) / std::pow(2 * (1 + lambda), m) * std::pow(t, m);
+                    (m % 2 ? odd : even) += term;
+                }
+                const double ref11 = oddFor11[i] ? odd : even, ref12 = signFor12[i] * (oddFor11[i] ? even : odd);
+                const double v11 = fullRangeScalar(k, series[i], false, sDash - 2), v12 = fullRangeScalar(k, series[i], true, sDash - 2);
+                worstFar = std::max(worstFar, std::max(std::fabs(v11 - ref11), std::fabs(v12 - ref12)));
+                EXPECT_NEAR(v11, ref11, 1e-12) << pairFunctionName(series[i]) << "11 lambda " << lambda << " s' " << sDash;
+                EXPECT_NEAR(v12, ref12, 1e-12) << pairFunctionName(series[i]) << "12 lambda " << lambda << " s' " << sDash;
+            }
+        }
+    }
+    // the families without a full-range form keep the near-field values
+    const PairFullRangeForms p = makeFullRangeForms(1, 1.4);
+    for (double xi = 1e-4; xi < 5; xi *= 10) {
+        const PairFunctionValues v = fullRange(p, xi), w = evaluate(p.nearField, xi);
+        for (int f = 0; f < NumPairFunctions; ++f)
+            if (!hasFullRangeForm(PairFunction(f)))
+                for (int a = 0; a < 2; ++a)
+                    for (int b = 0; b < 2; ++b) EXPECT_EQ(v.f[f][a][b], w.f[f][a][b]) << pairFunctionName(PairFunction(f));
+    }
+    std::printf("[worst] full range vs near-field forms (xi <= 1e-3): %.1e; vs plain far-field series (s' >= 10): %.1e absolute\n",
+                worstNear, worstFar);
+}
+
+// X^C: the exact series (Jeffery 1915) against two limits of its own: the closed-form contact values of
+// J&O (6.9)-(6.10) (zeta functions), and a small sphere near a very large one, which is the sphere-wall
+// rotation of wallNormalRotation (Jeffery's wall series, gap over the small radius eps = (1+lambda) xi/2).
+TEST(TwoSphereTheory, ExactRotationAboutLineOfCentresLimits)
+{
+    const double lambdas[] = {0.1, 1, 1.4, 10};
+    for (int l = 0; l < 4; ++l) {
+        const NearFieldConstants n = computeNearFieldConstants(lambdas[l], false);
+        double x11, x12;
+        exactRotationAboutLineOfCentres(lambdas[l], 1e-9, x11, x12);
+        EXPECT_NEAR(x11, n.f11[XC].c0, 1e-6 * n.f11[XC].c0) << lambdas[l];
+        EXPECT_NEAR(x12, n.f12[XC].c0, 1e-6 * std::fabs(n.f12[XC].c0)) << lambdas[l];
+    }
+    const double big = 1e7;
+    for (double eps = 1e-3; eps < 10; eps *= 4) {
+        double x11, x12;
+        exactRotationAboutLineOfCentres(big, 2 * eps / (1 + big), x11, x12);
+        EXPECT_NEAR(x11, wallNormalRotation(eps), 1e-5 * wallNormalRotation(eps)) << "eps " << eps;
+    }
+}
+
+// Truncation of the far-field sums: order 100 (default) against 150, over the whole range of gaps.
+TEST(TwoSphereTheory, FullRangeConvergedInOrder)
+{
+    const double lambdas[] = {1, 1.4, 0.1, 10};
+    double worst[4] = {0};
+    for (int l = 0; l < 4; ++l) {
+        const FullRangeConstants k100 = computeFullRangeConstants(lambdas[l], 100);
+        const FullRangeConstants k150 = computeFullRangeConstants(lambdas[l], 150);
+        for (double xi = 1e-5; xi < 10; xi *= 1.5)
+            for (int i = 0; i < 5; ++i)
+                for (int g = 0; g < 2; ++g) {
+                    const PairFunction f = fullRangeFamilies[i];
+                    const double a = fullRangeScalar(k100, f, g == 1, xi), b = fullRangeScalar(k150, f, g == 1, xi);
+                    worst[l] = std::max(worst[l], std::fabs(a - b) / std::max(std::fabs(b), 1.0));
+                }
+        EXPECT_LT(worst[l], 5e-4) << "lambda " << lambdas[l];
+        std::printf("[convergence] full range, lambda %g: |order 100 - order 150| <= %.1e\n", lambdas[l], worst[l]);
+    }
+}
+
+// The three entry points give the same values: fullRange(PairFullRangeForms), the convenience
+// fullRange(PairForms) and the cached TwoSphereTheory::fullValues; values() keeps the near-field forms.
+TEST(TwoSphereTheory, FullRangeEntryPointsAgree)
+{
+    TwoSphereTheory theory;
+    const PairFullRangeForms p = makeFullRangeForms(1, 1.4);
+    const PairForms near = makePairForms(1, 1.4);
+    for (double xi = 1e-6; xi < 10; xi *= 7) {
+        const PairFunctionValues a = fullRange(p, xi), b = fullRange(near, xi), c = theory.fullValues(1, 1.4, xi);
+        const PairFunctionValues d = theory.values(1, 1.4, xi), e = evaluate(near, xi);
+        for (int f = 0; f < NumPairFunctions; ++f)
+            for (int i = 0; i < 2; ++i)
+                for (int j = 0; j < 2; ++j) {
+                    EXPECT_EQ(a.f[f][i][j], b.f[f][i][j]);
+                    EXPECT_EQ(a.f[f][i][j], c.f[f][i][j]);
+                    EXPECT_EQ(d.f[f][i][j], e.f[f][i][j]);
+                }
+    }
+    EXPECT_EQ(theory.cachedPairs(), 1u);
+}

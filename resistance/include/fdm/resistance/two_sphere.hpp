@@ -36,6 +36,25 @@ struct PairFunctionValues {
 PairForms makePairForms(double a1, double a2, bool withM = false);
 PairFunctionValues evaluate(const PairForms& forms, double xi);  // xi floored at minimumGap
 
+// Full-range theory (docs/resistance.md, "Full-range forms"): X^A, Y^A, Y^B, Y^C from the matched forms
+// of J&O (near-field singular terms plus the far-field series with their own expansion subtracted),
+// X^C from its exact series (Jeffery 1915), valid at every gap; the other families (X^G, Y^G, Y^H, M, P)
+// are the near-field forms, as in evaluate().  The near-field forms themselves (evaluate, makePairForms,
+// the sub-grid model) are unchanged.  Same layout and units as evaluate(): [family][alpha][beta],
+// dimensional / viscosity; 21 and 22 from the 1/lambda constants by Eq. (A.4).
+struct PairFullRangeForms {
+    PairForms nearField;                // every family; the values of the families without a full-range form
+    FullRangeConstants k, kSwapped;     // lambda = a2/a1 (11, 12) and 1/lambda (22, 21)
+};
+// order: far-field powers kept (fullRangeDefaultOrder = 100, T23's truncation; converged to < 5e-4 for
+// 0.1 <= lambda <= 10, see the documentation before using more extreme size ratios).
+PairFullRangeForms makeFullRangeForms(double a1, double a2, bool withM = false, int order = fullRangeDefaultOrder);
+PairFunctionValues fullRange(const PairFullRangeForms& forms, double xi);  // xi floored at minimumGap
+// Convenience: builds the full-range constants of (forms.a1, forms.a2) at every call (~0.1 ms, plus
+// ~0.1 s once per process); the M values follow forms.hasMFunctions.  Prefer the cached
+// TwoSphereTheory::fullValues in loops.
+PairFunctionValues fullRange(const PairForms& forms, double xi);
+
 // Caches the forms per distinct radius pair: the O(1) constants cost ~0.1 ms per new lambda (series
 // sums) and nothing afterwards.  Not thread-safe: use one instance per thread.
 class TwoSphereTheory {
@@ -43,12 +62,16 @@ public:
     explicit TwoSphereTheory(bool withM = false) : withM_(withM) {}
     const PairForms& forms(double a1, double a2);
     PairFunctionValues values(double a1, double a2, double xi) { return evaluate(forms(a1, a2), xi); }
+    // Full-range values (fullRange above), with their own cache; values() is not affected.
+    const PairFullRangeForms& fullRangeForms(double a1, double a2);
+    PairFunctionValues fullValues(double a1, double a2, double xi) { return fullRange(fullRangeForms(a1, a2), xi); }
     std::size_t cachedPairs() const { return cache_.size(); }
 
 private:
     bool withM_;
     std::map<std::pair<double, double>, PairForms> cache_;
     const PairForms* last_ = nullptr;
+    std::map<std::pair<double, double>, PairFullRangeForms> fullCache_;
 };
 
 }  // namespace resistance
