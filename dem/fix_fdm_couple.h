@@ -3,7 +3,7 @@
    Syntax (docs/dem.md):
      fix ID all fdm/couple [transport socket|file] [host H] [port P] [portfile F] [directory D]
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
-                           [stresslets yes|no] [solver cg|ldlt] [tolerance t]
+                           [stresslets yes|no] [solver cg|ldlt] [tolerance t] [integrator ab2|euler]
      fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
@@ -95,6 +95,9 @@ class FixFdmCouple : public Fix {
   fdm::coupler::Options options_;
   double gravity_[3];
   bool move_;
+  bool adamsBashforth_;      // position update: Adams-Bashforth 2 (default) or Euler
+  bool haveVelocities_;
+  std::vector<double> currentVelocity_, previousVelocity_;  // 6N by tag, U_n and U_{n-1}
   double noFluidViscosity_, noFluidMesh_, noFluidDensity_;  // transport none (DEM only)
   bool stresslets_;          // per-particle stresslets asked for (fluid, sub-grid, contact)
   bool directSolver_;        // Eq. (31) by sparse LDLT instead of conjugate gradients

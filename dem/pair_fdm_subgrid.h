@@ -3,7 +3,7 @@
    walls) and the frictional contact of section 6 (roughness height h_r, Coulomb friction mu_s).
 
    Syntax (docs/dem.md):
-     pair_style fdm/subgrid [lubrication yes|no] [cutoff k] [contact kn kt mu_s h_r]
+     pair_style fdm/subgrid [lubrication yes|no] [cutoff k] [wall_cutoff k] [contact kn kt mu_s h_r]
                             [wall FACE ux uy uz] ...
      pair_coeff * *
 
@@ -81,15 +81,15 @@ class PairFdmSubgrid : public Pair {
 
   // settings
   bool lubrication_;
-  double cutoffCells_;
+  double cutoffCells_, wallCutoffCells_;
   double kn_, kt_, mu_, hr_;
   std::vector<Wall> walls_;
 
   // from the fluid solver (via fix fdm/couple) at the handshake
   double viscosity_, meshSize_;
-  std::unique_ptr<fdm::resistance::SubgridModel> model_;
+  std::unique_ptr<fdm::resistance::SubgridModel> model_, wallModel_;  // pairs, walls
 
-  double rangeGap_;            // largest surface gap with any interaction (contact or lubrication)
+  double rangeGap_;            // largest surface gap with any pair interaction (contact or lubrication)
   double rmin_, rmax_, distanceFactor_;
   class FixContactHistory *history_;
   class FixPropertyAtom *wallHistory_;

@@ -12,8 +12,8 @@ namespace res = fdm::resistance;
 
 namespace {
 
-// pair_style fdm/subgrid's default cut-off gap, in mesh cells (docs/dem.md)
-const double defaultCutoffCells = 0.5;
+// pair_style fdm/subgrid's default cut-off gaps, in mesh cells (docs/dem.md)
+const double defaultCutoffCells = 0.65, defaultWallCutoffCells = 0.75;
 
 // Two close unequal spheres (a2/a1 = 1.4, xi = 0.02 along a slanted line) and a third far away.
 Scene pairScene(double xi = 0.02)
@@ -242,7 +242,7 @@ TEST(PairFdmSubgrid, MovingWallBlockEntersEq31)
     expectContains(run.output, "0 sub-grid pair blocks, 1 wall blocks");
 
     Expected e = subgridMatrix(scene, fluid);
-    res::CutoffSubgridModel model(fluid.delta, defaultCutoffCells);
+    res::CutoffSubgridModel model(fluid.delta, defaultWallCutoffCells);
     const double x[3] = {3.0, 0.55, 4.0}, point[3] = {0, 0, 0}, normal[3] = {0, -1, 0}, wallU[3] = {0.3, 0, 0.1};
     res::WallBlock b;
     ASSERT_TRUE(res::subgridWallBlock(model, x, 0.5, point, normal, fluid.viscosity, b));

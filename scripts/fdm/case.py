@@ -256,6 +256,7 @@ units           si
 read_data       %(data)s
 pair_style      %(pair)s
 %(coeff)sneighbor        %(skin).17g bin
+neigh_modify    delay 0 every 1 check yes
 timestep        %(dt).17g
 %(before)s
 fix             couple all fdm/couple portfile ../fluid/coupling.port %(fix)s

@@ -1,0 +1,197 @@
+#!/usr/bin/env python3
+"""A pair of free spheres in simple shear flow between two moving walls (paper section 5.3, Fig. 14).
+
+Walls y = 0 and y = H move at -U and +U along x (shear rate 2U/H = 1); x and z are periodic. Sphere
+1 (a1 = 1) starts at x = Lx/2 + 3, sphere 2 (a2 = lambda a1) at x = Lx/2 - 3 (+-2.5 in a box
+shorter than 15 a1), both in the plane z = Lz/2, at y = H/2 -/+ r_y0/2: the relative position
+r = x2 - x1 starts at (-6, r_y0) (or (-4.5, r_y0)) and the
+shear brings sphere 2 over sphere 1. Without contact the relative trajectory is fore-aft symmetric
+(Stokes flow is reversible): the final cross-stream offset equals the initial one. With contact
+(roughness h_r, friction mu_s) it is not: the spheres touch for -1.39 <~ r_x/a1 <~ 0 in the paper
+(a2/a1 = 1.4, h_r = 5e-3 a1, mu_s = 0.5) and leave on a higher streamline.
+
+  pairShear.py                 lambda = 1 without contact, r_y0 = 0.5 (CI size: a1/Delta = 3, 12 x 8 x 6)
+  pairShear.py --contact       lambda = 1.4, h_r = 5e-3 a1, mu_s = 0.5
+  pairShear.py --full          both, a1/Delta = 5, 20 x 12 x 8, several impact parameters
+  pairShear.py --help          every option
+Writes results.json and results_pairShear.png here (docs/cases.md).
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
+from fdm import case, output  # noqa: E402
+
+
+def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0, size=(12.0, 8.0, 6.0), dt=0.05,
+                   tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True):
+    """One coupled run from r_x = -r_x_end to +r_x_end (r_x_end = 6, the paper's, or less in a box
+    shorter than 14 a1: the minimum image in the periodic x must stay unambiguous); returns the
+    relative trajectory and the gaps."""
+    a1, a2 = 1.0, ratio
+    delta = a1 / a_over_delta
+    Lx, H, Lz = size
+    shear = 1.0
+    U = shear * H / 2
+    eta = 1.0
+    name = "lambda%g_ry%g_ad%g_%s%s" % (ratio, r_y0, a_over_delta, "contact" if contact else "smooth",
+                                        "" if lubrication else "_nolub")
+    run_dir = os.path.join(workdir, name)
+    if os.path.isdir(run_dir):
+        shutil.rmtree(run_dir)
+    box = case.Box((0, 0, 0), (Lx, H, Lz), delta, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
+    zc = Lz / 2 + 0.25 * delta
+    r_x_end = min(6.0, Lx / 2 - 1.5)
+    p1 = (Lx / 2 + r_x_end / 2, H / 2 - r_y0 / 2, zc)
+    p2 = (Lx / 2 - r_x_end / 2, H / 2 + r_y0 / 2, zc)
+    # the relative x-velocity is about shear * r_y: enough steps to go from -r_x_end to r_x_end, with margin
+    steps = min(max_steps, int(math.ceil(2 * r_x_end / (shear * max(r_y0, 0.3)) / dt * 1.6)))
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
+                          first_step=(tol_lambda / 10, 3000), n_particles=2, tol_u=1e-5, tol_p=1e-4)
+    pair = "fdm/subgrid%s wall ylo %r 0 0 wall yhi %r 0 0" % ("" if cutoff is None else " cutoff %g" % cutoff, -U, U)
+    if not lubrication:
+        pair += " lubrication no"
+    if contact:
+        kn, kt, mu, hr = contact
+        pair += " contact %r %r %r %r" % (kn, kt, mu, hr)
+    # runs of 5 steps until sphere 2 has passed r_x_end (x2 - x1, minimum image in the periodic x;
+    # 5 steps move r_x by much less than the 1.5 a1 left before the minimum image flips)
+    rx = "variable        rx equal x[2]-x[1]-%(L)r*round((x[2]-x[1])/%(L)r)" % dict(L=Lx)
+    loop = ["thermo_style    custom step v_rx f_couple[1] f_couple[5] f_couple[6] f_couple[8]",
+            "thermo          20",
+            "variable        chunk loop %d" % int(math.ceil(steps / 5.0)),
+            "label           advance",
+            "run             5",
+            'if              "${rx} > %r" then "jump SELF finished"' % r_x_end,
+            "next            chunk",
+            "jump            SELF advance",
+            "label           finished"]
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=dt, pair_style=pair,
+                         fix_options="", before_run=rx, runs=loop, name="in.pairShear")
+    wall = case.run(run_dir, np_fluid=np_fluid)
+    parts = output.particles(os.path.join(run_dir, "fluid"))
+    steps_data = output.steps(os.path.join(run_dir, "fluid"))
+    one, two = parts["tag"] == 1, parts["tag"] == 2
+    rel = np.stack([parts[c][two] - parts[c][one] for c in ("x", "y", "z")], axis=1)
+    rel[:, 0] -= Lx * np.round(rel[:, 0] / Lx)
+    r = np.linalg.norm(rel, axis=1)
+    xi = 2 * r / (a1 + a2) - 2
+    gap = r - a1 - a2
+    if not keep:
+        shutil.rmtree(os.path.join(run_dir, "fluid", "constant", "polyMesh"), ignore_errors=True)
+        for d in os.listdir(os.path.join(run_dir, "fluid")):
+            if d.replace(".", "").isdigit() and d != "0":
+                shutil.rmtree(os.path.join(run_dir, "fluid", d), ignore_errors=True)
+    return dict(ratio=ratio, r_y0=r_y0, contact=contact, dt=dt, a_over_delta=a_over_delta, size=list(size),
+                cells=box.n[0] * box.n[1] * box.n[2], steps=int(len(r)), wall_seconds=wall,
+                inner_iterations_mean=float(steps_data["innerIterations"].mean()),
+                r_x=rel[:, 0].tolist(), r_y=rel[:, 1].tolist(), r_z=rel[:, 2].tolist(), xi=xi.tolist(),
+                gap_over_a1=(gap / a1).tolist())
+
+
+def summarise(t, h_r=None):
+    """The figures of one trajectory: initial and final offsets at |r_x| = the same distance,
+    minimum gap, the contact window."""
+    rx, ry, gap = np.array(t["r_x"]), np.array(t["r_y"]), np.array(t["gap_over_a1"])
+    start = abs(rx[0])
+    end = rx >= start
+    s = dict(r_x_start=float(rx[0]), r_y_start=float(ry[0]), min_gap_over_a1=float(gap.min()),
+             min_xi=float(min(t["xi"])), r_x_at_min_gap=float(rx[np.argmin(gap)]))
+    if end.any():
+        k = int(np.argmax(end))
+        # interpolate r_y at r_x = +start
+        f = (start - rx[k - 1]) / (rx[k] - rx[k - 1])
+        ry_end = ry[k - 1] + f * (ry[k] - ry[k - 1])
+        s.update(r_y_end=float(ry_end), fore_aft_asymmetry=float((ry_end - ry[0]) / ry[0]))
+    if h_r:
+        touching = gap < h_r
+        if touching.any():
+            idx = np.where(touching)[0]
+            s.update(contact_r_x_from=float(rx[idx[0]]), contact_r_x_to=float(rx[idx[-1]]))
+        else:
+            s.update(contact_r_x_from=None, contact_r_x_to=None)
+    return s
+
+
+def plot(results, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for i, t in enumerate(results["trajectories"]):
+        label = "a2/a1 = %g, r_y0 = %g%s" % (t["ratio"], t["r_y0"], ", contact" if t["contact"] else "")
+        axes[0].plot(t["r_x"], t["r_y"], "-", color="C%d" % i, label=label)
+        axes[1].semilogy(t["r_x"], np.maximum(t["gap_over_a1"], 1e-7), "-", color="C%d" % i, label=label)
+    axes[0].set_xlabel(r"$r_x/a_1$")
+    axes[0].set_ylabel(r"$r_y/a_1$")
+    axes[0].legend(fontsize=7)
+    axes[1].set_xlabel(r"$r_x/a_1$")
+    axes[1].set_ylabel(r"surface gap $/a_1$")
+    fig.suptitle("Sphere pair in simple shear flow (paper Fig. 14)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--full", action="store_true")
+    p.add_argument("--contact", action="store_true", help="the paper's contact case instead of the smooth one")
+    p.add_argument("--r-y0", type=float, nargs="+", default=None, help="initial cross-stream offsets / a1")
+    p.add_argument("--a-over-delta", type=float, default=3.0)
+    p.add_argument("--size", type=float, nargs=3, default=[12.0, 8.0, 6.0], help="Lx H Lz in units of a1")
+    p.add_argument("--dt", type=float, default=0.05, help="time step in units of 1/shear rate")
+    p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
+    p.add_argument("--tol-lambda", type=float, default=1e-3)
+    p.add_argument("--np-fluid", type=int, default=1)
+    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
+    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
+    p.add_argument("--keep", action="store_true")
+    args = p.parse_args(argv)
+
+    a1 = 1.0
+    h_r = 5e-3 * a1
+    # contact springs: stiff enough that the overlap F/kn stays well below h_r, soft enough for the
+    # explicit step (docs/contact.md)
+    contact = (1e3, 1e3, 0.5, h_r)
+    jobs = []
+    if args.full:
+        args.a_over_delta, args.size = 5.0, [20.0, 12.0, 8.0]
+        for ry in (args.r_y0 or [0.25, 0.5, 1.0]):
+            jobs.append((1.0, ry, None))
+        jobs.append((1.4, 0.93, contact))
+    elif args.contact:
+        jobs.append((1.4, (args.r_y0 or [0.93])[0], contact))
+    else:
+        for ry in (args.r_y0 or [0.5]):
+            jobs.append((1.0, ry, None))
+
+    os.makedirs(args.workdir, exist_ok=True)
+    t0 = time.time()
+    results = dict(case="pairShear", trajectories=[], summaries=[])
+    for ratio, ry, cont in jobs:
+        t = run_trajectory(args.workdir, ratio, ry, cont, args.a_over_delta, tuple(args.size), args.dt,
+                           tol_lambda=args.tol_lambda, cutoff=args.cutoff, np_fluid=args.np_fluid, keep=args.keep)
+        s = summarise(t, cont[3] / a1 if cont else None)
+        s.update(ratio=ratio, r_y0=ry, contact=bool(cont), wall_seconds=t["wall_seconds"], steps=t["steps"])
+        results["trajectories"].append(t)
+        results["summaries"].append(s)
+        print(json.dumps(s))
+    results["wall_seconds"] = time.time() - t0
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=1)
+    plot(results, os.path.join(os.path.dirname(args.out), "results_pairShear.png"))
+    print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))
+    return results
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,157 @@
+#!/usr/bin/env python3
+"""Two spheres pushed together along their line of centres (squeeze flow), with and without the
+sub-grid lubrication correction (paper section 3, Eq. 21 with Appendix C.2).
+
+Spheres of radii a1 = 1 and a2 = lambda*a1 in a periodic cube, held at a reduced gap
+xi = 2r/(a1 + a2) - 2 (fix fdm/couple move no), with equal and opposite forces F = 6 pi eta a1 along
+the line of centres. The closing velocity V = (U1 - U2).d, in units of F/(6 pi eta a1), is compared
+with the two-sphere theory (Jeffrey & Onishi 1984, full range: fdmResistance squeeze). Every gap is
+one coupled time step of one run (warm-started from the previous gap), once with pair_style
+fdm/subgrid and once with its lubrication switched off.
+
+  pairSqueeze.py               lambda = 1 and 1.4, xi = 1e-4 ... 1, a1/Delta = 4, L = 8 a1 (minutes)
+  pairSqueeze.py --full        a1/Delta = 5, L = 12 a1
+  pairSqueeze.py --help        every option
+Writes results.json and results_pairSqueeze.png here (docs/cases.md).
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
+from fdm import case, output, theory  # noqa: E402
+
+XI_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
+
+
+def run_pair(workdir, ratio, xis, subgrid, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-5, cutoff=None,
+             np_fluid=1, keep=False):
+    """One coupled run visiting every gap; returns the closing velocities (units F/(6 pi eta a1))."""
+    a1, a2 = 1.0, ratio
+    delta = a1 / a_over_delta
+    L = L_over_a * a1
+    eta = 1.0
+    F = 6 * math.pi * eta * a1
+    name = "lambda%g_ad%g_L%g_%s" % (ratio, a_over_delta, L_over_a, "subgrid" if subgrid else "nosubgrid")
+    run_dir = os.path.join(workdir, name)
+    if os.path.isdir(run_dir):
+        shutil.rmtree(run_dir)
+    box = case.Box((0, 0, 0), (L, L, L), delta)
+    centre = [L / 2 + 0.1 * delta, L / 2 + 0.2 * delta, L / 2 + 0.3 * delta]  # off the mesh's symmetry planes
+
+    def positions(xi):
+        gap = xi * (a1 + a2) / 2
+        return ((centre[0] - gap / 2 - a1, centre[1], centre[2]), (centre[0] + gap / 2 + a2, centre[1], centre[2]))
+
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+                          n_particles=2)
+    runs = []
+    for k, xi in enumerate(xis):
+        p1, p2 = positions(xi)
+        if k > 0:
+            runs.append("set             atom 1 x %r y %r z %r" % p1)
+            runs.append("set             atom 2 x %r y %r z %r" % p2)
+        runs.append("run             1")
+    p1, p2 = positions(xis[0])
+    pair = "fdm/subgrid" + ("" if cutoff is None else " cutoff %g" % cutoff) + ("" if subgrid else " lubrication no")
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0, pair_style=pair,
+                         before_run="group           one id 1\ngroup           two id 2\n"
+                                    "fix             push1 one addforce %r 0 0\n"
+                                    "fix             push2 two addforce %r 0 0" % (F, -F),
+                         runs=runs, name="in.pairSqueeze")
+    wall = case.run(run_dir, np_fluid=np_fluid)
+    parts = output.particles(os.path.join(run_dir, "fluid"))
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    U1 = parts["Ux"][parts["tag"] == 1]
+    U2 = parts["Ux"][parts["tag"] == 2]
+    velocity = [float(v) for v in (U1 - U2) / (F / (6 * math.pi * eta * a1))]
+    if not keep:
+        shutil.rmtree(os.path.join(run_dir, "fluid", "constant", "polyMesh"), ignore_errors=True)
+    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
+                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
+
+
+def relative_errors(values, reference):
+    return [(v - r) / r for v, r in zip(values, reference)]
+
+
+def plot(results, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for i, r in enumerate(results["cases"]):
+        colour = "C%d" % i
+        axes[0].loglog(r["xi"], r["theory"], "-", color=colour, label="theory, a2/a1 = %g" % r["lambda"])
+        axes[0].loglog(r["xi"], r["subgrid"]["velocity"], "o", color=colour, label="FDM + sub-grid")
+        axes[0].loglog(r["xi"], r["nosubgrid"]["velocity"], "x", color=colour, label="FDM alone")
+        axes[1].semilogx(r["xi"], [100 * e for e in r["subgrid"]["rel_error"]], "o-", color=colour,
+                         label="FDM + sub-grid, a2/a1 = %g" % r["lambda"])
+        axes[1].semilogx(r["xi"], [100 * e for e in r["nosubgrid"]["rel_error"]], "x--", color=colour,
+                         label="FDM alone, a2/a1 = %g" % r["lambda"])
+    axes[0].set_xlabel(r"$\xi = 2r/(a_1+a_2) - 2$")
+    axes[0].set_ylabel(r"closing velocity $/ (F/6\pi\eta a_1)$")
+    axes[0].legend(fontsize=7)
+    axes[1].set_xlabel(r"$\xi$")
+    axes[1].set_ylabel("error against theory [%]")
+    axes[1].set_yscale("symlog", linthresh=5)
+    axes[1].axhline(5, color="grey", lw=0.5)
+    axes[1].axhline(-5, color="grey", lw=0.5)
+    axes[1].legend(fontsize=7)
+    fig.suptitle("Squeeze flow of a sphere pair (a1/Delta = %g, L = %g a1)" % (results["a_over_delta"],
+                                                                             results["L_over_a"]))
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--full", action="store_true", help="a1/Delta = 5, L = 12 a1")
+    p.add_argument("--lambda", dest="ratios", type=float, nargs="+", default=[1.0, 1.4], help="a2/a1")
+    p.add_argument("--xi", type=float, nargs="+", default=XI_DEFAULT, help="reduced gaps, largest first")
+    p.add_argument("--a-over-delta", type=float, default=4.0)
+    p.add_argument("--L-over-a", type=float, default=8.0)
+    p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
+    p.add_argument("--tol-lambda", type=float, default=1e-4)
+    p.add_argument("--np-fluid", type=int, default=1)
+    p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison runs")
+    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
+    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
+    p.add_argument("--keep", action="store_true", help="keep the meshes")
+    args = p.parse_args(argv)
+    if args.full:
+        args.a_over_delta, args.L_over_a = 5.0, 12.0
+
+    os.makedirs(args.workdir, exist_ok=True)
+    t0 = time.time()
+    results = dict(case="pairSqueeze", a_over_delta=args.a_over_delta, L_over_a=args.L_over_a,
+                   cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda, cases=[])
+    for ratio in args.ratios:
+        reference = [theory.pair_squeeze_velocity(1.0, ratio, xi) for xi in args.xi]
+        entry = dict(**{"lambda": ratio}, xi=args.xi, theory=reference)
+        for subgrid in ([True] if args.no_reference else [True, False]):
+            r = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.L_over_a, args.tol_lambda,
+                         args.cutoff, args.np_fluid, args.keep)
+            r["rel_error"] = relative_errors(r["velocity"], reference)
+            entry["subgrid" if subgrid else "nosubgrid"] = r
+            print("lambda %g, sub-grid %s: %.0f s" % (ratio, "on" if subgrid else "off", r["wall_seconds"]))
+            for xi, v, ref, e in zip(args.xi, r["velocity"], reference, r["rel_error"]):
+                print("  xi %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (xi, v, ref, 100 * e))
+        results["cases"].append(entry)
+    results["wall_seconds"] = time.time() - t0
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=1)
+    if "nosubgrid" in results["cases"][0]:
+        plot(results, os.path.join(os.path.dirname(args.out), "results_pairSqueeze.png"))
+    print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))
+    return results
+
+
+if __name__ == "__main__":
+    main()

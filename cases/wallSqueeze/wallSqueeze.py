@@ -1,0 +1,144 @@
+#!/usr/bin/env python3
+"""A sphere pushed toward a plane wall (squeeze flow), with and without the sub-grid wall
+lubrication correction (paper Appendix D, Eq. D.6).
+
+A sphere of radius a between two walls at rest (y = 0 and y = H), periodic in x and z, held at
+eps = h/a - 1 from the wall y = 0 (fix fdm/couple move no), with a force F = 6 pi eta a toward it.
+Its velocity V, in units of F/(6 pi eta a), is compared with 1/X^A of a sphere and one wall
+(Brenner 1961, the reference table's column Fzt; fdmResistance squeeze --wall). The second wall is
+at H = 10 a by default. Every gap is one coupled time step of one run, once with pair_style
+fdm/subgrid and once with its lubrication switched off.
+
+  wallSqueeze.py               eps = 1e-4 ... 1, a/Delta = 4, 8a x 10a x 8a (minutes)
+  wallSqueeze.py --full        a/Delta = 5, 12a x 24a x 12a
+  wallSqueeze.py --help        every option
+Writes results.json and results_wallSqueeze.png here (docs/cases.md).
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
+from fdm import case, output, theory  # noqa: E402
+
+EPS_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
+
+
+def run_wall(workdir, epss, subgrid, a_over_delta=4.0, L_over_a=8.0, H_over_a=16.0, tol_lambda=1e-5, cutoff=None,
+             np_fluid=1, keep=False):
+    """One coupled run visiting every gap; returns the velocities toward the wall (units F/(6 pi eta a))."""
+    a = 1.0
+    delta = a / a_over_delta
+    L, H = L_over_a * a, H_over_a * a
+    eta = 1.0
+    F = 6 * math.pi * eta * a
+    name = "ad%g_L%g_H%g_%s" % (a_over_delta, L_over_a, H_over_a, "subgrid" if subgrid else "nosubgrid")
+    run_dir = os.path.join(workdir, name)
+    if os.path.isdir(run_dir):
+        shutil.rmtree(run_dir)
+    box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
+    x, z = L / 2 + 0.1 * delta, L / 2 + 0.3 * delta  # off the mesh's symmetry planes
+
+    def position(eps):
+        return (x, a * (1 + eps), z)
+
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+                          n_particles=1)
+    runs = []
+    for k, eps in enumerate(epss):
+        if k > 0:
+            runs.append("set             atom 1 x %r y %r z %r" % position(eps))
+        runs.append("run             1")
+    pair = ("fdm/subgrid" + ("" if cutoff is None else " cutoff %g" % cutoff) + " wall ylo 0 0 0 wall yhi 0 0 0" +
+            ("" if subgrid else " lubrication no"))
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
+                         before_run="fix             push all addforce 0 %r 0" % (-F), runs=runs,
+                         name="in.wallSqueeze")
+    wall = case.run(run_dir, np_fluid=np_fluid)
+    parts = output.particles(os.path.join(run_dir, "fluid"))
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    velocity = [float(v) for v in -parts["Uy"] / (F / (6 * math.pi * eta * a))]
+    if not keep:
+        shutil.rmtree(os.path.join(run_dir, "fluid", "constant", "polyMesh"), ignore_errors=True)
+    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
+                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
+
+
+def relative_errors(values, reference):
+    return [(v - r) / r for v, r in zip(values, reference)]
+
+
+def plot(results, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    r = results
+    axes[0].loglog(r["eps"], r["theory"], "k-", label="Brenner (1961)")
+    axes[0].loglog(r["eps"], r["subgrid"]["velocity"], "o", color="C0", label="FDM + sub-grid")
+    axes[0].loglog(r["eps"], r["nosubgrid"]["velocity"], "x", color="C1", label="FDM alone")
+    axes[1].semilogx(r["eps"], [100 * e for e in r["subgrid"]["rel_error"]], "o-", color="C0", label="FDM + sub-grid")
+    axes[1].semilogx(r["eps"], [100 * e for e in r["nosubgrid"]["rel_error"]], "x--", color="C1", label="FDM alone")
+    axes[0].set_xlabel(r"$\varepsilon = h/a - 1$")
+    axes[0].set_ylabel(r"velocity toward the wall $/ (F/6\pi\eta a)$")
+    axes[0].legend(fontsize=8)
+    axes[1].set_xlabel(r"$\varepsilon$")
+    axes[1].set_ylabel("error against theory [%]")
+    axes[1].set_yscale("symlog", linthresh=5)
+    axes[1].axhline(5, color="grey", lw=0.5)
+    axes[1].axhline(-5, color="grey", lw=0.5)
+    axes[1].legend(fontsize=8)
+    fig.suptitle("Sphere pushed toward a wall (a/Delta = %g, %g a x %g a x %g a)" % (
+        r["a_over_delta"], r["L_over_a"], r["H_over_a"], r["L_over_a"]))
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--full", action="store_true", help="a/Delta = 5, 12a x 24a x 12a")
+    p.add_argument("--eps", type=float, nargs="+", default=EPS_DEFAULT, help="reduced gaps, largest first")
+    p.add_argument("--a-over-delta", type=float, default=4.0)
+    p.add_argument("--L-over-a", type=float, default=8.0)
+    p.add_argument("--H-over-a", type=float, default=10.0)
+    p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
+    p.add_argument("--tol-lambda", type=float, default=1e-4)
+    p.add_argument("--np-fluid", type=int, default=1)
+    p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison run")
+    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
+    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
+    p.add_argument("--keep", action="store_true", help="keep the meshes")
+    args = p.parse_args(argv)
+    if args.full:
+        args.a_over_delta, args.L_over_a, args.H_over_a = 5.0, 12.0, 24.0
+
+    os.makedirs(args.workdir, exist_ok=True)
+    t0 = time.time()
+    reference = [theory.wall_squeeze_velocity(1.0, eps) for eps in args.eps]
+    results = dict(case="wallSqueeze", a_over_delta=args.a_over_delta, L_over_a=args.L_over_a, H_over_a=args.H_over_a,
+                   cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda, eps=args.eps, theory=reference)
+    for subgrid in ([True] if args.no_reference else [True, False]):
+        r = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.L_over_a, args.H_over_a, args.tol_lambda,
+                     args.cutoff, args.np_fluid, args.keep)
+        r["rel_error"] = relative_errors(r["velocity"], reference)
+        results["subgrid" if subgrid else "nosubgrid"] = r
+        print("sub-grid %s: %.0f s" % ("on" if subgrid else "off", r["wall_seconds"]))
+        for eps, v, ref, e in zip(args.eps, r["velocity"], reference, r["rel_error"]):
+            print("  eps %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (eps, v, ref, 100 * e))
+    results["wall_seconds"] = time.time() - t0
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=1)
+    if "nosubgrid" in results:
+        plot(results, os.path.join(os.path.dirname(args.out), "results_wallSqueeze.png"))
+    print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))
+    return results
+
+
+if __name__ == "__main__":
+    main()
