@@ -584,9 +584,17 @@ void FixFdmCouple::initial_integrate(int)
   const double dt = update->dt;
   const bool secondOrder = adamsBashforth_ && previousVelocity_.size() == solution_.size() && !previousVelocity_.empty();
   for (int i = 0; i < atom->nlocal; i++) {
-    const double *before = secondOrder ? &previousVelocity_[size_t(6) * (atom->tag[i] - 1)] : nullptr;
-    for (int d = 0; d < 3; d++)
-      atom->x[i][d] += secondOrder ? dt * (1.5 * atom->v[i][d] - 0.5 * before[d]) : dt * atom->v[i][d];
+    if (secondOrder) {
+      // v and omega become the velocities of this move, so that the contact springs of the pair
+      // style (tangential displacement += dt v_rel) follow the contact points exactly; the solve at
+      // the end of the step sets them to U_{n+1} again
+      const double *before = &previousVelocity_[size_t(6) * (atom->tag[i] - 1)];
+      for (int d = 0; d < 3; d++) {
+        atom->v[i][d] = 1.5 * atom->v[i][d] - 0.5 * before[d];
+        atom->omega[i][d] = 1.5 * atom->omega[i][d] - 0.5 * before[3 + d];
+      }
+    }
+    for (int d = 0; d < 3; d++) atom->x[i][d] += dt * atom->v[i][d];
   }
 }
 
@@ -603,8 +611,10 @@ cpl::Message FixFdmCouple::makeStep(const std::vector<Particle> &particles) cons
       double x = q.x[d];
       if (domain->periodicity[d]) x -= domain->prd[d] * std::floor((x - domain->boxlo[d]) / domain->prd[d]);
       step.at(p, sX + d) = x;
-      step.at(p, sUx + d) = q.v[d];
-      step.at(p, sWx + d) = q.omega[d];
+      // the last solved velocities U_n (v may hold this step's Adams-Bashforth displacement rate)
+      const bool solved = currentVelocity_.size() == size_t(6) * natoms_;
+      step.at(p, sUx + d) = solved ? currentVelocity_[size_t(6) * p + d] : q.v[d];
+      step.at(p, sWx + d) = solved ? currentVelocity_[size_t(6) * p + 3 + d] : q.omega[d];
     }
     step.at(p, sRadius) = q.radius;
   }

@@ -1,0 +1,921 @@
+#!/usr/bin/env python3
+"""Choosing the contact parameters of pair_style fdm/subgrid (k_n, k_t, mu_s, h_r) and the time step:
+DEM-only scenes run with fdmDEM and fix fdm/couple transport none (docs/contact.md).
+
+Units SI at the 1 m scale: sphere radius a = 1 m, viscosity eta = 1 Pa s, mesh size Delta = 0.2 m
+(a/Delta = 5), h_r = 0.01 m, loads of 10 N, k_n = k_t = 2000 N/m (F/k_n = h_r/2). Every scene is a
+LIGGGHTS input in this folder (in.normal, in.wall, in.sliding) that runs by hand as well:
+`fdmDEM -in in.normal -var kn 4000`. This script runs the sweeps:
+
+  normal    two spheres pressed together (in.normal) and a sphere pressed on a wall (in.wall) for
+            several k_n: steady gap against h_r - F/k_n, equal and opposite contact forces, the time
+            to reach the steady gap against the same overdamped equation integrated here with the
+            resistance functions of fdmResistance (zeta(gap), the pair's normal resistance)
+  sliding   a sphere squeezed between two walls (Fn per contact) and pulled along them (Ft per
+            contact, in.sliding): sticks below mu_s Fn with the spring displacement Ft/k_t, slides
+            above with the tangential force mu_s Fn; the threshold by bisection; a sphere pulled on
+            one wall rolls (in.wall, Ft): the stuck contact carries 4/7 Ft without lubrication
+  stability the explicit contact with the implicit (overdamped) velocity solve: per step the gap error
+            is multiplied by 1 - r (position update euler) or by the largest root of
+            l^2 - (1 - 3r/2) l - r/2 = 0 (ab2, the fix's default), r = dt k_n / zeta at the steady gap;
+            the limit dt (bisection) against the estimate 2 zeta/k_n (euler) or zeta/k_n (ab2), for
+            the pair with and without lubrication, the wall, and the tangential spring (2 zeta_t/(2 k_t))
+
+  contactTuning.py            the small sweeps (about a minute on 2 cores)
+  contactTuning.py --full     wider sweeps (k_n, h_r, loads through overlap, both integrators, dt grids)
+  contactTuning.py --help     every option
+Writes results.json and results_contactTuning.png here; run folders go to runs/.
+"""
+import argparse
+import concurrent.futures
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PROJECT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(PROJECT, "scripts"))
+from fdm import theory  # noqa: E402
+
+PI = math.pi
+# the scene: every length in units of a = 1 m, eta = 1 Pa s (the velocity scale F/(6 pi eta a))
+BASE = dict(a=1.0, eta=1.0, delta=0.2, hr=0.01, kn=2000.0, kt=2000.0, mu=0.5)
+LOAD = 10.0                      # N: F/k_n = h_r/2 at the base k_n
+DEFAULT_CUTOFFS = (0.65, 0.75)   # pair_style fdm/subgrid cutoff, wall_cutoff [mesh cells] if the log does not say
+MIN_GAP = 1e-5                   # the resistance functions are frozen below this reduced gap (docs/resistance.md)
+
+
+# ---------------------------------------------------------------------------------------------
+# running fdmDEM
+# ---------------------------------------------------------------------------------------------
+
+def _environment():
+    env = dict(os.environ)
+    lib = os.path.join(PROJECT, ".cache", "build", "lib")
+    if lib not in env.get("LD_LIBRARY_PATH", "").split(":"):
+        env["LD_LIBRARY_PATH"] = lib + (":" + env["LD_LIBRARY_PATH"] if env.get("LD_LIBRARY_PATH") else "")
+    if os.geteuid() == 0:
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return env
+
+
+def fdmdem():
+    exe = shutil.which("fdmDEM") or os.path.join(PROJECT, ".cache", "build", "bin", "fdmDEM")
+    if not os.path.isfile(exe):
+        raise FileNotFoundError("fdmDEM not built: run ./Allwmake")
+    return exe
+
+
+def _value(v):
+    return "%.17g" % v if isinstance(v, float) else str(v)
+
+
+_counter = [0]
+_counter_lock = threading.Lock()
+
+
+def run_scene(scene, variables, workdir, name=None, timeout=900):
+    """Runs `fdmDEM -in in.<scene> -var ...` in a folder of workdir; returns a dict with the output
+    table (`data`, numpy, one row per printed step), `ok`, `log` (the end of the screen output),
+    `seconds` and the sub-grid cut-offs the pair style reported."""
+    with _counter_lock:
+        _counter[0] += 1
+        index = _counter[0]
+    run_dir = os.path.join(workdir, name or "%s_%04d" % (scene, index))
+    if os.path.isdir(run_dir):
+        shutil.rmtree(run_dir)
+    os.makedirs(run_dir)
+    out = scene + ".dat"
+    cmd = [fdmdem(), "-in", os.path.join(HERE, "in." + scene)]
+    for key, v in dict(variables, out=out).items():
+        cmd += ["-var", key, _value(v)]
+    with open(os.path.join(run_dir, "command"), "w") as f:
+        f.write(" ".join(cmd) + "\n")
+    t0 = time.time()
+    proc = subprocess.run(cmd, cwd=run_dir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          errors="replace", timeout=timeout, env=_environment())
+    seconds = time.time() - t0
+    with open(os.path.join(run_dir, "log"), "w") as f:
+        f.write(proc.stdout)
+    data = None
+    path = os.path.join(run_dir, out)
+    if os.path.isfile(path):
+        try:
+            data = np.loadtxt(path, comments="#", ndmin=2)
+        except ValueError:
+            data = None
+    pair = re.search(r"pairs within a surface gap of ([0-9.eE+-]+) mesh cells", proc.stdout)
+    wall = re.search(r"walls within ([0-9.eE+-]+) mesh cells", proc.stdout)
+    ok = proc.returncode == 0 and data is not None and data.shape[0] > 0 and np.isfinite(data).all()
+    return dict(ok=ok, returncode=proc.returncode, data=data, log=proc.stdout[-3000:], seconds=seconds,
+                run_dir=run_dir, cutoff=float(pair.group(1)) if pair else None,
+                wall_cutoff=float(wall.group(1)) if wall else None)
+
+
+def probe_cutoffs(workdir):
+    """The cut-offs (mesh cells) pair_style fdm/subgrid uses by default, from its start-up line."""
+    r = run_scene("wall", dict(steps=1), workdir, name="probe")
+    if not r["ok"]:
+        raise RuntimeError("fdmDEM -in in.wall failed:\n" + r["log"])
+    return (r["cutoff"] or DEFAULT_CUTOFFS[0], r["wall_cutoff"] or DEFAULT_CUTOFFS[1])
+
+
+# ---------------------------------------------------------------------------------------------
+# resistances (fdmResistance): the zeta of the estimates
+# ---------------------------------------------------------------------------------------------
+
+class Resistance:
+    """Normal and tangential resistances of the scenes, from the sub-grid functions of the
+    resistance library (fdmResistance, the code the pair style calls) plus the isolated Stokes drag
+    that fix fdm/couple transport none puts in Eq. (31)."""
+
+    def __init__(self, a, eta, delta, cutoff, wall_cutoff):
+        self.a, self.eta, self.delta, self.cutoff, self.wall_cutoff = a, eta, delta, cutoff, wall_cutoff
+        self._cache = {}
+        self._lock = threading.Lock()
+        self._tables = {}
+        self._table_lock = threading.Lock()
+
+    def _call(self, key, *args):
+        with self._lock:
+            if key in self._cache:
+                return self._cache[key]
+        value = theory.resistance(*args)
+        with self._lock:
+            self._cache[key] = value
+        return value
+
+    def pair_XA(self, gap):
+        """Sub-grid squeeze resistance X^A_11 (N s/m) of two equal spheres at surface gap `gap`."""
+        xi = gap / self.a
+        if xi >= self.cutoff * self.delta / self.a:
+            return 0.0
+        xi = max(xi, MIN_GAP)
+        out = self._call(("pair", round(math.log(xi), 12)), "pair", "--a1", self.a, "--a2", self.a, "--xi", "%.17g" % xi,
+                         "--subgrid", "--delta", self.delta, "--cutoff", self.cutoff)
+        return self.eta * out["dimensional_over_eta"]["XA11"]
+
+    def wall_functions(self, gap):
+        """Sub-grid wall functions (XA, YA, ... dimensional, N s/m etc.) at surface gap `gap`."""
+        eps = gap / self.a
+        if eps >= self.wall_cutoff * self.delta / self.a:
+            return dict(XA=0.0, YA=0.0)
+        eps = max(eps, MIN_GAP)
+        out = self._call(("wall", round(math.log(eps), 12)), "wall", "--a", self.a, "--eps", "%.17g" % eps,
+                         "--delta", self.delta, "--cutoff", self.wall_cutoff)
+        return {k: self.eta * v for k, v in out["subgrid_dimensional_over_eta"].items()}
+
+    # zeta: force per unit velocity of the mode the contact spring acts on
+    def zeta_pair(self, gap, lubrication=True):
+        """Normal resistance of two free equal spheres: F = zeta (U1 - U2).n, F the load on each."""
+        return 3 * PI * self.eta * self.a + (self.pair_XA(gap) if lubrication else 0.0)
+
+    def zeta_wall(self, gap, lubrication=True):
+        return 6 * PI * self.eta * self.a + (self.wall_functions(gap)["XA"] if lubrication else 0.0)
+
+    def zeta_sandwich_tangential(self, gap, lubrication=True):
+        """A sphere translating between two walls at the same gap (no rotation, by symmetry)."""
+        return 6 * PI * self.eta * self.a + (2 * self.wall_functions(gap)["YA"] if lubrication else 0.0)
+
+    def zeta_pair_slip(self, gap, lubrication=True):
+        """Tangential (slip) resistance of the contact of two free equal spheres: equal and opposite
+        tangential forces f at the contact points (with their torques) make the contact points slip
+        at f/zeta_t; the spheres translate and rotate (Stokes drag, 8 pi eta a^3, plus the sub-grid
+        pair block of `fdmResistance matrix`). 12/7 pi eta a without lubrication."""
+        a, eta = self.a, self.eta
+        M = np.diag([6 * PI * eta * a] * 3 + [8 * PI * eta * a ** 3] * 3 + [6 * PI * eta * a] * 3
+                    + [8 * PI * eta * a ** 3] * 3)
+        if lubrication:
+            out = self._call(("matrix", round(gap, 15)), "matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % (2 * a + gap), 0, 0,
+                             "--a1", a, "--a2", a, "--delta", self.delta, "--eta", eta, "--cutoff", self.cutoff)
+            M = M + np.array(out["R"])
+        n = np.array([-1.0, 0.0, 0.0])     # from sphere 2 to sphere 1 (the pair style's n for i = 1)
+        t = np.array([0.0, 1.0, 0.0])
+        load = np.concatenate([t, np.cross(-a * n, t), -t, np.cross(a * n, -t)])
+        u = np.linalg.solve(M, load)
+        slip = u[0:3] - u[6:9] - np.cross(a * u[3:6] + a * u[9:12], n)
+        return 1.0 / float(slip @ t)
+
+    def table(self, kind, lubrication, points=40, jobs=2):
+        """zeta(gap) for the gap-history predictions: sampled on log-spaced gaps, interpolated in
+        log(gap) on gap * zeta (smooth: the lubrication is ~1/gap)."""
+        key = (kind, lubrication)
+        with self._table_lock:
+            if key not in self._tables:
+                self._tables[key] = self._make_table(kind, lubrication, points, jobs)
+            return self._tables[key]
+
+    def _make_table(self, kind, lubrication, points, jobs):
+        if not lubrication:
+            z = self.zeta_pair(1.0, False) if kind == "pair" else self.zeta_wall(1.0, False)
+            f = lambda gap: z  # noqa: E731
+        else:
+            cut = (self.cutoff if kind == "pair" else self.wall_cutoff) * self.delta
+            gaps = np.geomspace(MIN_GAP * self.a, cut, points)
+            zeta = self.zeta_pair if kind == "pair" else self.zeta_wall
+            with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+                values = np.array(list(pool.map(zeta, gaps)))
+            far = zeta(2 * cut)
+            logs, products = np.log(gaps), gaps * values
+
+            def f(gap):
+                if gap >= cut:
+                    return far
+                if gap <= gaps[0]:
+                    return values[0]
+                # quadratic (Lagrange) through the three nearest samples, in log(gap)
+                s = math.log(gap)
+                i = min(max(int(np.searchsorted(logs, s)), 1), len(logs) - 2)
+                x0, x1, x2 = logs[i - 1], logs[i], logs[i + 1]
+                y0, y1, y2 = products[i - 1], products[i], products[i + 1]
+                y = (y0 * (s - x1) * (s - x2) / ((x0 - x1) * (x0 - x2)) + y1 * (s - x0) * (s - x2) / ((x1 - x0) * (x1 - x2))
+                     + y2 * (s - x0) * (s - x1) / ((x2 - x0) * (x2 - x1)))
+                return y / gap
+        return f
+
+
+# ---------------------------------------------------------------------------------------------
+# the overdamped equation of the scenes, integrated as fix fdm/couple does
+# ---------------------------------------------------------------------------------------------
+
+def predict_gap(gap0, load, kn, hr, dt, steps, zeta, integrator="ab2", settle=None):
+    """Gap history of a sphere pressed by `load` onto a partner (pair: zeta of the pair; wall), with the
+    contact force kn (hr - gap) for gap < hr, exactly as fix fdm/couple steps it: the velocity is
+    solved at step n from the positions of step n (initial velocity 0), the position moves at the
+    next step with it (euler) or with 3/2 U_n - 1/2 U_(n-1) (ab2, from the third step on).
+    With `settle` = (g_ss, tol): stops 20 steps after |gap - g_ss| < tol holds."""
+    g = []
+    x, current, previous = gap0, 0.0, None
+    quiet = 0
+    for n in range(steps):
+        if integrator == "ab2" and previous is not None:
+            x -= dt * (1.5 * current - 0.5 * previous)
+        else:
+            x -= dt * current
+        v = (load - kn * max(0.0, hr - x)) / zeta(x)
+        if n > 0:
+            previous = current
+        current = v
+        g.append(x)
+        if settle is not None:
+            quiet = quiet + 1 if abs(x - settle[0]) < settle[1] else 0
+            if quiet > 20:
+                break
+    return np.array(g)
+
+
+def amplification_theory(r, integrator):
+    """|growth factor per step| of the linearised contact: euler 1 - r; ab2 the largest root of
+    l^2 - (1 - 3r/2) l - r/2 = 0."""
+    if integrator == "euler":
+        return abs(1 - r)
+    roots = np.roots([1.0, -(1 - 1.5 * r), -0.5 * r])
+    return float(max(abs(roots)))
+
+
+def limit_factor(integrator):
+    """r = dt k / zeta at the stability limit: 2 (euler), 1 (ab2)."""
+    return 2.0 if integrator == "euler" else 1.0
+
+
+# ---------------------------------------------------------------------------------------------
+# analysis helpers
+# ---------------------------------------------------------------------------------------------
+
+def settle_index(gap, target, tol):
+    """First index after which |gap - target| <= tol for good (None if never)."""
+    bad = np.nonzero(np.abs(gap - target) > tol)[0]
+    if len(bad) == 0:
+        return 0
+    return None if bad[-1] == len(gap) - 1 else int(bad[-1] + 1)
+
+
+def classify(error, scale, hr=None, gap=None, g_ss=None):
+    """Stability of a perturbed steady state from its error series (gap - g_ss, or the tangential
+    force error), error[0] being the initial perturbation. Linear stability: the perturbation never
+    grows beyond 1.5 times its initial size (a stable run of either integrator stays below it; an
+    unstable one, even growing by 0.1 % per step, passes it within the run). The late behaviour is
+    labelled too (beyond the limit the contact is nonlinear: limit cycles, contact loss, overlap)."""
+    e = np.abs(np.asarray(error, float))
+    n = len(e)
+    e0 = e[0]
+    w = max(5, min(40, n // 8))
+    last = e[-w:].max()
+    grew = bool(e[1:].max() > 1.5 * e0)
+    stable = not grew
+    if last < 1e-6 * e0 or last < 1e-10 * scale:   # 1e-10: round-off of positions ~ 1e-15 m
+        label = "converged"
+    elif stable:
+        label = "decaying"
+    else:
+        label = "growing"
+        if gap is not None:
+            late = gap[-max(w, n // 2):]
+            if late.max() >= hr:
+                label = "chatter (contact lost and made again)"
+            elif late.min() < 0 and late.min() < g_ss - (hr - g_ss):
+                label = "deep overlap"
+            else:
+                label = "bounded oscillation"
+    # growth factor per step in the linear window (|e| between 1e-9 and 20 times the start)
+    lo = 3
+    hi = lo
+    while hi + 1 < n and hi - lo < 60 and 1e-9 * e0 < e[hi + 1] < 20 * e0:
+        hi += 1
+    factor = None
+    if hi - lo >= 4:
+        # envelope: the larger of each pair of neighbours (the error alternates in sign)
+        a, b = max(e[lo], e[lo + 1]), max(e[hi - 1], e[hi])
+        if a > 0 and b > 0:
+            factor = float((b / a) ** (1.0 / (hi - 1 - lo)))
+    elif n > lo + 1 and e[lo + 1] <= 1e-9 * e0:
+        factor = 0.0
+    return dict(stable=stable, label=label, factor_measured=factor, max_error_over_initial=float(e.max() / e0),
+                late_error_over_initial=float(last / e0))
+
+
+def parallel(jobs, function, items):
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        return list(pool.map(function, items))
+
+
+# ---------------------------------------------------------------------------------------------
+# (a) normal contact: pair and wall under a load
+# ---------------------------------------------------------------------------------------------
+
+def normal_run(res, workdir, geometry, kn, load, hr, lubrication=True, integrator="ab2", gap0=0.05, r_target=0.25,
+               max_steps=200000, steps=None, p=BASE):
+    """One loaded contact from gap0 to its steady state; dt = r_target zeta(h_r)/kn (the smallest
+    resistance met in contact; the estimate of the limit is zeta/kn for ab2). The number of steps
+    comes from the predicted gap history (until settled to 1e-9 F/kn), unless `steps` is given
+    (then no prediction)."""
+    a, eta = p["a"], p["eta"]
+    zeta_of = res.zeta_pair if geometry == "pair" else res.zeta_wall
+    g_ss = hr - load / kn
+    compression = load / kn
+    zeta_entry = zeta_of(hr, lubrication)
+    zeta_ss = zeta_of(g_ss, lubrication)
+    dt = r_target * min(zeta_entry, zeta_ss) / kn
+    if steps is None:
+        table = res.table(geometry, lubrication)
+        predicted = predict_gap(gap0, load, kn, hr, dt, max_steps, table, integrator,
+                                settle=(g_ss, 1e-9 * compression))
+        steps = min(max_steps, int(1.15 * len(predicted)) + 40)
+    else:
+        predicted = None
+    variables = dict(kn=kn, kt=p["kt"], mu=p["mu"], hr=hr, F=load, dt=dt, steps=steps, gap0=gap0, a=a, eta=eta,
+                     delta=p["delta"], lub="yes" if lubrication else "no", integ=integrator)
+    r = run_scene("normal" if geometry == "pair" else "wall", variables, workdir)
+    out = dict(geometry=geometry, kn=kn, load=load, hr=hr, lubrication=lubrication, integrator=integrator, dt=dt,
+               steps=steps, gap0=gap0, gap_theory=g_ss, compression_theory=compression, zeta_at_hr=zeta_entry,
+               zeta_steady=zeta_ss, tau_steady=zeta_ss / kn, ok=r["ok"], seconds=r["seconds"])
+    if not r["ok"]:
+        out["log"] = r["log"]
+        return out
+    d = r["data"]
+    gap = d[:, 1]
+    t = d[:, 0] * dt
+    if geometry == "pair":
+        contact = d[:, 4]                       # contact force on sphere 1 (along x: -F_n)
+        out["force_balance"] = float(np.max(np.abs(d[:, 4] + d[:, 5])) / load)   # |F1 + F2| / F
+        normal_force_end = -contact[-1]
+    else:
+        normal_force_end = d[-1, 3]
+        out["force_balance"] = None
+    out.update(
+        gap_end=float(gap[-1]),
+        gap_error=float((gap[-1] - g_ss) / compression),     # relative to the spring compression F/kn
+        normal_force_end=float(normal_force_end),
+        normal_force_error=float((normal_force_end - load) / load),
+        t_contact=float(t[np.argmax(gap < hr)]) if (gap < hr).any() else None,
+        min_gap=float(gap.min()),
+    )
+    i = settle_index(gap, g_ss, 0.01 * compression)
+    out["t_settle"] = float(t[i]) if i is not None else None
+    if predicted is not None:
+        n_pred = min(len(predicted), len(gap))
+        out["history_vs_prediction"] = float(np.max(np.abs(gap[:n_pred] - predicted[:n_pred])) / compression)
+        j = settle_index(predicted, g_ss, 0.01 * compression)
+        out["t_settle_predicted"] = float((j + 1) * dt) if j is not None else None
+    if out["t_settle"] is not None and out["t_contact"] is not None:
+        out["relaxation_over_tau"] = (out["t_settle"] - out["t_contact"]) / out["tau_steady"]
+    # every 10th point of the history for the figure
+    out["history"] = dict(t=t[::max(1, len(t) // 400)].tolist(), gap=gap[::max(1, len(t) // 400)].tolist())
+    return out
+
+
+def normal_sweep(res, workdir, full, jobs, integrator):
+    cases = []
+    kns = [10000, 4000, 2000, 1333.3333333333333, 1111.1111111111111] if full else [4000, 2000, 1111.1111111111111]
+    for geometry in ("pair", "wall"):
+        for kn in kns:
+            cases.append(dict(geometry=geometry, kn=kn, load=LOAD, hr=BASE["hr"], lubrication=True))
+    if full:
+        for geometry in ("pair", "wall"):
+            for hr in (0.0075, 0.02):
+                cases.append(dict(geometry=geometry, kn=BASE["kn"], load=LOAD, hr=hr, lubrication=True))
+            for kn in (4000, 2000, 1000, 666.6666666666666):   # F/kn = h_r/4 ... 1.5 h_r: overlap without lubrication
+                cases.append(dict(geometry=geometry, kn=kn, load=LOAD, hr=BASE["hr"], lubrication=False))
+            # an overlap with lubrication: the sub-grid functions are frozen at a gap of 1e-5 a
+            cases.append(dict(geometry=geometry, kn=666.6666666666666, load=LOAD, hr=BASE["hr"], lubrication=True))
+    else:
+        cases.append(dict(geometry="pair", kn=666.6666666666666, load=LOAD, hr=BASE["hr"], lubrication=False))
+    return parallel(jobs, lambda c: normal_run(res, workdir, integrator=integrator, **c), cases)
+
+
+# ---------------------------------------------------------------------------------------------
+# (b) sliding threshold: a sphere between two walls
+# ---------------------------------------------------------------------------------------------
+
+def sliding_run(res, workdir, ratio, integrator="ab2", lubrication=True, Fn=LOAD, kt=None, r_target=0.25, steps=400,
+                p=BASE):
+    """Ft = ratio mu_s Fn per contact."""
+    kn, kt, mu, hr = p["kn"], kt or p["kt"], p["mu"], p["hr"]
+    Ft = ratio * mu * Fn
+    g_w = hr - Fn / kn
+    zeta_t = res.zeta_sandwich_tangential(g_w, lubrication)
+    dt = r_target * zeta_t / (2 * kt)
+    variables = dict(kn=kn, kt=kt, mu=mu, hr=hr, Fn=Fn, Ft=Ft, dt=dt, steps=steps, a=p["a"], eta=p["eta"],
+                     delta=p["delta"], lub="yes" if lubrication else "no", integ=integrator)
+    r = run_scene("sliding", variables, workdir)
+    out = dict(ratio=ratio, Ft=Ft, Fn=Fn, mu=mu, kt=kt, dt=dt, integrator=integrator, lubrication=lubrication,
+               zeta_t=zeta_t, ok=r["ok"])
+    if not r["ok"]:
+        out["log"] = r["log"]
+        return out
+    d = r["data"]
+    u, ft, dx = d[:, 2], d[:, 4], d[:, 1]
+    scale = 2 * Ft / zeta_t                               # the initial speed
+    stuck = bool(abs(u[-1]) < 1e-8 * scale)
+    sliding_speed = 2 * (Ft - mu * Fn) / zeta_t
+    out.update(stuck=stuck, U_end=float(u[-1]), ft_end=float(ft[-1]), ft_over_Ft=float(ft[-1] / Ft),
+               ft_over_muFn=float(ft[-1] / (mu * Fn)), displacement=float(dx[-1]),
+               spring_theory=Ft / kt, omega_max=float(np.max(np.abs(d[:, 3]))),
+               normal_force_sum_max=float(np.max(np.abs(d[:, 5]))), gap_wall=float(d[-1, 6]),
+               gap_wall_theory=g_w)
+    if stuck:
+        out["displacement_over_spring"] = float(dx[-1] / (Ft / kt))
+        # the position update ab2 moves the sphere by 1/2 dt (U_last - U_first) less than the spring
+        # history (which adds dt U_n each step): the first velocity is u[0]
+        out["ab2_offset_expected"] = float(-0.5 * dt * u[0]) if integrator == "ab2" else 0.0
+    else:
+        out["sliding_speed_theory"] = sliding_speed
+        out["sliding_speed_error"] = float((u[-1] - sliding_speed) / sliding_speed)
+        out["steady"] = bool(abs(u[-1] - u[-11]) < 1e-6 * abs(u[-1]))
+    return out
+
+
+def sliding_sweep(res, workdir, full, jobs, integrator):
+    ratios = [0.25, 0.5, 0.75, 0.9, 0.95, 0.98, 1.02, 1.05, 1.1, 1.5, 2.0, 3.0] if full else [0.5, 0.9, 0.98, 1.02,
+                                                                                                1.1, 1.5]
+    runs = parallel(jobs, lambda q: sliding_run(res, workdir, q, integrator), ratios)
+    extra = [dict(ratio=0.5, integrator="euler" if integrator == "ab2" else "ab2")]
+    if full:
+        extra += [dict(ratio=0.5, lubrication=False), dict(ratio=1.5, lubrication=False)]
+    runs_extra = parallel(jobs, lambda c: sliding_run(res, workdir, integrator=c.get("integrator", integrator),
+                                                      ratio=c["ratio"], lubrication=c.get("lubrication", True)), extra)
+    # the threshold by bisection between the largest stuck and the smallest sliding load
+    stuck = [r["ratio"] for r in runs if r["ok"] and r["stuck"]]
+    slid = [r["ratio"] for r in runs if r["ok"] and not r["stuck"]]
+    threshold = None
+    if stuck and slid and max(stuck) < min(slid):
+        lo, hi = max(stuck), min(slid)
+        for _ in range(8 if full else 5):
+            mid = 0.5 * (lo + hi)
+            r = sliding_run(res, workdir, mid, integrator, steps=800)
+            if not r["ok"]:
+                break
+            if r["stuck"]:
+                lo = mid
+            else:
+                hi = mid
+        threshold = dict(ratio=0.5 * (lo + hi), bracket=[lo, hi])
+    return dict(runs=runs, extra=runs_extra, threshold=threshold)
+
+
+def rolling_runs(res, workdir, jobs, integrator):
+    """A sphere pressed on one wall (F) and pulled at its centre along it (Ft): it rolls, the contact
+    point sticks and carries the fraction c of Ft, c = 4/7 without lubrication."""
+    def one(lubrication):
+        kn, F, Ft = BASE["kn"], LOAD, 1.0
+        # the slip of the contact point of a free sphere: translation and rotation, Stokes drag only
+        # (a lower bound of the resistance), 1/zeta = 1/(6 pi eta a) + a^2/(8 pi eta a^3)
+        zeta_slip = 24.0 / 7.0 * PI * BASE["eta"] * BASE["a"]
+        dt = 0.25 * min(res.zeta_wall(BASE["hr"], lubrication), zeta_slip) / max(kn, BASE["kt"])
+        # settle the normal gap, then the rolling: several normal and tangential time scales
+        steps = 3000 if not lubrication else 1500
+        r = run_scene("wall", dict(kn=kn, kt=BASE["kt"], mu=BASE["mu"], hr=BASE["hr"], F=F, Ft=Ft, dt=dt, steps=steps,
+                                   gap0=BASE["hr"] - F / kn, lub="yes" if lubrication else "no", integ=integrator),
+                      workdir)
+        out = dict(lubrication=lubrication, Ft=Ft, F=F, dt=dt, ok=r["ok"])
+        if r["ok"]:
+            d = r["data"]
+            ux, w, ft = d[-1, 8], d[-1, 9], d[-1, 10]
+            out.update(ft_over_Ft=float(-ft / Ft), U=float(ux), a_omega=float(-BASE["a"] * w),
+                       slip_over_U=float((ux + BASE["a"] * w) / ux), theory_no_lubrication=4.0 / 7.0)
+        else:
+            out["log"] = r["log"]
+        return out
+    return parallel(jobs, one, [False, True])
+
+
+# ---------------------------------------------------------------------------------------------
+# (c) stability of the explicit contact
+# ---------------------------------------------------------------------------------------------
+
+class StabilityConfig:
+    """A steady contact perturbed a little, run at a given dt; `mode` is 'normal' (gap) or
+    'tangential' (stuck spring between two walls)."""
+
+    def __init__(self, res, name, geometry, lubrication, integrator, p=BASE):
+        self.res, self.name, self.geometry, self.lubrication, self.integrator, self.p = (
+            res, name, geometry, lubrication, integrator, p)
+        self.kn, self.kt, self.hr = p["kn"], p["kt"], p["hr"]
+        if geometry == "tangential":
+            self.Fn = LOAD
+            self.Ft = 0.1 * p["mu"] * LOAD          # far below the cap: the growth is seen before sliding
+            self.g_w = self.hr - self.Fn / self.kn
+            self.zeta = res.zeta_sandwich_tangential(self.g_w, lubrication)
+            self.stiffness = 2 * self.kt            # two springs on one sphere
+        elif geometry == "pair_tangential":
+            # two free spheres at their steady gap; a tangential kick of one step loads the spring,
+            # which then relaxes (or not) with the spheres translating and rotating
+            self.load = LOAD
+            self.g_ss = self.hr - self.load / self.kn
+            self.kick = 0.01 * p["mu"] * LOAD
+            self.zeta = res.zeta_pair_slip(self.g_ss, lubrication)
+            self.stiffness = self.kt
+        else:
+            self.load = LOAD
+            self.g_ss = self.hr - self.load / self.kn
+            self.compression = self.load / self.kn
+            self.perturbation = 0.01 * self.compression
+            zeta = res.zeta_pair if geometry == "pair" else res.zeta_wall
+            self.zeta = zeta(self.g_ss, lubrication)
+            self.zeta_at_start = zeta(self.g_ss + self.perturbation, lubrication)
+            self.stiffness = self.kn
+        # the tangential spring is integrated with the displacement of the step, so by the fix's integrator
+        self.limit_r = limit_factor(integrator)
+        self.dt_estimate = self.limit_r * self.zeta / self.stiffness
+
+    def run(self, workdir, dt, steps=400):
+        p = self.p
+        common = dict(kn=self.kn, kt=self.kt, mu=p["mu"], hr=self.hr, dt=dt, steps=steps, a=p["a"], eta=p["eta"],
+                      delta=p["delta"], lub="yes" if self.lubrication else "no", integ=self.integrator)
+        if self.geometry == "tangential":
+            r = run_scene("sliding", dict(common, Fn=self.Fn, Ft=self.Ft), workdir)
+        elif self.geometry == "pair_tangential":
+            r = run_scene("normal", dict(common, F=self.load, gap0=self.g_ss, kick=self.kick, kicksteps=1), workdir)
+        else:
+            r = run_scene("normal" if self.geometry == "pair" else "wall",
+                          dict(common, F=self.load, gap0=self.g_ss + self.perturbation), workdir)
+        out = dict(dt=dt, r=dt * self.stiffness / self.zeta, ok=r["ok"])
+        if not r["ok"]:
+            out.update(stable=False, label="run failed", log=r["log"][-600:])
+            return out
+        d = r["data"]
+        if self.geometry == "tangential":
+            c = classify(d[:, 4] - self.Ft, self.Ft)
+            out["ft_max"] = float(np.abs(d[:, 4]).max())
+            out["sliding_seen"] = bool(np.abs(d[:, 4]).max() >= 0.999 * p["mu"] * self.Fn)
+            if c["label"] == "growing":
+                c["label"] = "chatter at the Coulomb cap" if out["sliding_seen"] else "growing"
+        elif self.geometry == "pair_tangential":
+            ft = d[1:, 10]                          # tangential contact force on sphere 1, after the kick
+            c = classify(ft, self.kick)
+            out["ft_max"] = float(np.abs(ft).max())
+            out["sliding_seen"] = bool(out["ft_max"] >= 0.999 * p["mu"] * self.load)
+            if c["label"] == "growing":
+                c["label"] = "chatter at the Coulomb cap" if out["sliding_seen"] else "growing"
+        else:
+            gap = d[:, 1]
+            c = classify(gap - self.g_ss, self.compression, self.hr, gap, self.g_ss)
+            out["min_gap"] = float(gap.min())
+            out["max_gap"] = float(gap.max())
+            # zeta from the fix's own outputs at the first step: -(F^SG + F^FDM)/closing speed
+            if self.geometry == "pair":
+                out["zeta_from_outputs"] = float(-(d[0, 8] + d[0, 9]) / (d[0, 2] - d[0, 3]))
+            else:
+                out["zeta_from_outputs"] = float(-(d[0, 4] + d[0, 5]) / d[0, 2])
+        out.update(c)
+        out["factor_theory"] = amplification_theory(out["r"], self.integrator)
+        return out
+
+    def find_limit(self, workdir, rel_tol=0.01, steps=400):
+        """Bisection in dt between a stable and an unstable run, starting from the estimate."""
+        lo, hi = 0.8 * self.dt_estimate, 1.25 * self.dt_estimate
+        runs = []
+        r_lo, r_hi = self.run(workdir, lo, steps), self.run(workdir, hi, steps)
+        runs += [r_lo, r_hi]
+        for _ in range(6):
+            if r_lo["stable"]:
+                break
+            hi, r_hi = lo, r_lo
+            lo /= 1.5
+            r_lo = self.run(workdir, lo, steps)
+            runs.append(r_lo)
+        for _ in range(6):
+            if not r_hi["stable"]:
+                break
+            lo, r_lo = hi, r_hi
+            hi *= 1.5
+            r_hi = self.run(workdir, hi, steps)
+            runs.append(r_hi)
+        while hi / lo - 1 > rel_tol:
+            mid = math.sqrt(lo * hi)
+            r = self.run(workdir, mid, steps)
+            runs.append(r)
+            if r["stable"]:
+                lo = mid
+            else:
+                hi = mid
+        measured = math.sqrt(lo * hi)
+        summary = dict(name=self.name, geometry=self.geometry, lubrication=self.lubrication,
+                       integrator=self.integrator, stiffness=self.stiffness, zeta=self.zeta,
+                       limit_r_theory=self.limit_r, dt_estimate=self.dt_estimate, dt_measured=measured,
+                       dt_bracket=[lo, hi], measured_over_estimate=measured / self.dt_estimate,
+                       r_measured=measured * self.stiffness / self.zeta, runs=len(runs))
+        if self.geometry in ("pair", "wall"):
+            summary.update(gap_steady=self.g_ss, zeta_at_start=self.zeta_at_start,
+                           zeta_from_outputs=runs[0].get("zeta_from_outputs"))
+        elif self.geometry == "pair_tangential":
+            summary.update(gap_steady=self.g_ss)
+        else:
+            summary.update(gap_wall=self.g_w)
+        return summary
+
+
+def stability_study(res, workdir, full, jobs):
+    configs = []
+    for integrator in ("ab2", "euler"):
+        configs += [StabilityConfig(res, "pair, lubrication", "pair", True, integrator),
+                    StabilityConfig(res, "pair, no lubrication", "pair", False, integrator)]
+    configs += [StabilityConfig(res, "wall, lubrication", "wall", True, "ab2"),
+                StabilityConfig(res, "tangential (two walls), lubrication", "tangential", True, "ab2"),
+                StabilityConfig(res, "pair tangential, lubrication", "pair_tangential", True, "ab2")]
+    if full:
+        configs += [StabilityConfig(res, "wall, lubrication", "wall", True, "euler"),
+                    StabilityConfig(res, "tangential (two walls), lubrication", "tangential", True, "euler"),
+                    StabilityConfig(res, "pair tangential, lubrication", "pair_tangential", True, "euler"),
+                    StabilityConfig(res, "pair tangential, no lubrication", "pair_tangential", False, "ab2")]
+        for integrator in ("ab2", "euler"):
+            configs += [StabilityConfig(res, "wall, no lubrication", "wall", False, integrator),
+                        StabilityConfig(res, "tangential (two walls), no lubrication", "tangential", False,
+                                        integrator)]
+    tolerance = 0.001 if full else 0.01
+    limits = parallel(jobs, lambda c: c.find_limit(workdir, rel_tol=tolerance), configs)
+    # dt grid of the figure: the pair with lubrication, both integrators, r = dt kn / zeta
+    grid_r = ([0.1, 0.25, 0.5, 0.75, 0.9, 1.1, 1.25, 1.5, 1.75, 1.9, 2.1, 2.5, 3, 4, 6] if full
+              else [0.25, 0.5, 0.75, 0.9, 1.1, 1.5, 1.9, 2.1, 3.0])
+    grid = []
+    for integrator in ("ab2", "euler"):
+        c = StabilityConfig(res, "pair, lubrication", "pair", True, integrator)
+        runs = parallel(jobs, lambda rr: c.run(workdir, rr * c.zeta / c.stiffness, 400), grid_r)
+        for r in runs:
+            r["integrator"] = integrator
+        grid += runs
+    if full:
+        c = StabilityConfig(res, "pair, no lubrication", "pair", False, "euler")
+        runs = parallel(jobs, lambda rr: c.run(workdir, rr * c.zeta / c.stiffness, 400), grid_r)
+        for r in runs:
+            r["integrator"] = "euler"
+            r["config"] = "pair, no lubrication"
+        grid += runs
+    return dict(limits=limits, grid=grid, bisection_tolerance=tolerance)
+
+
+# ---------------------------------------------------------------------------------------------
+# the figure
+# ---------------------------------------------------------------------------------------------
+
+def plot(results, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(2, 2, figsize=(12, 9))
+
+    a = ax[0, 0]
+    for i, r in enumerate(x for x in results["normal"]["runs"] if x["ok"] and x["lubrication"] and x["hr"] == BASE["hr"]):
+        colour = "C%d" % (i % 10)
+        h = r["history"]
+        a.plot(h["t"], np.array(h["gap"]) / r["hr"], color=colour, ls="-" if r["geometry"] == "pair" else "--",
+               label="%s, k_n = %.0f N/m" % (r["geometry"], r["kn"]))
+        a.axhline(r["gap_theory"] / r["hr"], color=colour, lw=0.5)
+    a.axhline(1.0, color="k", lw=0.8)
+    a.set_xscale("log")
+    a.set_ylim(-0.2, 3)
+    a.set_xlabel("t [s]")
+    a.set_ylabel("gap / h_r")
+    a.set_title("(a) gap under F = %g N (lines: h_r - F/k_n)" % LOAD)
+    a.legend(fontsize=7)
+
+    a = ax[0, 1]
+    s = results["sliding"]
+    runs = [r for r in s["runs"] if r["ok"]]
+    q = np.array([r["ratio"] for r in runs])
+    a.plot(q, [r["ft_over_muFn"] for r in runs], "o", label="tangential contact force / (mu_s F_n)")
+    a.plot(q, [r["displacement"] / (r["mu"] * r["Fn"] / r["kt"]) for r in runs], "s", mfc="none",
+           label="sphere displacement / (mu_s F_n / k_t) (end of run)")
+    qq = np.linspace(0, max(q.max(), 1.5), 100)
+    a.plot(qq, np.minimum(qq, 1.0), "k-", lw=0.8, label="min(F_t, mu_s F_n) / (mu_s F_n)")
+    a.set_ylim(0, 2)
+    a.set_xlabel("F_t / (mu_s F_n)")
+    a.set_ylabel("ratio")
+    a2 = a.twinx()
+    a2.plot(q, [r["U_end"] for r in runs], "^", color="C3", label="sliding speed [m/s]")
+    a2.set_ylabel("U at the end [m/s]", color="C3")
+    title = "(b) sphere between two walls, pulled"
+    if s["threshold"]:
+        title += ": slides above %.4f mu_s F_n" % s["threshold"]["ratio"]
+    a.set_title(title)
+    a.legend(fontsize=7, loc="upper left")
+
+    a = ax[1, 0]
+    grid = results["stability"]["grid"]
+    for integrator, marker in (("ab2", "o"), ("euler", "s")):
+        pts = [g for g in grid if g["integrator"] == integrator and g.get("config") is None and g["ok"]
+               and g["factor_measured"] is not None]
+        a.plot([g["r"] for g in pts], [g["factor_measured"] for g in pts], marker, mfc="none",
+               label="measured, %s" % integrator)
+        rr = np.linspace(0.01, max(g["r"] for g in grid) * 1.05, 300)
+        a.plot(rr, [amplification_theory(x, integrator) for x in rr], "-", lw=0.8, label="theory, %s" % integrator)
+    a.axhline(1.0, color="k", lw=0.8)
+    a.set_xlabel("r = dt k_n / zeta (zeta at the steady gap)")
+    a.set_ylabel("|growth factor of the gap error per step|")
+    a.set_ylim(0, 3)
+    a.set_title("(c) pair with lubrication, perturbed steady contact")
+    a.legend(fontsize=7)
+
+    a = ax[1, 1]
+    limits = results["stability"]["limits"]
+    labels = ["%s\n%s" % (l["name"].replace(", ", ",\n", 1), l["integrator"]) for l in limits]
+    x = np.arange(len(limits))
+    a.bar(x - 0.2, [l["dt_measured"] for l in limits], 0.4, label="measured (bisection)")
+    a.bar(x + 0.2, [l["dt_estimate"] for l in limits], 0.4, label="estimate 2 zeta/k (euler), zeta/k (ab2)")
+    a.set_yscale("log")
+    a.set_xticks(x)
+    a.set_xticklabels(labels, fontsize=6, rotation=90)
+    a.set_ylabel("largest stable dt [s]")
+    a.set_title("(c) stability limit of the time step")
+    a.legend(fontsize=7)
+    fig.suptitle("contactTuning: a = 1 m, eta = 1 Pa s, Delta = 0.2 m, h_r = %g m, mu_s = %g, F = %g N"
+                 % (BASE["hr"], BASE["mu"], LOAD))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+# ---------------------------------------------------------------------------------------------
+
+def summarise(results):
+    """The named figures of results.json."""
+    n = [r for r in results["normal"]["runs"] if r["ok"]]
+    s = results["sliding"]
+    sl = [r for r in s["runs"] if r["ok"]]
+    lim = {("%s, %s" % (l["name"], l["integrator"])): l for l in results["stability"]["limits"]}
+    default = lim.get("pair, lubrication, ab2")
+    euler = lim.get("pair, lubrication, euler")
+    rolling = [r for r in results["rolling"] if r["ok"] and not r["lubrication"]]
+    stuck_euler = [r for r in sl + s["extra"] if r["ok"] and r.get("stuck") and r["integrator"] == "euler"]
+    stuck_ab2 = [r for r in sl + s["extra"] if r["ok"] and r.get("stuck") and r["integrator"] == "ab2"]
+    return dict(
+        normal_gap_error=max(abs(r["gap_error"]) for r in n),
+        normal_force_error=max(abs(r["normal_force_error"]) for r in n),
+        normal_force_balance=max(r["force_balance"] for r in n if r["force_balance"] is not None),
+        normal_history_vs_prediction=max(r.get("history_vs_prediction", 0.0) for r in n),
+        sliding_threshold_ratio=s["threshold"]["ratio"] if s["threshold"] else None,
+        sliding_force_ratio=max((abs(r["ft_over_muFn"] - 1) for r in sl if not r["stuck"]), default=None),
+        sliding_speed_error=max((abs(r["sliding_speed_error"]) for r in sl if not r["stuck"]), default=None),
+        stick_force_error=max((abs(r["ft_over_Ft"] - 1) for r in sl if r["stuck"]), default=None),
+        stick_displacement_ratio_euler=[r["displacement_over_spring"] for r in stuck_euler],
+        stick_displacement_ratio_ab2=[r["displacement_over_spring"] for r in stuck_ab2],
+        rolling_force_ratio=rolling[0]["ft_over_Ft"] if rolling else None,
+        stability_limit_dt=default["dt_measured"] if default else None,
+        stability_limit_dt_estimate=default["dt_estimate"] if default else None,
+        stability_limit_ratio=default["measured_over_estimate"] if default else None,
+        stability_limit_dt_euler=euler["dt_measured"] if euler else None,
+        stability_limit_dt_estimate_euler=euler["dt_estimate"] if euler else None,
+        stability_limits={k: dict(dt_measured=v["dt_measured"], dt_estimate=v["dt_estimate"],
+                                  ratio=v["measured_over_estimate"], zeta=v["zeta"], r_measured=v["r_measured"])
+                          for k, v in lim.items()},
+    )
+
+
+def print_report(results):
+    f = results["figures"]
+    print("(a) normal contact under F = %g N (gap error relative to F/k_n):" % LOAD)
+    print("  %-5s %-4s %9s %7s %10s %10s %9s %9s %9s %9s %9s" % ("geom", "lub", "k_n", "h_r", "gap theory", "gap end",
+                                                                  "error", "tau [s]", "t_contact", "t_settle",
+                                                                  "predicted"))
+    for r in results["normal"]["runs"]:
+        if not r["ok"]:
+            print("  %s k_n %g: run failed" % (r["geometry"], r["kn"]))
+            continue
+        print("  %-5s %-4s %9.1f %7.4f %10.4g %10.4g %9.1e %9.3g %9.3g %9s %9s" % (
+            r["geometry"], "yes" if r["lubrication"] else "no", r["kn"], r["hr"], r["gap_theory"], r["gap_end"],
+            r["gap_error"], r["tau_steady"], r["t_contact"] or float("nan"),
+            "%.3g" % r["t_settle"] if r["t_settle"] is not None else "-",
+            "%.3g" % r["t_settle_predicted"] if r.get("t_settle_predicted") is not None else "-"))
+    print("  largest |F1 + F2|/F = %.2e; gap history against the prediction: %.2e F/k_n"
+          % (f["normal_force_balance"], f["normal_history_vs_prediction"]))
+    print("(b) sphere between two walls, F_n = %g N per contact, mu_s = %g:" % (LOAD, BASE["mu"]))
+    for r in results["sliding"]["runs"] + results["sliding"]["extra"]:
+        if not r["ok"]:
+            print("  Ft/(mu Fn) %g: run failed" % r["ratio"])
+            continue
+        if r["stuck"]:
+            print("  Ft/(mu Fn) %-5g %-5s lub %-3s stuck:   ft/Ft %.9f, displacement / (Ft/k_t) %.6f" % (
+                r["ratio"], r["integrator"], "yes" if r["lubrication"] else "no", r["ft_over_Ft"],
+                r["displacement_over_spring"]))
+        else:
+            print("  Ft/(mu Fn) %-5g %-5s lub %-3s sliding: ft/(mu Fn) %.9f, U %.5g m/s (theory %.5g)" % (
+                r["ratio"], r["integrator"], "yes" if r["lubrication"] else "no", r["ft_over_muFn"], r["U_end"],
+                r["sliding_speed_theory"]))
+    if results["sliding"]["threshold"]:
+        t = results["sliding"]["threshold"]
+        print("  threshold: Ft/(mu_s Fn) = %.5f (bracket %.5f .. %.5f)" % (t["ratio"], t["bracket"][0], t["bracket"][1]))
+    for r in results["rolling"]:
+        if r["ok"]:
+            print("  one wall, pulled at the centre (rolls), lubrication %s: ft/Ft = %.6f (4/7 = %.6f without "
+                  "lubrication), slip/U %.1e" % ("yes" if r["lubrication"] else "no", r["ft_over_Ft"], 4 / 7.,
+                                                 r["slip_over_U"]))
+    print("(c) stability limit of dt (bisection to %g %%):" % (100 * results["stability"]["bisection_tolerance"]))
+    print("  %-42s %-5s %10s %12s %12s %8s %8s" % ("scene", "integ", "zeta", "dt measured", "dt estimate", "ratio",
+                                                   "r meas."))
+    for l in results["stability"]["limits"]:
+        print("  %-42s %-5s %10.4g %12.5g %12.5g %8.4f %8.4f" % (l["name"], l["integrator"], l["zeta"],
+                                                                 l["dt_measured"], l["dt_estimate"],
+                                                                 l["measured_over_estimate"], l["r_measured"]))
+    print("  pair with lubrication, dt grid (r = dt k_n / zeta):")
+    for g in results["stability"]["grid"]:
+        if g.get("config"):
+            continue
+        print("    %-5s r %5.2f: growth factor %s (theory %.3f), %s, gap %.4g .. %.4g" % (
+            g["integrator"], g["r"], "%.3f" % g["factor_measured"] if g.get("factor_measured") is not None else "-",
+            g["factor_theory"], g["label"], g.get("min_gap", float("nan")), g.get("max_gap", float("nan"))))
+
+
+def _json_default(o):
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError("%r is not JSON serialisable" % (o,))
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--full", action="store_true", help="wider sweeps")
+    p.add_argument("--integrator", choices=("ab2", "euler"), default="ab2",
+                   help="position update of fix fdm/couple for the normal and sliding sweeps (the stability "
+                        "study runs both)")
+    p.add_argument("--jobs", type=int, default=2, help="fdmDEM runs at once")
+    p.add_argument("--only", nargs="+", choices=("normal", "sliding", "stability"), default=None)
+    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
+    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
+    args = p.parse_args(argv)
+    parts = args.only or ["normal", "sliding", "stability"]
+
+    os.makedirs(args.workdir, exist_ok=True)
+    t0 = time.time()
+    cutoff, wall_cutoff = probe_cutoffs(args.workdir)
+    res = Resistance(BASE["a"], BASE["eta"], BASE["delta"], cutoff, wall_cutoff)
+    results = dict(case="contactTuning", full=args.full, units="SI, a = 1 m, eta = 1 Pa s",
+                   parameters=dict(BASE, load=LOAD, cutoff_cells=cutoff, wall_cutoff_cells=wall_cutoff),
+                   integrator=args.integrator)
+    if "normal" in parts:
+        t = time.time()
+        results["normal"] = dict(runs=normal_sweep(res, args.workdir, args.full, args.jobs, args.integrator))
+        results["normal"]["seconds"] = time.time() - t
+    if "sliding" in parts:
+        t = time.time()
+        results["sliding"] = sliding_sweep(res, args.workdir, args.full, args.jobs, args.integrator)
+        results["rolling"] = rolling_runs(res, args.workdir, args.jobs, args.integrator)
+        results["sliding"]["seconds"] = time.time() - t
+    if "stability" in parts:
+        t = time.time()
+        results["stability"] = stability_study(res, args.workdir, args.full, args.jobs)
+        results["stability"]["seconds"] = time.time() - t
+    if len(parts) == 3:
+        results["figures"] = summarise(results)
+    results["wall_seconds"] = time.time() - t0
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=1, default=_json_default)
+    if len(parts) == 3:
+        print_report(results)
+        plot(results, os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_contactTuning.png"))
+    print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))
+    return results
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,112 @@
+"""The sub-grid lubrication in the coupled code (real fdmFoam + real fdmDEM with pair_style fdm/subgrid):
+squeeze flow of an unequal pair and of a sphere toward a wall against theory (cases pairSqueeze,
+wallSqueeze, small meshes), frame invariance of the coupled system (Eq. 24), and a pair in shear."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+from conftest import load_case_module
+from fdm import case, output
+
+
+@pytest.fixture(scope="module")
+def pair_squeeze():
+    return load_case_module("pairSqueeze")
+
+
+@pytest.fixture(scope="module")
+def wall_squeeze():
+    return load_case_module("wallSqueeze")
+
+
+def test_pair_squeeze_unequal_spheres(tmp_path, env, pair_squeeze):
+    # a2/a1 = 1.4: the closing velocity under equal and opposite forces, against Jeffrey & Onishi
+    from fdm import theory
+    xis = [1e-2, 1e-3, 1e-4]
+    ref = [theory.pair_squeeze_velocity(1.0, 1.4, xi) for xi in xis]
+    on = pair_squeeze.run_pair(str(tmp_path), 1.4, xis, True, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-4)
+    assert on["converged"]
+    errors = [(v - r) / r for v, r in zip(on["velocity"], ref)]
+    assert max(abs(e) for e in errors) < 0.05, errors
+    # without the correction the FDM alone cannot resolve the gap: the pair closes far too fast
+    off = pair_squeeze.run_pair(str(tmp_path), 1.4, [1e-3], False, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-4)
+    assert (off["velocity"][0] - ref[1]) / ref[1] > 1.0, (off["velocity"], ref[1])
+
+
+def test_wall_squeeze(tmp_path, env, wall_squeeze):
+    from fdm import theory
+    epss = [1e-2, 1e-3]
+    ref = [theory.wall_squeeze_velocity(1.0, e) for e in epss]
+    on = wall_squeeze.run_wall(str(tmp_path), epss, True, a_over_delta=4.0, L_over_a=8.0, H_over_a=10.0,
+                               tol_lambda=1e-4)
+    errors = [(v - r) / r for v, r in zip(on["velocity"], ref)]
+    assert max(abs(e) for e in errors) < 0.05, errors
+    off = wall_squeeze.run_wall(str(tmp_path), [1e-3], False, a_over_delta=4.0, L_over_a=8.0, H_over_a=10.0,
+                                tol_lambda=1e-4)
+    assert (off["velocity"][0] - ref[1]) / ref[1] > 1.0, (off["velocity"], ref[1])
+
+
+def run_sheared_pair(root, frame_velocity):
+    """Two close unequal spheres (xi = 0.01, oblique to the flow) held in a Couette cell whose walls
+    move at (-U + V, U + V): the same scene seen from a frame translating at -V along x."""
+    H, U, V = 6.0, 3.0, frame_velocity
+    box = case.Box((0, 0, 0), (8.0, H, 6.0), 1.0 / 3.0,
+                   faces=("cyclic", ((-U + V, 0, 0), (U + V, 0, 0)), "cyclic"))
+    a1, a2, xi = 1.0, 1.4, 0.01
+    r = (a1 + a2) * (1 + xi / 2)
+    d = np.array([0.8, 0.6, 0.0])
+    x1 = np.array([3.1, 2.4, 3.05])
+    x2 = x1 + r * d
+    case.write_fluid_case(os.path.join(root, "fluid"), box, tol_lambda=1e-7, n_max=6000, n_particles=2)
+    case.write_dem_input(os.path.join(root, "dem"), box, [tuple(x1) + (a1,), tuple(x2) + (a2,)],
+                         pair_style="fdm/subgrid wall ylo %r 0 0 wall yhi %r 0 0" % (-U + V, U + V))
+    case.run(root)
+    parts = output.particles(os.path.join(root, "fluid"))
+    return {c: parts[c] for c in ("Ux", "Uy", "Uz", "Wx", "Wy", "Wz")}
+
+
+def test_frame_invariance_of_the_coupled_system(tmp_path, env):
+    # Eq. (24): the sub-grid correction sees only relative motion, so the same scene in a frame
+    # translating along the walls gives the same relative velocities and the same rotations, and
+    # velocities shifted by the frame velocity.
+    V = 0.7
+    a = run_sheared_pair(str(tmp_path / "rest"), 0.0)
+    b = run_sheared_pair(str(tmp_path / "moving"), V)
+    scale = 1.0  # shear rate 1 x a1
+    rel_a = np.array([a[c][1] - a[c][0] for c in ("Ux", "Uy", "Uz")])
+    rel_b = np.array([b[c][1] - b[c][0] for c in ("Ux", "Uy", "Uz")])
+    assert np.abs(rel_a).max() > 1e-3  # the pair does move relative to itself
+    assert np.abs(rel_a - rel_b).max() < 1e-4 * scale, (rel_a, rel_b)
+    for c in ("Wx", "Wy", "Wz"):
+        assert np.abs(a[c] - b[c]).max() < 1e-4 * scale, (c, a[c], b[c])
+    assert np.abs(b["Ux"] - a["Ux"] - V).max() < 1e-4 * scale
+
+
+@pytest.fixture(scope="module")
+def pair_shear():
+    return load_case_module("pairShear")
+
+
+def test_pair_in_shear_comes_close_but_never_touches(tmp_path, env, pair_shear):
+    # Equal spheres without contact, r_y0 = 0.5 (paper 5.3, CI size): the sub-grid lubrication lets
+    # the pair come within 1e-3 a1 but not closer than the 1e-5 floor (paper: ~4e-5 a1 on the
+    # limiting open trajectory); without it the FDM alone lets them pass through each other.
+    t = pair_shear.run_trajectory(str(tmp_path), ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
+                                  size=(12.0, 8.0, 6.0), dt=0.05)
+    s = pair_shear.summarise(t)
+    assert np.isfinite(t["xi"]).all()
+    assert "r_y_end" in s, "the trajectory did not come back to |r_x| = %g" % -s["r_x_start"]
+    assert 1e-5 < s["min_gap_over_a1"] < 1e-3, s
+    assert s["r_y_end"] > 0, s  # an open trajectory: sphere 2 passes over sphere 1
+
+
+@pytest.mark.full
+@pytest.mark.xfail(strict=True, reason="fore-aft asymmetry 0.68 at dt = 0.05, 0.31 at dt = 0.025 (docs/validation.md): "
+                                       "a time-step error not yet understood")
+def test_pair_in_shear_is_fore_aft_symmetric(tmp_path, env, pair_shear):
+    t = pair_shear.run_trajectory(str(tmp_path), ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
+                                  size=(12.0, 8.0, 6.0), dt=0.05)
+    s = pair_shear.summarise(t)
+    assert abs(s["fore_aft_asymmetry"]) < 0.02, s
