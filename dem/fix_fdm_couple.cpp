@@ -89,7 +89,7 @@ struct FixFdmCouple::System {
 };
 
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
-  Fix(lmp, narg, arg), move_(true), adamsBashforth_(true), haveVelocities_(false), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(false), tolerance_(1e-10), pair_(nullptr),
+  Fix(lmp, narg, arg), move_(true), adamsBashforth_(true), haveVelocities_(false), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), solverIterationsMax_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0)

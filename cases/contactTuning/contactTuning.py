@@ -18,8 +18,10 @@ LIGGGHTS input in this folder (in.normal, in.wall, in.sliding) that runs by hand
   stability the explicit contact with the implicit (overdamped) velocity solve: per step the gap error
             is multiplied by 1 - r (position update euler) or by the largest root of
             l^2 - (1 - 3r/2) l - r/2 = 0 (ab2, the fix's default), r = dt k_n / zeta at the steady gap;
-            the limit dt (bisection) against the estimate 2 zeta/k_n (euler) or zeta/k_n (ab2), for
-            the pair with and without lubrication, the wall, and the tangential spring (2 zeta_t/(2 k_t))
+            the limit dt (bisection) against the estimate 2 zeta/k (euler) or zeta/k (ab2), for the
+            normal spring (k_n) of the pair with and without lubrication and of the wall, and for the
+            tangential spring (k_t; 2 k_t for a sphere between two walls), whose history follows the
+            displacement of the step and so has the same limit
 
   contactTuning.py            the small sweeps (about a minute on 2 cores)
   contactTuning.py --full     wider sweeps (k_n, h_r, loads through overlap, both integrators, dt grids)
@@ -463,10 +465,9 @@ def sliding_run(res, workdir, ratio, integrator="ab2", lubrication=True, Fn=LOAD
                normal_force_sum_max=float(np.max(np.abs(d[:, 5]))), gap_wall=float(d[-1, 6]),
                gap_wall_theory=g_w)
     if stuck:
+        # the spring history adds the displacement of each step (either integrator): the sphere's
+        # displacement is the spring's elongation Ft/kt
         out["displacement_over_spring"] = float(dx[-1] / (Ft / kt))
-        # the position update ab2 moves the sphere by 1/2 dt (U_last - U_first) less than the spring
-        # history (which adds dt U_n each step): the first velocity is u[0]
-        out["ab2_offset_expected"] = float(-0.5 * dt * u[0]) if integrator == "ab2" else 0.0
     else:
         out["sliding_speed_theory"] = sliding_speed
         out["sliding_speed_error"] = float((u[-1] - sliding_speed) / sliding_speed)

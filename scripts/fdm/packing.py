@@ -1,0 +1,388 @@
+"""Random dense packings of spheres in a periodic box (numpy only), written as LIGGGHTS data files.
+
+    from fdm import packing
+    p = packing.random_packing(1000, 0.45, bidisperse=True, seed=1)   # the paper's a1 = 1, a2 = 1.4
+    p.min_gap, p.phi, p.box                                           # measured, not assumed
+    packing.write_data("spheres.data", p)                            # atom_style sphere, type 1 / 2
+    case.write_dem_input(dem_dir, box, p.spheres(), ...)             # or as (x, y, z, a) tuples
+    demonly.Scene(p, ...)                                            # fdmDEM scenes (fdm/demonly.py)
+
+Command line (prints a summary, writes the data file):
+
+    python3 -m fdm.packing N PHI [--bidisperse] [--seed S] [--min-gap G] [--box-multiple D]
+                                 [--shake SWEEPS] [--walls y] -o FILE
+
+Boxes are periodic, or wall-bounded along some axes (walls=(1,): planar walls at y = 0 and
+y = L, every sphere at least min_gap from them; LIGGGHTS boundary 'p f p'), for Couette cells.
+
+Method. Radii: all a1 (monodisperse) or the paper's bidisperse suspension (section 6: a1 = 1,
+a2 = 1.4 a1, the two populations occupying equal volumes, i.e. n1 a1^3 = n2 a2^3). The cubic box
+side follows from the target volume fraction phi (optionally rounded to a multiple of a mesh size,
+so that the same box can be meshed by blockMesh; phi is then recomputed). Centres are placed
+uniformly at random at their full size (overlapping), then the overlaps are removed by iterative
+pairwise displacement ("overlap relaxation"): every pair whose surface gap is below a target gap
+g_t = (1 + margin) min_gap is pushed apart along its line of centres, each sphere by 0.55 of the
+deficit (a slight over-relaxation; minimum image in the periodic directions; a sphere closer than
+g_t to a wall is put back at g_t), all pairs at once, until the smallest surface gap in the box is
+>= min_gap: 100-350 sweeps at phi = 0.45-0.5. The result is a stiff, worst case for lubrication:
+the relaxation leaves the pairs it separated at about g_t, ~1.4 pairs per sphere below 1e-3 a1 at
+phi = 0.45 and ~1.7 at phi = 0.5 (min_gap 1e-4). Optionally, hard-sphere Monte Carlo sweeps (moves
+rejected if any gap would drop below min_gap) then loosen them: after 100 sweeps ~0.07 pairs per
+sphere below 1e-3 a1 at phi = 0.45 (1000 spheres: 5 s). Neighbours come from a periodic cell list
+(Verlet list with a skin, rebuilt when a sphere has moved half the skin): 1000 spheres at
+phi = 0.5 take under a second without Monte Carlo.
+
+The minimum gap is measured at the end over every pair (minimum image, O(N) with the cell list)
+and returned in Packing.min_gap; generation fails (RuntimeError) if it is below min_gap.
+Lengths are in units of a1 (scale them with `scale`)."""
+import argparse
+import math
+import sys
+
+import numpy as np
+
+A2_OVER_A1 = 1.4
+
+
+class Packing:
+    """N spheres in the box [0, L)^3, periodic except along the axes in walls (planar walls at 0 and
+    L there): positions (N, 3), radii (N,), types (N,) (1 for a1, 2 for a2), box (L, L, L), phi
+    (actual volume fraction), min_gap (smallest surface gap, pairs and walls, measured),
+    min_wall_gap, and the generator's statistics in info."""
+
+    def __init__(self, positions, radii, types, box, info=None, walls=()):
+        self.positions = np.asarray(positions, dtype=float)
+        self.radii = np.asarray(radii, dtype=float)
+        self.types = np.asarray(types, dtype=int)
+        self.box = np.asarray(box, dtype=float)
+        self.walls = tuple(walls)
+        self.info = dict(info or {})
+        self.min_gap = minimum_gap(self.positions, self.radii, self.box, self.walls)
+        w = wall_gaps(self.positions, self.radii, self.box, self.walls)
+        self.min_wall_gap = float(w.min()) if w.size else math.inf
+
+    @property
+    def boundary(self):
+        """LIGGGHTS boundary command arguments, e.g. 'p f p' for walls=(1,)."""
+        return " ".join("f" if d in self.walls else "p" for d in range(3))
+
+    @property
+    def n(self):
+        return len(self.radii)
+
+    @property
+    def phi(self):
+        return float(np.sum(4.0 / 3.0 * math.pi * self.radii ** 3) / np.prod(self.box))
+
+    def spheres(self):
+        """[(x, y, z, a), ...] as fdm.case.write_dem_input takes them."""
+        return [(float(x[0]), float(x[1]), float(x[2]), float(a)) for x, a in zip(self.positions, self.radii)]
+
+    def gaps(self, cutoff):
+        """Surface gaps of every pair closer than `cutoff` (surface to surface), sorted."""
+        i, j, d = neighbour_pairs(self.positions, self.box, 2 * self.radii.max() + cutoff, self.walls)
+        g = d - self.radii[i] - self.radii[j]
+        return np.sort(g[g < cutoff])
+
+    def summary(self):
+        gaps = self.gaps(0.1 * self.radii.min())
+        a = self.radii.min()
+        return ("%d spheres (%s), box %s (boundary %s), phi %.4f, min surface gap %.3g a1%s; pairs with gap "
+                "< 1e-3 a1: %d, < 1e-2 a1: %d, < 0.1 a1: %d; %s"
+                % (self.n, ", ".join("%d of radius %g" % (np.sum(self.radii == r), r) for r in np.unique(self.radii)),
+                   " x ".join("%g" % b for b in self.box), self.boundary, self.phi, self.min_gap / a,
+                   "" if not self.walls else " (walls: %.3g a1)" % (self.min_wall_gap / a),
+                   np.sum(gaps < 1e-3 * a), np.sum(gaps < 1e-2 * a), len(gaps),
+                   ", ".join("%s %s" % (k, v) for k, v in self.info.items())))
+
+
+def counts(n, bidisperse):
+    """(n1, n2): sphere counts of radius a1 and a2 = 1.4 a1 with equal volumes (n1 a1^3 = n2 a2^3)."""
+    if not bidisperse:
+        return n, 0
+    n2 = int(round(n / (1.0 + A2_OVER_A1 ** 3)))
+    return n - n2, n2
+
+
+def box_side(radii, phi, multiple=None):
+    """Side of the cube holding spheres of these radii at volume fraction phi (rounded to the
+    nearest multiple of `multiple`, e.g. the mesh size, if given)."""
+    side = (np.sum(4.0 / 3.0 * math.pi * np.asarray(radii) ** 3) / phi) ** (1.0 / 3.0)
+    if multiple:
+        side = max(1, round(side / multiple)) * multiple
+    return float(side)
+
+
+# ------------------------------------------------------------------------------------------------
+# neighbour search: periodic cell list, vectorised
+# ------------------------------------------------------------------------------------------------
+
+def _periodic_mask(walls):
+    mask = np.ones(3, dtype=bool)
+    for axis in walls:
+        mask[axis] = False
+    return mask
+
+
+def _minimum_image(dx, box, periodic=(True, True, True)):
+    return dx - np.where(periodic, box, 0.0) * np.round(dx / box)
+
+
+def _wrap(x, box, periodic):
+    return x - np.where(periodic, box, 0.0) * np.floor(x / box)
+
+
+def neighbour_pairs(x, box, cutoff, walls=()):
+    """Every pair i < j with centre distance < cutoff (minimum image in the periodic directions,
+    i.e. all but the axes listed in walls); returns (i, j, distance). Needs cutoff < box/2."""
+    x = np.asarray(x, dtype=float)
+    box = np.asarray(box, dtype=float)
+    periodic = _periodic_mask(walls)
+    n = len(x)
+    if np.any(cutoff >= box / 2):
+        raise ValueError("neighbour cut-off %g is not below half the box %s" % (cutoff, box))
+    ncell = np.maximum(np.floor(box / cutoff).astype(int), 1)
+    if np.any(ncell < 3) or n < 64:
+        # small box or few spheres: all pairs
+        i, j = np.triu_indices(n, 1)
+    else:
+        # cells wrap in every direction; in a wall-bounded one the true distance removes the far pairs
+        xw = np.clip(_wrap(x, box, periodic), 0.0, box * (1 - 1e-15))
+        c = np.minimum((xw / (box / ncell)).astype(int), ncell - 1)
+        cell = (c[:, 0] * ncell[1] + c[:, 1]) * ncell[2] + c[:, 2]
+        order = np.argsort(cell, kind="stable")
+        ncells = int(np.prod(ncell))
+        occupancy = np.bincount(cell, minlength=ncells)
+        start = np.concatenate(([0], np.cumsum(occupancy)[:-1]))
+        width = int(occupancy.max())
+        members = -np.ones((ncells, width), dtype=int)
+        rank = np.arange(n) - start[cell[order]]
+        members[cell[order], rank] = order
+        ii, jj = [], []
+        for o in np.array(np.meshgrid([-1, 0, 1], [-1, 0, 1], [-1, 0, 1], indexing="ij")).reshape(3, -1).T:
+            cn = (c + o) % ncell
+            other = members[(cn[:, 0] * ncell[1] + cn[:, 1]) * ncell[2] + cn[:, 2]]  # (n, width)
+            i_ = np.repeat(np.arange(n), width)
+            j_ = other.ravel()
+            keep = (j_ > i_)
+            ii.append(i_[keep])
+            jj.append(j_[keep])
+        i = np.concatenate(ii)
+        j = np.concatenate(jj)
+        # a pair can be seen through two offsets only if ncell < 3 (excluded above): no duplicates
+    d = np.linalg.norm(_minimum_image(x[i] - x[j], box, periodic), axis=1)
+    keep = d < cutoff
+    return i[keep], j[keep], d[keep]
+
+
+def wall_gaps(x, radii, box, walls=()):
+    """Surface gaps to the walls (the faces 0 and L of each axis in walls), shape (N, 2 len(walls))."""
+    cols = []
+    for axis in walls:
+        cols.append(x[:, axis] - radii)
+        cols.append(box[axis] - x[:, axis] - radii)
+    return np.array(cols).T if cols else np.zeros((len(radii), 0))
+
+
+def minimum_gap(x, radii, box, walls=()):
+    """Smallest surface gap over every pair (minimum image in the periodic directions) and, with
+    walls, every sphere-wall gap; +inf for a single sphere without walls."""
+    g = math.inf
+    w = wall_gaps(x, radii, box, walls)
+    if w.size:
+        g = float(w.min())
+    if len(radii) < 2:
+        return g
+    rmax = float(np.max(radii))
+    cutoff = min(2 * rmax * 1.5, 0.499 * float(np.min(box)))
+    i, j, d = neighbour_pairs(x, box, cutoff, walls)
+    if len(i) == 0:
+        return min(g, math.inf if cutoff >= 2 * rmax else float(cutoff - 2 * rmax))
+    return min(g, float(np.min(d - radii[i] - radii[j])))
+
+
+# ------------------------------------------------------------------------------------------------
+# generation
+# ------------------------------------------------------------------------------------------------
+
+def relax_overlaps(x, radii, box, min_gap, margin=0.5, max_iterations=20000, skin=None, step=0.55, walls=()):
+    """Pushes apart every pair (and pushes off the walls every sphere) with a surface gap below
+    (1 + margin) min_gap until the smallest gap is >= min_gap. x is modified in place; returns the
+    number of sweeps."""
+    periodic = _periodic_mask(walls)
+    target = (1.0 + margin) * min_gap
+    skin = 0.3 * float(np.min(radii)) if skin is None else skin
+    cutoff = 2 * float(np.max(radii)) + target + skin
+    reference = x.copy()
+    i, j, _ = neighbour_pairs(x, box, cutoff, walls)
+    contact = radii[i] + radii[j] + target
+    for sweep in range(1, max_iterations + 1):
+        if np.max(np.linalg.norm(_minimum_image(x - reference, box, periodic), axis=1)) > 0.5 * skin:
+            reference = x.copy()
+            i, j, _ = neighbour_pairs(x, box, cutoff, walls)
+            contact = radii[i] + radii[j] + target
+        dx = _minimum_image(x[i] - x[j], box, periodic)
+        d = np.linalg.norm(dx, axis=1)
+        deficit = contact - d
+        bad = deficit > 0
+        wall_gap = wall_gaps(x, radii, box, walls)
+        pair_ok = not np.any(bad) or np.min(d - radii[i] - radii[j]) >= min_gap
+        if pair_ok and (wall_gap.size == 0 or wall_gap.min() >= min_gap):
+            return sweep
+        for k, axis in enumerate(walls):  # off the walls, to the target gap
+            lo = np.maximum(target - wall_gap[:, 2 * k], 0.0)
+            hi = np.maximum(target - wall_gap[:, 2 * k + 1], 0.0)
+            x[:, axis] += lo - hi
+        b = np.nonzero(bad)[0]
+        dd = np.where(d[b] > 0, d[b], 1e-12)
+        n = dx[b] / dd[:, None]
+        n[d[b] == 0] = np.array([1.0, 0.0, 0.0])
+        push = (step * deficit[b])[:, None] * n
+        move = np.zeros_like(x)
+        np.add.at(move, i[b], push)
+        np.add.at(move, j[b], -push)
+        x += move
+        x[:] = _wrap(x, box, periodic)
+    raise RuntimeError("overlap relaxation did not reach a minimum gap of %g in %d sweeps (phi too high?)"
+                       % (min_gap, max_iterations))
+
+
+def shake(x, radii, box, min_gap, sweeps, rng, max_step=None, walls=()):
+    """Hard-sphere Monte Carlo: each sweep tries one random displacement per sphere (uniform in a
+    cube of half-side max_step, adapted towards 40 % acceptance, at least 0.02 a1), rejected if any surface gap would
+    drop below min_gap (pairs and walls). x is modified in place; returns the acceptance ratio."""
+    periodic = _periodic_mask(walls)
+    n = len(radii)
+    step = 0.1 * float(np.min(radii)) if max_step is None else max_step
+    min_step = 0.02 * float(np.min(radii))  # a floor: gaps of 1e-4 must not freeze the moves
+    skin = 0.5 * float(np.min(radii))
+    cutoff = 2 * float(np.max(radii)) + min_gap + skin
+    accepted = tried = 0
+    for _ in range(sweeps):
+        i, j, _ = neighbour_pairs(x, box, cutoff, walls)
+        neighbours = [[] for _ in range(n)]
+        for a, b in zip(i.tolist(), j.tolist()):
+            neighbours[a].append(b)
+            neighbours[b].append(a)
+        neighbours = [np.array(v, dtype=int) for v in neighbours]
+        start = x.copy()
+        step = min(step, 0.2 * skin)  # a move plus the sweep's drift stays within the skin
+        acc_sweep = 0
+        for p in rng.permutation(n):
+            trial = x[p] + rng.uniform(-step, step, 3)
+            if np.linalg.norm(_minimum_image(trial - start[p], box, periodic)) > 0.45 * skin:
+                continue
+            if any(trial[a] - radii[p] < min_gap or box[a] - trial[a] - radii[p] < min_gap for a in walls):
+                tried += 1
+                continue
+            nb = neighbours[p]
+            if len(nb):
+                d = np.linalg.norm(_minimum_image(x[nb] - trial, box, periodic), axis=1)
+                if np.any(d - radii[nb] - radii[p] < min_gap):
+                    tried += 1
+                    continue
+            x[p] = _wrap(trial, box, periodic)
+            accepted += 1
+            acc_sweep += 1
+            tried += 1
+        ratio = acc_sweep / n
+        step = max(step * (1.2 if ratio > 0.4 else 0.8), min_step)
+    return accepted / tried if tried else 0.0
+
+
+def random_packing(n, phi, bidisperse=False, seed=0, min_gap=1e-4, box_multiple=None, shake_sweeps=0,
+                   margin=0.5, a1=1.0, walls=()):
+    """A random packing of n spheres at volume fraction phi in a cube (see the module's docstring),
+    periodic except along the axes in walls (e.g. walls=(1,): planar walls at y = 0 and y = L, for
+    a Couette cell; every sphere at least min_gap from them too). min_gap: smallest surface gap
+    required (units of length, a1 = 1 by default); box_multiple: round the box side to a multiple
+    of this (a mesh size; phi changes slightly); shake_sweeps: hard-sphere Monte Carlo sweeps after
+    the relaxation. Deterministic for a seed."""
+    rng = np.random.default_rng(seed)
+    n1, n2 = counts(n, bidisperse)
+    radii = np.concatenate([np.full(n1, a1), np.full(n2, A2_OVER_A1 * a1)])
+    types = np.concatenate([np.ones(n1, dtype=int), 2 * np.ones(n2, dtype=int)])
+    perm = rng.permutation(n)  # mix the two sizes in tag order
+    radii, types = radii[perm], types[perm]
+    side = box_side(radii, phi, box_multiple)
+    box = np.full(3, side)
+    if 2 * radii.max() + 2 * min_gap >= side / 2:
+        raise ValueError("box side %g is too small for spheres of radius %g" % (side, radii.max()))
+    x = rng.uniform(0.0, 1.0, (n, 3)) * box
+    for axis in walls:  # centres where the sphere fits between the walls
+        x[:, axis] = radii + 2 * min_gap + rng.uniform(0.0, 1.0, n) * (side - 2 * radii - 4 * min_gap)
+    sweeps = relax_overlaps(x, radii, box, min_gap, margin=margin, walls=walls)
+    acceptance = shake(x, radii, box, min_gap, shake_sweeps, rng, walls=walls) if shake_sweeps else None
+    info = dict(seed=seed, relaxation_sweeps=sweeps)
+    if shake_sweeps:
+        info.update(mc_sweeps=shake_sweeps, mc_acceptance=round(acceptance, 3))
+    p = Packing(x, radii, types, box, info, walls)
+    if not (p.min_gap >= min_gap):
+        raise RuntimeError("packing has a minimum gap %g below the requested %g" % (p.min_gap, min_gap))
+    return p
+
+
+def write_data(path, p, density=1000.0, scale=1.0, title=None):
+    """LIGGGHTS data file (read_data; atom_style sphere: id type diameter density x y z), box
+    [0, L)^3, one atom type per radius (1: a1, 2: a2). scale multiplies every length."""
+    ntypes = int(p.types.max())
+    with open(path, "w") as f:
+        if title is None:  # LIGGGHTS reads a short first line only
+            title = "fdm.packing: %d spheres, box %s (%s), phi %.5f, min surface gap %.4g" % (
+                p.n, " ".join("%.10g" % b for b in p.box), p.boundary, p.phi, p.min_gap)
+        f.write("%s\n\n%d atoms\n%d atom types\n\n" % (title[:200], p.n, ntypes))
+        for d, axis in enumerate("xyz"):
+            f.write("0 %.17g %slo %shi\n" % (scale * p.box[d], axis, axis))
+        f.write("\nAtoms\n\n")
+        for k in range(p.n):
+            x = scale * p.positions[k]
+            f.write("%d %d %.17g %.17g %.17g %.17g %.17g\n"
+                    % (k + 1, p.types[k], 2 * scale * p.radii[k], density, x[0], x[1], x[2]))
+    return path
+
+
+def read_data(path, walls=()):
+    """Reads a data file written by write_data (or any atom_style sphere data file with a box
+    starting at 0) back into a Packing (walls: the wall-bounded axes, not in the file)."""
+    box = np.zeros(3)
+    atoms = []
+    with open(path) as f:
+        lines = f.read().splitlines()
+    section = None
+    for line in lines[1:]:
+        words = line.split("#")[0].split()
+        if not words:
+            continue
+        if len(words) == 4 and words[2].endswith("lo") and words[3].endswith("hi"):
+            box["xyz".index(words[2][0])] = float(words[1]) - float(words[0])
+        elif words[0] == "Atoms":
+            section = "atoms"
+        elif section == "atoms" and len(words) >= 7:
+            atoms.append([float(w) for w in words[:7]])
+    a = np.array(sorted(atoms))
+    return Packing(a[:, 4:7], a[:, 2] / 2, a[:, 1].astype(int), box, walls=walls)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("n", type=int, help="number of spheres")
+    ap.add_argument("phi", type=float, help="target volume fraction")
+    ap.add_argument("--bidisperse", action="store_true", help="a1 = 1, a2 = 1.4, equal volumes (paper section 6)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--min-gap", type=float, default=1e-4, help="smallest surface gap [a1] (default 1e-4)")
+    ap.add_argument("--box-multiple", type=float, default=None, help="round the box side to a multiple of this")
+    ap.add_argument("--shake", type=int, default=0, help="hard-sphere Monte Carlo sweeps after the relaxation")
+    ap.add_argument("--walls", default="", help="wall-bounded axes, e.g. y (walls at y = 0 and y = L)")
+    ap.add_argument("--density", type=float, default=1000.0)
+    ap.add_argument("-o", "--output", default=None, help="LIGGGHTS data file to write")
+    args = ap.parse_args(argv)
+    p = random_packing(args.n, args.phi, args.bidisperse, args.seed, args.min_gap, args.box_multiple, args.shake,
+                       walls=tuple("xyz".index(c) for c in args.walls))
+    print(p.summary())
+    if args.output:
+        write_data(args.output, p, args.density)
+        print("wrote", args.output)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
