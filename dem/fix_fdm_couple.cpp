@@ -70,6 +70,10 @@ void FixFdmCouple::Timing::add(const Timing &t)
   solves += t.solves;
   solverIterations += t.solverIterations;
   solverIterationsMax = std::max(solverIterationsMax, t.solverIterationsMax);
+  gapTargets += t.gapTargets;
+  gapLimited += t.gapLimited;
+  gapFallbacks += t.gapFallbacks;
+  gapSweepsMax = std::max(gapSweepsMax, t.gapSweepsMax);
 }
 
 // Eq. (31) on rank 0 for one time step.
@@ -89,7 +93,7 @@ struct FixFdmCouple::System {
 };
 
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
-  Fix(lmp, narg, arg), move_(true), adamsBashforth_(true), haveVelocities_(false), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
+  Fix(lmp, narg, arg), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), solverIterationsMax_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0)
@@ -145,6 +149,11 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       const std::string v = value(1);
       if (v != "euler" && v != "ab2") error->all(FLERR, "fix fdm/couple: integrator must be euler or ab2");
       adamsBashforth_ = (v == "ab2");
+      i++;
+    } else if (key == "gap_update") {
+      const std::string v = value(1);
+      if (v != "log" && v != "none") error->all(FLERR, "fix fdm/couple: gap_update must be log or none");
+      gapUpdate_ = (v == "log");
       i++;
     } else if (key == "stresslets") {
       const std::string v = value(1);
@@ -566,6 +575,27 @@ void FixFdmCouple::setup(int)
   // set between runs of fixed particles); later runs continue from where contacts (h_r > 0, finite
   // kn) may legitimately have pressed particles a little into each other.
   allAgree(comm->me == 0 ? checkConfiguration(particles, firstSetup || !move_) : std::string());
+  // A planned position update continues the previous run only from where that run left the
+  // particles: if the input has moved them since (set, displace_atoms, read_restart ...), the next
+  // step starts afresh (Euler from the current velocities, then Adams-Bashforth again).
+  int keepPlan = havePlan_ ? 1 : 0;
+  if (comm->me == 0 && keepPlan) {
+    for (int p = 0; p < natoms_ && keepPlan; p++) {
+      double d[3];
+      for (int k = 0; k < 3; k++) d[k] = particles[p].x[k] - planPositions_[size_t(3) * p + k];
+      domain->minimum_image(d);
+      if (std::fabs(d[0]) + std::fabs(d[1]) + std::fabs(d[2]) > 1e-12 * (1.0 + std::fabs(particles[p].x[0]) +
+                                                                      std::fabs(particles[p].x[1]) + std::fabs(particles[p].x[2])))
+        keepPlan = 0;
+    }
+  }
+  MPI_Bcast(&keepPlan, 1, MPI_INT, 0, world);
+  if (!keepPlan) {
+    havePlan_ = false;
+    haveVelocities_ = false;
+    previousVelocity_.clear();
+    planPositions_.clear();
+  }
   fillPerAtomArray();
   runStart_ = MPI_Wtime();
   run_ = Timing();
@@ -573,25 +603,21 @@ void FixFdmCouple::setup(int)
 
 void FixFdmCouple::initial_integrate(int)
 {
-  // Step 1 of the algorithm (4.3): move the particles with the velocities solved at the previous
-  // step. Nothing else: there is no particle inertia (Eq. 28d-e).
-  // Euler, x += dt U_n, moves two spheres turning around each other apart by (|U_t| dt)^2/(2r) every
-  // step: near contact (gaps of 1e-3 a and less in shear) that drift is larger than the gap itself
-  // and breaks the reversibility of Stokes flow unless dt is tiny. Adams-Bashforth 2,
-  // x += dt (3/2 U_n - 1/2 U_{n-1}), turns it into O(dt^4) at no extra fluid solve; its explicit
-  // stability limit for stiff contact springs is half Euler's (docs/contact.md).
+  // Step 1 of the algorithm (4.3): move the particles. Nothing else: there is no particle inertia
+  // (Eqs. 28d-e). The displacement rates were planned at the end of the previous step
+  // (planNextMove: Adams-Bashforth 2 with the log-gap correction of position_update.h); the very
+  // first step moves with the velocities the input gave.
   if (!move_) return;
   const double dt = update->dt;
-  const bool secondOrder = adamsBashforth_ && previousVelocity_.size() == solution_.size() && !previousVelocity_.empty();
   for (int i = 0; i < atom->nlocal; i++) {
-    if (secondOrder) {
-      // v and omega become the velocities of this move, so that the contact springs of the pair
-      // style (tangential displacement += dt v_rel) follow the contact points exactly; the solve at
-      // the end of the step sets them to U_{n+1} again
-      const double *before = &previousVelocity_[size_t(6) * (atom->tag[i] - 1)];
+    if (havePlan_) {
+      // v and omega become the rates of this move, so that the contact springs of the pair style
+      // (tangential displacement += dt v_rel) follow the contact points exactly; the solve at the
+      // end of the step sets them to U_{n+1} again
+      const double *rate = &moveRate_[size_t(6) * (atom->tag[i] - 1)];
       for (int d = 0; d < 3; d++) {
-        atom->v[i][d] = 1.5 * atom->v[i][d] - 0.5 * before[d];
-        atom->omega[i][d] = 1.5 * atom->omega[i][d] - 0.5 * before[3 + d];
+        atom->v[i][d] = rate[d];
+        atom->omega[i][d] = rate[3 + d];
       }
     }
     for (int d = 0; d < 3; d++) atom->x[i][d] += dt * atom->v[i][d];
@@ -912,14 +938,73 @@ void FixFdmCouple::final_integrate()
     }
   }
 
+  if (move_ && comm->me == 0) {
+    t0 = MPI_Wtime();
+    planNextMove(particles);
+    run_.solve += MPI_Wtime() - t0;
+  }
   t0 = MPI_Wtime();
   scatter();
   run_.gatherScatter += MPI_Wtime() - t0;
   run_.steps++;
 }
 
+void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
+{
+  // rank 0, U_n just solved at the positions x_n the step started from (particles): the rates of
+  // the next position update (position_update.h). currentVelocity_ still holds U_{n-1} here.
+  namespace motion = fdm::motion;
+  motion::Configuration c;
+  c.n = natoms_;
+  c.x.resize(size_t(3) * natoms_);
+  c.radius.resize(natoms_);
+  for (int p = 0; p < natoms_; p++) {
+    for (int k = 0; k < 3; k++) c.x[size_t(3) * p + k] = particles[p].x[k];
+    c.radius[p] = particles[p].radius;
+  }
+  c.u = solution_;
+  if (havePlan_ && haveVelocities_ && planPositions_.size() == c.x.size()) {
+    c.xPrevious = planPositions_;
+    c.uPrevious = currentVelocity_;
+  }
+  for (int d = 0; d < 3; d++) c.period[d] = domain->periodicity[d] ? domain->prd[d] : 0.0;
+
+  std::vector<int> closePairs;
+  std::vector<motion::Wall> walls;
+  if (gapUpdate_ && system_) {
+    const System &sys = *system_;
+    for (size_t b = 0; sys.pairRecord > 0 && b < sys.pairs.size() / sys.pairRecord; b++) {
+      closePairs.push_back(int(std::lround(sys.pairs[b * sys.pairRecord])) - 1);
+      closePairs.push_back(int(std::lround(sys.pairs[b * sys.pairRecord + 1])) - 1);
+    }
+  }
+  if (gapUpdate_ && pair_)
+    for (const PairFdmSubgrid::Wall &w : pair_->walls())
+      walls.push_back(motion::Wall{w.axis, w.side, w.side == 0 ? domain->boxlo[w.axis] : domain->boxhi[w.axis]});
+
+  motion::Options options;
+  options.adamsBashforth = adamsBashforth_;
+  options.gapCorrection = gapUpdate_;
+  const motion::Statistics stats = motion::displacementRates(c, closePairs, walls, update->dt, options, moveRate_);
+  run_.gapTargets += stats.pairGaps + stats.wallGaps;
+  run_.gapLimited += stats.limited;
+  run_.gapFallbacks += stats.fallback ? 1 : 0;
+  run_.gapSweepsMax = std::max(run_.gapSweepsMax, stats.sweeps);
+  planPositions_ = c.x;
+  havePlan_ = true;
+}
+
 void FixFdmCouple::scatter()
 {
+  if (move_) {
+    int planned = havePlan_ ? 1 : 0;
+    MPI_Bcast(&planned, 1, MPI_INT, 0, world);
+    havePlan_ = planned != 0;
+    if (havePlan_) {
+      moveRate_.resize(size_t(6) * natoms_);
+      MPI_Bcast(moveRate_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
+    }
+  }
   // the velocities of the step now ending are the "previous" ones of the next position update
   if (haveVelocities_) previousVelocity_ = currentVelocity_;
   MPI_Bcast(solution_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
@@ -971,15 +1056,25 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
 {
   if (comm->me != 0) return;
   const double percent = wall > 0 ? 100.0 / wall : 0.0;
-  char line[1024];
+  std::string gapStats = " (gap_update none)";
+  if (gapUpdate_) {
+    char g[200];
+    std::snprintf(g, sizeof g, " with log gaps: %.3g gap targets per step, at most %d sweeps, %ld limited, "
+                  "%ld steps kept straight (contradictory targets)",
+                  t.steps ? double(t.gapTargets) / t.steps : 0.0, t.gapSweepsMax, t.gapLimited, t.gapFallbacks);
+    gapStats = g;
+  }
+  char line[1400];
   std::snprintf(line, sizeof line,
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
-                "%s iterations mean %.1f max %ld; last step %ld sub-grid pair blocks, %ld wall blocks, %ld contacts%s\n",
+                "%s iterations mean %.1f max %ld; last step %ld sub-grid pair blocks, %ld wall blocks, %ld contacts; "
+                "position update %s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
                 directSolver_ ? "LDLT" : "CG", t.solves ? double(t.solverIterations) / t.solves : 0.0,
                 t.solverIterationsMax, pairBlocks_, wallBlocks_, contacts_,
+                adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");
   if (screen) fputs(line, screen);
   if (logfile) fputs(line, logfile);

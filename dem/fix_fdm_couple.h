@@ -4,6 +4,7 @@
      fix ID all fdm/couple [transport socket|file] [host H] [port P] [portfile F] [directory D]
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
                            [stresslets yes|no] [solver cg|ldlt] [tolerance t] [integrator ab2|euler]
+                           [gap_update log|none]
      fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
@@ -23,6 +24,7 @@
 
 #include "fix.h"
 #include "fdm/coupler.h"
+#include "position_update.h"
 
 #include <memory>
 #include <string>
@@ -70,7 +72,11 @@ class FixFdmCouple : public Fix {
   struct Timing {
     double solve, exchange, gatherScatter;
     long steps, solves, solverIterations, solverIterationsMax;
-    Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0) {}
+    long gapTargets, gapLimited;   // log-gap targets of the position update, and those limited
+    long gapFallbacks;             // steps where the targets contradicted each other (straight step)
+    int gapSweepsMax;
+    Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
+               gapTargets(0), gapLimited(0), gapFallbacks(0), gapSweepsMax(0) {}
     void add(const Timing &t);
   };
 
@@ -86,6 +92,7 @@ class FixFdmCouple : public Fix {
   void subgridResults(const std::vector<Particle> &particles);
   fdm::coupler::Message noFluidIntegrals(const std::vector<Particle> &particles) const;
   void storeStepDone(const fdm::coupler::Message &done);
+  void planNextMove(const std::vector<Particle> &particles);
   void scatter();
   void fillPerAtomArray();
   void allAgree(const std::string &problemOnRank0);
@@ -96,8 +103,13 @@ class FixFdmCouple : public Fix {
   double gravity_[3];
   bool move_;
   bool adamsBashforth_;      // position update: Adams-Bashforth 2 (default) or Euler
+  bool gapUpdate_;           // log-gap correction of the position update (position_update.h)
   bool haveVelocities_;
   std::vector<double> currentVelocity_, previousVelocity_;  // 6N by tag, U_n and U_{n-1}
+  // The next position update, planned on rank 0 once U_n is known and broadcast: displacement
+  // rates (6N by tag, x += dt rate), and the positions x_n it starts from (rank 0, 3N by tag).
+  bool havePlan_;
+  std::vector<double> moveRate_, planPositions_;
   double noFluidViscosity_, noFluidMesh_, noFluidDensity_;  // transport none (DEM only)
   bool stresslets_;          // per-particle stresslets asked for (fluid, sub-grid, contact)
   bool directSolver_;        // Eq. (31) by sparse LDLT instead of conjugate gradients

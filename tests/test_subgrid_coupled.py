@@ -95,24 +95,17 @@ def pair_shear():
     return load_case_module("pairShear")
 
 
-def test_pair_in_shear_comes_close_but_never_touches(tmp_path, env, pair_shear):
-    # Equal spheres without contact, r_y0 = 0.5 (paper 5.3, CI size): the sub-grid lubrication lets
-    # the pair come within 1e-3 a1 but not closer than the 1e-5 floor (paper: ~4e-5 a1 on the
-    # limiting open trajectory); without it the FDM alone lets them pass through each other.
+def test_pair_in_shear_is_fore_aft_symmetric(tmp_path, env, pair_shear):
+    # Equal smooth spheres, r_y0 = 0.5, dt = 0.05 / shear rate (paper 5.3 at CI size, about 3 min):
+    # Stokes flow is reversible, so the relative trajectory comes back to its initial offset (2 %, the
+    # issue's tolerance) with its closest approach at r_x = 0, and the spheres never touch. The
+    # straight Adams-Bashforth step (gap_update none) misses this by +68 % at the same dt, Euler by
+    # +198 % (docs/validation.md): the log-gap position update is what this test checks.
     t = pair_shear.run_trajectory(str(tmp_path), ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
                                   size=(12.0, 8.0, 6.0), dt=0.05)
     s = pair_shear.summarise(t)
     assert np.isfinite(t["xi"]).all()
     assert "r_y_end" in s, "the trajectory did not come back to |r_x| = %g" % -s["r_x_start"]
-    assert 1e-5 < s["min_gap_over_a1"] < 1e-3, s
-    assert s["r_y_end"] > 0, s  # an open trajectory: sphere 2 passes over sphere 1
-
-
-@pytest.mark.full
-@pytest.mark.xfail(strict=True, reason="fore-aft asymmetry 0.68 at dt = 0.05, 0.31 at dt = 0.025 (docs/validation.md): "
-                                       "a time-step error not yet understood")
-def test_pair_in_shear_is_fore_aft_symmetric(tmp_path, env, pair_shear):
-    t = pair_shear.run_trajectory(str(tmp_path), ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
-                                  size=(12.0, 8.0, 6.0), dt=0.05)
-    s = pair_shear.summarise(t)
     assert abs(s["fore_aft_asymmetry"]) < 0.02, s
+    assert abs(s["r_x_at_min_gap"]) < 0.3, s
+    assert 0 < s["min_gap_over_a1"] < 1e-3, s

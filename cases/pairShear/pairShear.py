@@ -32,7 +32,8 @@ from fdm import case, output  # noqa: E402
 
 
 def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0, size=(12.0, 8.0, 6.0), dt=0.05,
-                   tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True):
+                   tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True,
+                   gap_update="log", integrator="ab2"):
     """One coupled run from r_x = -r_x_end to +r_x_end (r_x_end = 6, the paper's, or less in a box
     shorter than 14 a1: the minimum image in the periodic x must stay unambiguous); returns the
     relative trajectory and the gaps."""
@@ -42,8 +43,8 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
     shear = 1.0
     U = shear * H / 2
     eta = 1.0
-    name = "lambda%g_ry%g_ad%g_%s%s" % (ratio, r_y0, a_over_delta, "contact" if contact else "smooth",
-                                        "" if lubrication else "_nolub")
+    name = "lambda%g_ry%g_ad%g_%s%s_dt%g_%s_%s" % (ratio, r_y0, a_over_delta, "contact" if contact else "smooth",
+                                                "" if lubrication else "_nolub", dt, integrator, gap_update)
     run_dir = os.path.join(workdir, name)
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
@@ -75,7 +76,7 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
             "jump            SELF advance",
             "label           finished"]
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=dt, pair_style=pair,
-                         fix_options="", before_run=rx, runs=loop, name="in.pairShear")
+                         fix_options="integrator %s gap_update %s" % (integrator, gap_update), before_run=rx, runs=loop, name="in.pairShear")
     wall = case.run(run_dir, np_fluid=np_fluid)
     parts = output.particles(os.path.join(run_dir, "fluid"))
     steps_data = output.steps(os.path.join(run_dir, "fluid"))
@@ -90,7 +91,7 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
         for d in os.listdir(os.path.join(run_dir, "fluid")):
             if d.replace(".", "").isdigit() and d != "0":
                 shutil.rmtree(os.path.join(run_dir, "fluid", d), ignore_errors=True)
-    return dict(ratio=ratio, r_y0=r_y0, contact=contact, dt=dt, a_over_delta=a_over_delta, size=list(size),
+    return dict(ratio=ratio, r_y0=r_y0, contact=contact, dt=dt, integrator=integrator, gap_update=gap_update, a_over_delta=a_over_delta, size=list(size),
                 cells=box.n[0] * box.n[1] * box.n[2], steps=int(len(r)), wall_seconds=wall,
                 inner_iterations_mean=float(steps_data["innerIterations"].mean()),
                 r_x=rel[:, 0].tolist(), r_y=rel[:, 1].tolist(), r_z=rel[:, 2].tolist(), xi=xi.tolist(),
@@ -151,6 +152,8 @@ def main(argv=None):
     p.add_argument("--dt", type=float, default=0.05, help="time step in units of 1/shear rate")
     p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
     p.add_argument("--tol-lambda", type=float, default=1e-3)
+    p.add_argument("--integrator", choices=("ab2", "euler"), default="ab2", help="fix fdm/couple integrator")
+    p.add_argument("--gap-update", choices=("log", "none"), default="log", help="fix fdm/couple gap_update")
     p.add_argument("--np-fluid", type=int, default=1)
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(HERE, "results.json"))
@@ -179,9 +182,11 @@ def main(argv=None):
     results = dict(case="pairShear", trajectories=[], summaries=[])
     for ratio, ry, cont in jobs:
         t = run_trajectory(args.workdir, ratio, ry, cont, args.a_over_delta, tuple(args.size), args.dt,
-                           tol_lambda=args.tol_lambda, cutoff=args.cutoff, np_fluid=args.np_fluid, keep=args.keep)
+                           tol_lambda=args.tol_lambda, cutoff=args.cutoff, np_fluid=args.np_fluid, keep=args.keep,
+                           gap_update=args.gap_update, integrator=args.integrator)
         s = summarise(t, cont[3] / a1 if cont else None)
-        s.update(ratio=ratio, r_y0=ry, contact=bool(cont), wall_seconds=t["wall_seconds"], steps=t["steps"])
+        s.update(ratio=ratio, r_y0=ry, contact=bool(cont), wall_seconds=t["wall_seconds"], steps=t["steps"],
+                 dt=args.dt, integrator=args.integrator, gap_update=args.gap_update)
         results["trajectories"].append(t)
         results["summaries"].append(s)
         print(json.dumps(s))

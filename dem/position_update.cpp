@@ -1,0 +1,156 @@
+// Position update with the log-gap correction (see position_update.h).
+#include "position_update.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fdm {
+namespace motion {
+
+namespace {
+
+struct Gap {
+  int i, j;       // j < 0: a wall, index -1 - j
+  double target;  // surface gap wanted at step n+1
+};
+
+void minimumImage(double d[3], const double period[3])
+{
+  for (int k = 0; k < 3; k++)
+    if (period[k] > 0) d[k] -= period[k] * std::round(d[k] / period[k]);
+}
+
+// Surface gap of pair (i, j) and its rate of change d.(U_j - U_i) for positions x, velocities u.
+void pairGap(const Configuration &c, const std::vector<double> &x, const std::vector<double> &u, int i, int j,
+             double &h, double &hdot)
+{
+  double d[3];
+  for (int k = 0; k < 3; k++) d[k] = x[3 * j + k] - x[3 * i + k];
+  minimumImage(d, c.period);
+  const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  h = r - c.radius[i] - c.radius[j];
+  hdot = 0;
+  if (r > 0)
+    for (int k = 0; k < 3; k++) hdot += d[k] / r * (u[6 * j + k] - u[6 * i + k]);
+}
+
+void wallGap(const Configuration &c, const std::vector<double> &x, const std::vector<double> &u, int i,
+             const Wall &w, double &h, double &hdot)
+{
+  const double sign = w.side == 0 ? 1.0 : -1.0;  // from the wall into the fluid
+  h = sign * (x[3 * i + w.axis] - w.position) - c.radius[i];
+  hdot = sign * u[6 * i + w.axis];
+}
+
+// h_{n+1} = h_n exp(dt [3/2 (hdot/h)_n - 1/2 (hdot/h)_{n-1}]), Euler in log h without a usable
+// previous gap. Returns false if the gap is closed (h_n <= 0: contact overlap, left to the
+// straight step).
+bool logTarget(double h, double hdot, bool havePrevious, double hPrevious, double hdotPrevious, double dt,
+               const Options &o, double &target, long &limited)
+{
+  if (!(h > 0)) return false;
+  double rate = hdot / h;
+  if (o.adamsBashforth && havePrevious && hPrevious > 0) rate = 1.5 * rate - 0.5 * hdotPrevious / hPrevious;
+  double step = dt * rate;
+  if (std::fabs(step) > o.maxLogStep) {
+    step = std::copysign(o.maxLogStep, step);
+    limited++;
+  }
+  target = h * std::exp(step);
+  return true;
+}
+
+}  // namespace
+
+Statistics displacementRates(const Configuration &c, const std::vector<int> &closePairs,
+                             const std::vector<Wall> &walls, double dt, const Options &o, std::vector<double> &rate)
+{
+  Statistics stats;
+  const int n = c.n;
+  const bool previous = c.uPrevious.size() == size_t(6) * n && c.xPrevious.size() == size_t(3) * n;
+  const bool multistep = o.adamsBashforth && previous;
+  rate.assign(size_t(6) * n, 0.0);
+  for (size_t k = 0; k < rate.size(); k++) rate[k] = multistep ? 1.5 * c.u[k] - 0.5 * c.uPrevious[k] : c.u[k];
+  if (!o.gapCorrection || !(dt > 0)) return stats;
+
+  std::vector<Gap> gaps;
+  for (size_t p = 0; p + 1 < closePairs.size(); p += 2) {
+    const int i = closePairs[p], j = closePairs[p + 1];
+    double h, hdot, hp = 0, hdotp = 0, target;
+    pairGap(c, c.x, c.u, i, j, h, hdot);
+    if (previous) pairGap(c, c.xPrevious, c.uPrevious, i, j, hp, hdotp);
+    if (logTarget(h, hdot, previous, hp, hdotp, dt, o, target, stats.limited)) {
+      gaps.push_back(Gap{i, j, target});
+      stats.pairGaps++;
+    }
+  }
+  for (int i = 0; i < n; i++)
+    for (size_t w = 0; w < walls.size(); w++) {
+      double h, hdot, hp = 0, hdotp = 0, target;
+      wallGap(c, c.x, c.u, i, walls[w], h, hdot);
+      if (!(h < c.radius[i])) continue;
+      if (previous) wallGap(c, c.xPrevious, c.uPrevious, i, walls[w], hp, hdotp);
+      if (logTarget(h, hdot, previous, hp, hdotp, dt, o, target, stats.limited)) {
+        gaps.push_back(Gap{i, -1 - int(w), target});
+        stats.wallGaps++;
+      }
+    }
+  if (gaps.empty()) return stats;
+
+  // the straight step, then moved along the lines of centres until every gap has its target
+  std::vector<char> touched(n, 0);
+  for (const Gap &g : gaps) {
+    touched[g.i] = 1;
+    if (g.j >= 0) touched[g.j] = 1;
+  }
+  std::vector<double> y(size_t(3) * n);
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < 3; k++) y[3 * i + k] = c.x[3 * i + k] + dt * rate[6 * i + k];
+  double previousWorst = HUGE_VAL;
+  for (stats.sweeps = 1; stats.sweeps <= o.maxSweeps; stats.sweeps++) {
+    double worst = 0;
+    for (const Gap &g : gaps) {
+      double miss;
+      if (g.j >= 0) {
+        double d[3];
+        for (int k = 0; k < 3; k++) d[k] = y[3 * g.j + k] - y[3 * g.i + k];
+        minimumImage(d, c.period);
+        const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        const double ai = c.radius[g.i], aj = c.radius[g.j];
+        miss = ai + aj + g.target - r;  // > 0: push apart
+        // the smaller sphere (less drag) takes the larger share
+        const double wi = aj / (ai + aj), wj = ai / (ai + aj);
+        for (int k = 0; k < 3; k++) {
+          y[3 * g.i + k] -= wi * miss * d[k] / r;
+          y[3 * g.j + k] += wj * miss * d[k] / r;
+        }
+      } else {
+        const Wall &w = walls[size_t(-1 - g.j)];
+        const double sign = w.side == 0 ? 1.0 : -1.0;
+        const double h = sign * (y[3 * g.i + w.axis] - w.position) - c.radius[g.i];
+        miss = g.target - h;
+        y[3 * g.i + w.axis] += sign * miss;
+      }
+      worst = std::max(worst, std::fabs(miss) / g.target);
+    }
+    stats.worst = worst;
+    if (worst <= o.tolerance) break;
+    // inconsistent targets (see Options::tolerance): stop once the sweeps no longer gain
+    if (stats.sweeps >= 3 && worst > 0.8 * previousWorst) break;
+    previousWorst = worst;
+  }
+  stats.sweeps = std::min(stats.sweeps, o.maxSweeps);
+  if (stats.worst > o.fallback) {
+    // the targets contradict each other (relative motions of gaps far from lubrication's
+    // hdot ~ h, at a large dt): this step keeps the straight step rather than a bad compromise
+    stats.fallback = true;
+    return stats;
+  }
+  for (int i = 0; i < n; i++)
+    if (touched[i])
+      for (int k = 0; k < 3; k++) rate[6 * i + k] = (y[3 * i + k] - c.x[3 * i + k]) / dt;
+  return stats;
+}
+
+}  // namespace motion
+}  // namespace fdm
