@@ -130,7 +130,7 @@ void printPairValues(const char* name, const PairFunctionValues& v, const PairFo
 const char* pairNormalisation =
     "kim_karrila: Kim & Karrila scalars; 11 and 12 divided by eta times 6 pi a1 (A), 4 pi a1^2 (B, G), 8 pi a1^3 (C, H), "
     "20/3 pi a1^3 (M), 6 pi a1^2 (P); 21 and 22 by the same with a2 (so that X21(lambda) = X12(1/lambda), paper Eq. A.4). "
-    "dimensional_over_eta: the dimensional function divided by the viscosity. XP: leading lubrication term only.";
+    "dimensional_over_eta: the dimensional function divided by the viscosity. XP: 1/xi and ln(1/xi) terms derived by lubrication theory, O(1) constant from the twin-multipole pressure series (docs/resistance.md).";
 
 int fullRangeOrder(const Arguments& args)
 {
@@ -238,7 +238,7 @@ int wallCommand(const Arguments& args)
     const WallScalars dim = wallTheoryDimensional(a, eps);
     std::printf("{\n  \"command\": \"wall\",\n  \"a\": %s, \"eps\": %s, \"eps_used\": %s,\n", number(a).c_str(), number(eps).c_str(),
                 number(eps > minimumGap ? eps : minimumGap).c_str());
-    std::printf("  \"normalisation\": \"kim_karrila: divided by eta times 6 pi a (XA, YA), 4 pi a^2 (YB, XG, YG), 8 pi a^3 (XC, YC, YH), 6 pi a^2 (XP); d = unit normal into the wall; YB < 0 with that d. dimensional_over_eta: divided by the viscosity. XG, XP: leading lubrication terms; YG, YH: paper Eq. (D.4).\",\n");
+    std::printf("  \"normalisation\": \"kim_karrila: divided by eta times 6 pi a (XA, YA), 4 pi a^2 (YB, XG, YG), 8 pi a^3 (XC, YC, YH), 6 pi a^2 (XP); d = unit normal into the wall; YB < 0 with that d. dimensional_over_eta: divided by the viscosity. XG, XP: singular lubrication terms (no O(1) constant); YG, YH: paper Eq. (D.4).\",\n");
     std::printf("  \"kim_karrila\": {");
     for (int i = 0; i < NumWallFunctions; ++i)
         std::printf("%s\n    \"%s\": %s", i ? "," : "", wallFunctionName(WallFunction(i)), number(kk.f[i]).c_str());

@@ -218,6 +218,26 @@ struct SeriesTriangle {
         }
     }
 
+    // The pressure-moment series (docs/resistance.md, "Pressure moment X^P"): the trace of the force dipole of
+    // sphere 1 is -a1 times the surface integral of the pressure, which by the mean-value property is
+    // 4 pi a1^2 times the pressure of sphere 2's decaying harmonics at x1.  With J&O's axisymmetric table
+    // (pressure harmonic n of a sphere ~ P_n a^n / r^(n+1) P_n(cos theta), normalised so that P_100 = 1 is
+    // the isolated sphere), the X^P series in Kim-Karrila units (6 pi a1^2) is
+    //   X11P = sum_odd a_m t^m,  X12P = -sum_even a_m t^m,  a_m = sum_{n+p+q+1=m} P_npq lambda^(p+n) / (1+lambda)^m,
+    // i.e. c[m][j] = sum_{n+p=j, q=m-1-j} P(n, p, q) (t = 2/s').
+    static SeriesTriangle pressureMoment(const TripleTable& table)
+    {
+        SeriesTriangle s;
+        s.order = table.order();
+        s.c.resize(s.order + 1);
+        for (int k = 0; k <= s.order; ++k) {
+            s.c[k].assign(k + 1, 0.0);
+            for (int j = 1; j < k; ++j)
+                for (int n = 1; n <= j; ++n) s.c[k][j] += table(n, j - n, k - 1 - j);
+        }
+        return s;
+    }
+
     // f_k / (2 (1 + lambda))^k, computed without forming lambda^k (no overflow for large lambda, k).
     double normalisedTerm(int k, double lambda) const
     {
@@ -243,7 +263,7 @@ struct SeriesTriangle {
     }
 };
 
-enum SeriesId { SeriesXA, SeriesXG, SeriesYA, SeriesYB, SeriesYG, SeriesYC, SeriesYH, SeriesXM, SeriesYM, SeriesZM, NumSeries };
+enum SeriesId { SeriesXA, SeriesXG, SeriesYA, SeriesYB, SeriesYG, SeriesYC, SeriesYH, SeriesXM, SeriesYM, SeriesZM, SeriesXP, NumSeries };
 
 // Orders: 100 as in T23's generator for A, B, C, G, H and X^M; 130 for Y^M and 200 for Z^M, whose sums
 // converge more slowly (T23 uses 130, and 150 / 200 for the even / odd Z^M sums).
@@ -255,6 +275,7 @@ struct SeriesStore {
             std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(100, 1);
             s[SeriesXA] = SeriesTriangle(t->P, 1, 1.0, false);      // J&O (3.15), T23 (9)
             s[SeriesXG] = SeriesTriangle(t->P, 2, 0.75, false);     // Ichiki et al. (94)
+            s[SeriesXP] = SeriesTriangle::pressureMoment(t->P);     // every n: pressure at the other centre
         }
         {
             std::unique_ptr<RecurrenceTables> t = buildAsymmetric(100, TranslationStart1);
@@ -310,6 +331,14 @@ double subtractedSum(const SeriesTriangle& series, double lambda, Parity parity,
     return sum;
 }
 
+// sum_{j >= 0} (first + 2 j)^-2 = psi'(first/2) / 4, asymptotic series of the trigamma function (first >= 50:
+// the next term is below 1e-14 relative).
+double inverseSquareTail(int first)
+{
+    const double x = 0.5 * first, x2 = x * x;
+    return 0.25 * (1 / x + 1 / (2 * x2) + 1 / (6 * x2 * x) - 1 / (30 * x2 * x2 * x));
+}
+
 NearFieldForm form(double inv, double log, double c0, double xlog)
 {
     NearFieldForm f;
@@ -334,6 +363,7 @@ double farFieldCoefficient(PairFunction family, int k, double lambda)
     case XG: id = SeriesXG; break;
     case YG: id = SeriesYG; break;
     case YH: id = SeriesYH; break;
+    case XP: id = SeriesXP; break;
     default: throw std::invalid_argument("farFieldCoefficient: no far-field series kept for this family");
     }
     return store.s[id].normalisedTerm(k, lambda) * std::pow(2 * (1 + lambda), k);
@@ -361,10 +391,31 @@ NearFieldConstants computeNearFieldConstants(double lam, bool withM)
         const double A12 = -2 / l1 * (g1 / 4 + 2 * g2 * L - 2 * g3 + subtractedSum(s, lam, Odd, M, g1, g2, g3));
         k.f11[XA] = form(g1, g2, A11, g3);
         k.f12[XA] = form(-g1, -g2, 0.5 * l1 * A12, -g3);
-        // pressure moment, leading lubrication term only (see docs/resistance.md): lever arm a1 times
-        // the squeeze force, normalised by 6 pi a1^2.
-        k.f11[XP] = form(g1, 0, 0, 0);
-        k.f12[XP] = form(-g1, 0, 0, 0);
+        // Pressure moment X^P (trace of the force dipole), Kim-Karrila with 6 pi a1^2; derivation and checks in
+        // docs/resistance.md, "Pressure moment X^P":
+        //  * 1/xi: s1 = -a1 (integral of p over sphere 1), and at leading order that integral is the squeeze
+        //    force: g1 of X^A.
+        //  * ln(1/xi): g2P = g2 + w^3 - 2 w^2 with w = lambda/(1+lambda) = a_r/a1 (a_r = a1 a2/(a1+a2)), i.e.
+        //    g2P = lambda (1 - 4 lambda) / (5 (1+lambda)^2): X^A's g2 (J&O (3.16)) plus the two lubrication
+        //    integrals that separate the pressure integral from the force, the pressure on the tilted surface
+        //    (1 - n.d ~ rho^2/(2 a1^2): + w^3) and the viscous traction along d (-3 eta V rho^2/(a1 h^2): -2 w^2).
+        //    Checked against the series a_m -> g1 + 2 g2P/m below (test PressureMomentSeriesMatchesNearField).
+        //  * O(1): the J&O subtraction of the series of SeriesTriangle::pressureMoment, truncated at M, with
+        //    the tail sum_{m>M} (a_m - g1 - 2 g2P/m) ~ L/m^2 estimated from the mean L of m^2 (a_m - g1 - 2 g2P/m)
+        //    over M/2 <= m <= M (that mean is -4 g3P, g3P the unknown coefficient of xi ln(1/xi), not kept).
+        //    Near contact: odd S1 = 1/xi + 1/4, S2 = ln(1/xi) + 2 ln 2; even S1 = 1/xi + 3/4, S2 = ln(1/xi).
+        const double w = lam / l1;
+        const double g2P = g2 + w * w * w - 2 * w * w;
+        const SeriesTriangle& sp = store.s[SeriesXP];
+        double level = 0;
+        int count = 0;
+        for (int m = M / 2; m <= M; ++m, ++count) level += double(m) * m * (sp.normalisedTerm(m, lam) - g1 - 2 * g2P / m);
+        level /= count;
+        const double tailOdd = level * inverseSquareTail(M + 1), tailEven = level * inverseSquareTail(M + 2);
+        const double P11 = g1 / 4 + 2 * g2P * L + subtractedSum(sp, lam, Odd, M, g1, g2P, 0) + tailOdd;
+        const double P12 = -(-g1 / 4 + subtractedSum(sp, lam, Even, M, g1, g2P, 0) + tailEven);
+        k.f11[XP] = form(g1, g2P, P11, 0);
+        k.f12[XP] = form(-g1, -g2P, P12, 0);
     }
     // Y^A: J&O (4.15)-(4.18).
     {

@@ -131,7 +131,9 @@ WallScalars wallTheory(double eps)
     w.f[WallXC] = wallNormalRotation(eps);
     w.f[WallYC] = wallParallelRotation(eps);
     w.f[WallXG] = 1.5 / eps - 1.2 * std::log(1 / eps);
-    w.f[WallXP] = 1 / eps;
+    // pressure moment: lambda -> inf limit of the two-sphere X^P (docs/resistance.md): 1/eps plus
+    // (g2 + 1 - 2) ln(1/eps) with Cox & Brenner's g2 = 1/5; O(1) constant not known
+    w.f[WallXP] = 1 / eps - 0.8 * std::log(1 / eps);
     // D.4 in Kim-Karrila units (a = 1): Y^G = [(1+eps) 6 pi Y^A + 1/2 4 pi Y^B] / (4 pi), etc.
     w.f[WallYG] = (1 + eps) * 1.5 * w.f[WallYA] + 0.5 * w.f[WallYB];
     w.f[WallYH] = -(1 + eps) * 0.5 * w.f[WallYB] - 0.5 * w.f[WallYC];

@@ -20,7 +20,9 @@
 namespace fdm {
 namespace resistance {
 
-// Scalar families of paper Eq. (A.1).  XP is the pressure moment (trace of the force dipole).
+// Scalar families of paper Eq. (A.1).  XP is the pressure moment (trace of the force dipole): 1/xi and
+// ln(1/xi) terms by lubrication theory, O(1) constant from the twin-multipole pressure series; no
+// xi ln(1/xi) term (docs/resistance.md).  X^Q has no slot (only its C.1 combination with X^P is used).
 enum PairFunction { XA, YA, YB, XC, YC, XG, YG, YH, XM, YM, ZM, XP, NumPairFunctions };
 const char* pairFunctionName(PairFunction f);
 
@@ -48,7 +50,9 @@ NearFieldConstants computeNearFieldConstants(double lambda, bool withM = false);
 double hurwitzZeta3(double a);  // sum_{k>=0} (k+a)^-3, a > 0
 
 // Far-field series coefficient f_k(lambda) of J&O (3.15)/(9), J92, as tabulated in
-// reference/two_sphere_general_lambda/farfield_fk.csv ("XA","YA","YB","YC","XG","YG","YH").
+// reference/two_sphere_general_lambda/farfield_fk.csv ("XA","YA","YB","YC","XG","YG","YH"); also XP,
+// the pressure-moment series built here from the X^A table (X11P = sum_odd, X12P = -sum_even of
+// f_k/(2(1+lambda))^k t^k, t = 2/s'; docs/resistance.md, "Pressure moment X^P").
 double farFieldCoefficient(PairFunction family, int k, double lambda);
 
 // ---------------------------------------------------------------------------------------------

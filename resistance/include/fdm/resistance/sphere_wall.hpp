@@ -12,7 +12,8 @@
 //   XC  rotation (normal axis)   Jeffery (1915) exact series sinh^3(alpha) sum csch^3(n alpha)
 //   XG  normal stresslet         leading lubrication terms 3/(2 eps) - (6/5) ln(1/eps): the lambda -> inf
 //                                 limit of Jeffrey (1992) (19b); O(1) constant not included
-//   XP  pressure moment          leading lubrication term 1/eps (lever arm a times the squeeze force)
+//   XP  pressure moment          1/eps - (4/5) ln(1/eps): the lambda -> inf limit of the two-sphere X^P
+//                                 (docs/resistance.md, "Pressure moment X^P"); O(1) constant not included
 //   YG, YH                       from paper Eq. (D.4) applied to YA, YB, YC (exact for their singular
 //                                 parts; these are what the frame-invariant sub-grid matrix uses)
 #ifndef FDM_RESISTANCE_SPHERE_WALL_HPP
