@@ -152,6 +152,7 @@ def main(argv=None):
     p.add_argument("--dt", type=float, default=0.05, help="time step in units of 1/shear rate")
     p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
     p.add_argument("--tol-lambda", type=float, default=1e-3)
+    p.add_argument("--kn", type=float, default=1e3, help="contact stiffness kn = kt [N/m] of the --contact case")
     p.add_argument("--integrator", choices=("ab2", "euler"), default="ab2", help="fix fdm/couple integrator")
     p.add_argument("--gap-update", choices=("log", "none"), default="log", help="fix fdm/couple gap_update")
     p.add_argument("--np-fluid", type=int, default=1)
@@ -164,7 +165,7 @@ def main(argv=None):
     h_r = 5e-3 * a1
     # contact springs: stiff enough that the overlap F/kn stays well below h_r, soft enough for the
     # explicit step (docs/contact.md)
-    contact = (1e3, 1e3, 0.5, h_r)
+    contact = (args.kn, args.kn, 0.5, h_r)
     jobs = []
     if args.full:
         args.a_over_delta, args.size = 5.0, [20.0, 12.0, 8.0]
