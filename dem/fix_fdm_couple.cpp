@@ -985,6 +985,7 @@ void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
   motion::Options options;
   options.adamsBashforth = adamsBashforth_;
   options.gapCorrection = gapUpdate_;
+  if (pair_ && pair_->contactActive()) options.contactGap = pair_->roughness();
   const motion::Statistics stats = motion::displacementRates(c, closePairs, walls, update->dt, options, moveRate_);
   run_.gapTargets += stats.pairGaps + stats.wallGaps;
   run_.gapLimited += stats.limited;

@@ -58,6 +58,7 @@ class PairFdmSubgrid : public Pair {
 
   bool lubricationActive() const { return lubrication_ && model_; }
   bool contactActive() const { return hr_ > 0; }
+  double roughness() const { return hr_; }
   const std::vector<Wall> &walls() const { return walls_; }
   // Per-atom contact stresslet S^c (Eq. 52: xx xy xz yy yz zz) of the last compute, if requested.
   void requestContactStress(bool on) { contactStressRequested_ = on; }

@@ -48,7 +48,7 @@ void wallGap(const Configuration &c, const std::vector<double> &x, const std::ve
 bool logTarget(double h, double hdot, bool havePrevious, double hPrevious, double hdotPrevious, double dt,
                const Options &o, double &target, long &limited)
 {
-  if (!(h > 0)) return false;
+  if (!(h > 0) || h < o.contactGap) return false;
   double rate = hdot / h;
   if (o.adamsBashforth && havePrevious && hPrevious > 0) rate = 1.5 * rate - 0.5 * hdotPrevious / hPrevious;
   double step = dt * rate;

@@ -12,7 +12,7 @@
        h_{n+1} = h_n exp( dt [3/2 (hdot/h)_n - 1/2 (hdot/h)_{n-1}] ),   hdot = d.(U_2 - U_1),
    and the straight step is then moved along the lines of centres (Gauss-Seidel sweeps, each pair
    shared in inverse proportion to the radii, walls do not move) until every such gap has its
-   target. The target is exact for a rigid rotation (h unchanged) and for a lubrication squeeze at
+   target (gaps inside contact springs, h < h_r, keep the straight step). The target is exact for a rigid rotation (h unchanged) and for a lubrication squeeze at
    constant force (hdot/h constant), keeps gaps positive at any dt, and differs from the straight
    step by O(dt^3): the scheme stays second order. Plain C++ (no LIGGGHTS), tested in
    dem/tests/test_position_update.cpp. */
@@ -51,6 +51,9 @@ struct Options {
   double tolerance = 1e-4;
   int maxSweeps = 30;
   double fallback = 0.5;             // still this far from a target after the sweeps: straight step
+  // Gaps below the roughness height h_r are held by contact springs (hdot not ~ h): they keep the
+  // straight step, whose stability limits docs/contact.md gives.
+  double contactGap = 0;
 };
 
 struct Statistics {

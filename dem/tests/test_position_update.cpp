@@ -301,3 +301,24 @@ TEST(PositionUpdate, ContradictoryTargetsKeepTheStraightStep)
     }
   }
 }
+
+TEST(PositionUpdate, GapsInsideContactSpringsKeepTheStraightStep)
+{
+  // h = 2e-3 < h_r = 5e-3: a contact spring holds this gap, the straight step stays
+  motion::Configuration c;
+  c.n = 2;
+  c.radius = {1.0, 1.0};
+  c.x = {0, 0, 0, 2.002, 0, 0};
+  c.u = {0.01, 0, 0, 0, 0, 0, -0.01, 0, 0, 0, 0, 0};
+  motion::Options o;
+  o.contactGap = 5e-3;
+  std::vector<double> rate;
+  motion::Statistics stats = motion::displacementRates(c, {0, 1}, {motion::Wall{0, 0, -1.001}}, 0.05, o, rate);
+  EXPECT_EQ(stats.pairGaps, 0);
+  EXPECT_EQ(stats.wallGaps, 0);
+  EXPECT_DOUBLE_EQ(rate[0], 0.01);
+  o.contactGap = 1e-3;
+  stats = motion::displacementRates(c, {0, 1}, {motion::Wall{0, 0, -1.0015}}, 0.05, o, rate);
+  EXPECT_EQ(stats.pairGaps, 1);  // 2e-3 and 1.5e-3 are outside h_r = 1e-3: log targets
+  EXPECT_EQ(stats.wallGaps, 1);
+}
