@@ -329,6 +329,34 @@ void PairFdmSubgrid::addContactStress(int i, const double force[3], const double
   }
 }
 
+void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
+                                double force[3], double nxft[3]) const
+{
+  // The tangential spring and the Coulomb cap shared by pair and wall contacts: the elongation
+  // accumulates the tangential relative velocity of the contact points over dt (0 in setup force
+  // evaluations, which do not advance time), stays in the tangent plane, and kt |shear| is capped
+  // at mu_s |F_n| (sliding: the spring is reset to the cap). Returns the total force on the
+  // particle on the n side, and n x F_t for the torques.
+  const double vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
+  for (int d = 0; d < 3; d++) shear[d] += (vr[d] - vn * n[d]) * dt;
+  const double sn = shear[0] * n[0] + shear[1] * n[1] + shear[2] * n[2];
+  for (int d = 0; d < 3; d++) shear[d] -= sn * n[d];
+  double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
+  const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
+  const double ftMax = mu_ * normalForce;
+  if (ftNorm > ftMax) {
+    const double scale = ftMax / ftNorm;
+    for (int d = 0; d < 3; d++) {
+      ft[d] *= scale;
+      if (kt_ > 0) shear[d] = -ft[d] / kt_;
+    }
+  }
+  for (int d = 0; d < 3; d++) force[d] = normalForce * n[d] + ft[d];
+  nxft[0] = n[1] * ft[2] - n[2] * ft[1];
+  nxft[1] = n[2] * ft[0] - n[0] * ft[2];
+  nxft[2] = n[0] * ft[1] - n[1] * ft[0];
+}
+
 void PairFdmSubgrid::contactForces()
 {
   // Section 6 (Gallier et al. 2014): contact once the surface gap is below h_r; linear normal
@@ -337,8 +365,7 @@ void PairFdmSubgrid::contactForces()
   double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
   const double *radius = atom->radius;
   const int nlocal = atom->nlocal;
-  const bool updateHistory = !update->setupflag;  // setup force evaluations do not advance time
-  const double dt = update->dt;
+  const double dt = update->setupflag ? 0.0 : update->dt;  // setup force evaluations do not advance time
   int **firstTouch = listgranhistory->firstneigh;
   double **firstShear = listgranhistory->firstdouble;
 
@@ -367,23 +394,8 @@ void PairFdmSubgrid::contactForces()
       for (int d = 0; d < 3; d++) w[d] = radius[i] * omega[i][d] + radius[j] * omega[j][d];
       const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - v[j][d] - wxn[d];
-      const double vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
-      if (updateHistory)
-        for (int d = 0; d < 3; d++) shear[d] += (vr[d] - vn * n[d]) * dt;
-      const double sn = shear[0] * n[0] + shear[1] * n[1] + shear[2] * n[2];  // stay in the tangent plane
-      for (int d = 0; d < 3; d++) shear[d] -= sn * n[d];
-      double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
-      const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
-      const double ftMax = mu_ * normalForce;
-      if (ftNorm > ftMax) {  // sliding: Coulomb, and the spring is reset to the cap
-        const double scale = ftMax / ftNorm;
-        for (int d = 0; d < 3; d++) {
-          ft[d] *= scale;
-          if (kt_ > 0) shear[d] = -ft[d] / kt_;
-        }
-      }
-      const double force[3] = {normalForce * n[0] + ft[0], normalForce * n[1] + ft[1], normalForce * n[2] + ft[2]};
-      const double nxft[3] = {n[1] * ft[2] - n[2] * ft[1], n[2] * ft[0] - n[0] * ft[2], n[0] * ft[1] - n[1] * ft[0]};
+      double force[3], nxft[3];
+      contactLaw(n, normalForce, vr, dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];
@@ -412,8 +424,7 @@ void PairFdmSubgrid::wallContactForces()
   // Eq. 52 is the particle's, from its centre to the wall).
   double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
   const double *radius = atom->radius;
-  const bool updateHistory = !update->setupflag;
-  const double dt = update->dt;
+  const double dt = update->setupflag ? 0.0 : update->dt;
   double **history = wallHistory_->array_atom;
   for (int i = 0; i < atom->nlocal; i++) {
     for (size_t k = 0; k < walls_.size(); k++) {
@@ -434,23 +445,8 @@ void PairFdmSubgrid::wallContactForces()
       const double aw[3] = {radius[i] * omega[i][0], radius[i] * omega[i][1], radius[i] * omega[i][2]};
       const double wxn[3] = {aw[1] * n[2] - aw[2] * n[1], aw[2] * n[0] - aw[0] * n[2], aw[0] * n[1] - aw[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - wall.velocity[d] - wxn[d];
-      const double vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
-      if (updateHistory)
-        for (int d = 0; d < 3; d++) shear[d] += (vr[d] - vn * n[d]) * dt;
-      const double sn = shear[0] * n[0] + shear[1] * n[1] + shear[2] * n[2];
-      for (int d = 0; d < 3; d++) shear[d] -= sn * n[d];
-      double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
-      const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
-      const double ftMax = mu_ * normalForce;
-      if (ftNorm > ftMax) {
-        const double scale = ftMax / ftNorm;
-        for (int d = 0; d < 3; d++) {
-          ft[d] *= scale;
-          if (kt_ > 0) shear[d] = -ft[d] / kt_;
-        }
-      }
-      const double force[3] = {normalForce * n[0] + ft[0], normalForce * n[1] + ft[1], normalForce * n[2] + ft[2]};
-      const double nxft[3] = {n[1] * ft[2] - n[2] * ft[1], n[2] * ft[0] - n[0] * ft[2], n[0] * ft[1] - n[1] * ft[0]};
+      double force[3], nxft[3];
+      contactLaw(n, normalForce, vr, dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];

@@ -77,6 +77,8 @@ class PairFdmSubgrid : public Pair {
   void fluidParameters();
   void contactForces();
   void wallContactForces();
+  void contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
+                  double force[3], double nxft[3]) const;
   void addContactStress(int i, const double force[3], const double branch[3], double weight);
   std::string wallName(const Wall &w) const;
 
