@@ -20,14 +20,28 @@ void minimumImage(double d[3], const double period[3])
     if (period[k] > 0) d[k] -= period[k] * std::round(d[k] / period[k]);
 }
 
+// x_j - x_i (minimum image) into d; returns its length.
+double separation(const Configuration &c, const std::vector<double> &x, int i, int j, double d[3])
+{
+  for (int k = 0; k < 3; k++) d[k] = x[3 * j + k] - x[3 * i + k];
+  minimumImage(d, c.period);
+  return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+// +1 for a wall below the fluid (side 0), -1 above: the direction from the wall into the fluid.
+double intoFluid(const Wall &w) { return w.side == 0 ? 1.0 : -1.0; }
+
+double wallGapOf(const Configuration &c, const std::vector<double> &x, int i, const Wall &w)
+{
+  return intoFluid(w) * (x[3 * i + w.axis] - w.position) - c.radius[i];
+}
+
 // Surface gap of pair (i, j) and its rate of change d.(U_j - U_i) for positions x, velocities u.
 void pairGap(const Configuration &c, const std::vector<double> &x, const std::vector<double> &u, int i, int j,
              double &h, double &hdot)
 {
   double d[3];
-  for (int k = 0; k < 3; k++) d[k] = x[3 * j + k] - x[3 * i + k];
-  minimumImage(d, c.period);
-  const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  const double r = separation(c, x, i, j, d);
   h = r - c.radius[i] - c.radius[j];
   hdot = 0;
   if (r > 0)
@@ -37,9 +51,8 @@ void pairGap(const Configuration &c, const std::vector<double> &x, const std::ve
 void wallGap(const Configuration &c, const std::vector<double> &x, const std::vector<double> &u, int i,
              const Wall &w, double &h, double &hdot)
 {
-  const double sign = w.side == 0 ? 1.0 : -1.0;  // from the wall into the fluid
-  h = sign * (x[3 * i + w.axis] - w.position) - c.radius[i];
-  hdot = sign * u[6 * i + w.axis];
+  h = wallGapOf(c, x, i, w);
+  hdot = intoFluid(w) * u[6 * i + w.axis];
 }
 
 // h_{n+1} = h_n exp(dt [3/2 (hdot/h)_n - 1/2 (hdot/h)_{n-1}]), Euler in log h without a usable
@@ -113,9 +126,7 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
       double miss;
       if (g.j >= 0) {
         double d[3];
-        for (int k = 0; k < 3; k++) d[k] = y[3 * g.j + k] - y[3 * g.i + k];
-        minimumImage(d, c.period);
-        const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        const double r = separation(c, y, g.i, g.j, d);
         const double ai = c.radius[g.i], aj = c.radius[g.j];
         miss = ai + aj + g.target - r;  // > 0: push apart
         // the smaller sphere (less drag) takes the larger share
@@ -126,10 +137,8 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
         }
       } else {
         const Wall &w = walls[size_t(-1 - g.j)];
-        const double sign = w.side == 0 ? 1.0 : -1.0;
-        const double h = sign * (y[3 * g.i + w.axis] - w.position) - c.radius[g.i];
-        miss = g.target - h;
-        y[3 * g.i + w.axis] += sign * miss;
+        miss = g.target - wallGapOf(c, y, g.i, w);
+        y[3 * g.i + w.axis] += intoFluid(w) * miss;
       }
       worst = std::max(worst, std::fabs(miss) / g.target);
     }
