@@ -1,5 +1,6 @@
 // Unit tests of the coupler: wire format, both transports, and every failure a user can meet.
 #include "fdm/coupler.h"
+#include "scratch.h"
 
 #include <gtest/gtest.h>
 
@@ -35,8 +36,10 @@ std::string hostName()
 
 std::string tempPath(const std::string& name)
 {
-    return "/tmp/fdmCouplerTest." + std::to_string(getpid()) + "." + name;
+    return fdm::testing::scratchPath("fdmCouplerTest", name);
 }
+
+FDM_SCRATCH_CLEANUP("fdmCouplerTest");
 
 Message sample(uint64_t step = 12, uint32_t iteration = 3)
 {

@@ -5,6 +5,7 @@
 #define FDM_DEM_TEST_HARNESS_H
 
 #include "fdm/coupler.h"
+#include "scratch.h"
 
 #include <gtest/gtest.h>
 
@@ -33,7 +34,7 @@ const double pi = 3.14159265358979323846;
 
 std::string workDir(const std::string& name)
 {
-    const std::string dir = "/tmp/fdmDEMTest." + std::to_string(getpid()) + "." + name;
+    const std::string dir = fdm::testing::scratchPath("fdmDEMTest", name);
     ::mkdir(dir.c_str(), 0755);
     return dir;
 }

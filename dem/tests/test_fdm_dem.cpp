@@ -455,6 +455,8 @@ TEST(FdmDEMErrors, UnknownKeyword)
     expectFailure("keyword", scene, nullptr, "fix fdm/couple: unknown keyword gravitation", false);
 }
 
+FDM_SCRATCH_CLEANUP("fdmDEMTest");
+
 int main(int argc, char** argv)
 {
     // mpirun refuses root unless told
