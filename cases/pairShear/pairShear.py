@@ -1,17 +1,18 @@
 #!/usr/bin/env python3
 """A pair of free spheres in simple shear flow between two moving walls (paper section 5.3, Fig. 14).
 
-Walls y = 0 and y = H move at -U and +U along x (shear rate 2U/H = 1); x and z are periodic. Sphere
-1 (a1 = 1) starts at x = Lx/2 + 3, sphere 2 (a2 = lambda a1) at x = Lx/2 - 3 (+-2.5 in a box
-shorter than 15 a1), both in the plane z = Lz/2, at y = H/2 -/+ r_y0/2: the relative position
-r = x2 - x1 starts at (-6, r_y0) (or (-4.5, r_y0)) and the
-shear brings sphere 2 over sphere 1. Without contact the relative trajectory is fore-aft symmetric
-(Stokes flow is reversible): the final cross-stream offset equals the initial one. With contact
-(roughness h_r, friction mu_s) it is not: the spheres touch for -1.39 <~ r_x/a1 <~ 0 in the paper
-(a2/a1 = 1.4, h_r = 5e-3 a1, mu_s = 0.5) and leave on a higher streamline.
+Walls y = 0 and y = H move at -U and +U along x (shear rate 2U/H = 1); x and z are periodic. The
+spheres (a1 = 1, a2 = lambda a1) start in the plane z = Lz/2, symmetric about the box centre, so
+that the relative position r = x2 - x1 starts at (r_x0, r_y0): r_x0 = -6 (-4.5 in a box shorter
+than 15 a1) without contact, -3.48 with contact (the paper's Fig. 15). The shear brings sphere 2
+over sphere 1. Without contact the relative trajectory is fore-aft symmetric (Stokes flow is
+reversible): the final cross-stream offset equals the initial one. With contact (roughness h_r,
+friction mu_s) it is not: the spheres touch for -1.39 <~ r_x/a1 <~ 0 in the paper (a2/a1 = 1.4,
+r_y0 = 0.93, h_r = 5e-3 a1, mu_s = 0.5) and leave on a higher streamline.
 
   pairShear.py                 lambda = 1 without contact, r_y0 = 0.5 (CI size: a1/Delta = 3, 12 x 8 x 6)
-  pairShear.py --contact       lambda = 1.4, h_r = 5e-3 a1, mu_s = 0.5
+  pairShear.py --contact       lambda = 1.4, h_r = 5e-3 a1, mu_s = 0.5 (kn = 2e4, kt = 200 N/m)
+  pairShear.py --contact --size 20 12 10     the same with room: the paper's contact window
   pairShear.py --full          both, a1/Delta = 5, 20 x 12 x 8, several impact parameters
   pairShear.py --help          every option
 Writes results.json and results_pairShear.png here (docs/cases.md).
@@ -31,12 +32,26 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdm import case, output  # noqa: E402
 
 
+# The paper's contact case (section 5.3, Figs. 14-15): a2/a1 = 1.4, r^0 = (-3.48, 0.93) a1
+PAPER_CONTACT_RATIO, PAPER_CONTACT_R_X0, PAPER_CONTACT_R_Y0 = 1.4, -3.48, 0.93
+
+
+def paper_contact(a1=1.0, kn=2e4, kt=200.0):
+    """(kn, kt, mu_s, h_r) of the paper's contact case: h_r = 5e-3 a1, mu_s = 0.5. The springs are
+    ours (docs/contact.md): the pair is pressed together by F_n ~ 27 N, so kn = 2e4 N/m keeps the
+    contact in the roughness layer (F_n/(kn h_r) ~ 0.27, gap ~ 3.6e-3 a1) and the surfaces part as
+    soon as the load turns (softer springs let lubrication hold the pair inside h_r long after
+    r_x = 0). Both springs are within the ab2 limit at dt = 0.05: dt kn/zeta_n ~ 0.55 (zeta_n ~ 1800
+    N s/m at that gap), dt kt/zeta_t ~ 0.5."""
+    return (kn, kt, 0.5, 5e-3 * a1)
+
+
 def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0, size=(12.0, 8.0, 6.0), dt=0.05,
                    tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True,
-                   gap_update="log", integrator="ab2"):
-    """One coupled run from r_x = -r_x_end to +r_x_end (r_x_end = 6, the paper's, or less in a box
-    shorter than 14 a1: the minimum image in the periodic x must stay unambiguous); returns the
-    relative trajectory and the gaps."""
+                   gap_update="log", integrator="ab2", r_x0=None):
+    """One coupled run from r_x = r_x0 (default -r_x_end) to +r_x_end (r_x_end = 6, the paper's, or
+    less in a box shorter than 14 a1: the minimum image in the periodic x must stay unambiguous);
+    returns the relative trajectory and the gaps."""
     a1, a2 = 1.0, ratio
     delta = a1 / a_over_delta
     Lx, H, Lz = size
@@ -45,16 +60,21 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
     eta = 1.0
     name = "lambda%g_ry%g_ad%g_%s%s_dt%g_%s_%s" % (ratio, r_y0, a_over_delta, "contact" if contact else "smooth",
                                                 "" if lubrication else "_nolub", dt, integrator, gap_update)
+    if r_x0 is not None:
+        name += "_rx%g" % r_x0
     run_dir = os.path.join(workdir, name)
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
     box = case.Box((0, 0, 0), (Lx, H, Lz), delta, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
     zc = Lz / 2 + 0.25 * delta
     r_x_end = min(6.0, Lx / 2 - 1.5)
-    p1 = (Lx / 2 + r_x_end / 2, H / 2 - r_y0 / 2, zc)
-    p2 = (Lx / 2 - r_x_end / 2, H / 2 + r_y0 / 2, zc)
-    # the relative x-velocity is about shear * r_y: enough steps to go from -r_x_end to r_x_end, with margin
-    steps = min(max_steps, int(math.ceil(2 * r_x_end / (shear * max(r_y0, 0.3)) / dt * 1.6)))
+    r_x_start = -r_x_end if r_x0 is None else r_x0
+    if not -r_x_end <= r_x_start < 0:
+        raise ValueError("pairShear: r_x0 = %g must lie in [-%g, 0) for a box of length %g" % (r_x_start, r_x_end, Lx))
+    p1 = (Lx / 2 - r_x_start / 2, H / 2 - r_y0 / 2, zc)
+    p2 = (Lx / 2 + r_x_start / 2, H / 2 + r_y0 / 2, zc)
+    # the relative x-velocity is about shear * r_y: enough steps to go from r_x0 to r_x_end, with margin
+    steps = min(max_steps, int(math.ceil((r_x_end - r_x_start) / (shear * max(r_y0, 0.3)) / dt * 1.6)))
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
                           first_step=(tol_lambda / 10, 3000), n_particles=2, tol_u=1e-5, tol_p=1e-4)
     pair = "fdm/subgrid%s wall ylo %r 0 0 wall yhi %r 0 0" % ("" if cutoff is None else " cutoff %g" % cutoff, -U, U)
@@ -94,6 +114,7 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
     return dict(ratio=ratio, r_y0=r_y0, contact=contact, dt=dt, integrator=integrator, gap_update=gap_update, a_over_delta=a_over_delta, size=list(size),
                 cells=box.n[0] * box.n[1] * box.n[2], steps=int(len(r)), wall_seconds=wall,
                 inner_iterations_mean=float(steps_data["innerIterations"].mean()),
+                unconverged_steps=int((steps_data["converged"] == 0).sum()),
                 r_x=rel[:, 0].tolist(), r_y=rel[:, 1].tolist(), r_z=rel[:, 2].tolist(), xi=xi.tolist(),
                 gap_over_a1=(gap / a1).tolist())
 
@@ -116,7 +137,17 @@ def summarise(t, h_r=None):
         touching = gap < h_r
         if touching.any():
             idx = np.where(touching)[0]
-            s.update(contact_r_x_from=float(rx[idx[0]]), contact_r_x_to=float(rx[idx[-1]]))
+
+            def crossing(i, j):
+                # r_x where the gap passes h_r between samples i and j (log-linear: the gap changes
+                # by a factor per step near contact)
+                if min(i, j) < 0 or max(i, j) >= len(gap) or gap[i] <= 0 or gap[j] <= 0:
+                    return float(rx[min(max(j, 0), len(gap) - 1)])
+                f = np.log(h_r / gap[i]) / np.log(gap[j] / gap[i])
+                return float(rx[i] + f * (rx[j] - rx[i]))
+
+            s.update(contact_r_x_from=crossing(idx[0] - 1, idx[0]), contact_r_x_to=crossing(idx[-1], idx[-1] + 1),
+                     contact_steps=int(len(idx)))
         else:
             s.update(contact_r_x_from=None, contact_r_x_to=None)
     return s
@@ -152,7 +183,10 @@ def main(argv=None):
     p.add_argument("--dt", type=float, default=0.05, help="time step in units of 1/shear rate")
     p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
     p.add_argument("--tol-lambda", type=float, default=1e-3)
-    p.add_argument("--kn", type=float, default=1e3, help="contact stiffness kn = kt [N/m] of the --contact case")
+    p.add_argument("--kn", type=float, default=2e4, help="normal contact stiffness [N/m] of the --contact case")
+    p.add_argument("--kt", type=float, default=200.0, help="tangential contact stiffness [N/m] of the --contact case")
+    p.add_argument("--r-x0", type=float, default=None,
+                   help="initial r_x / a1 (default: -3.48 with contact, the paper's Fig. 15; without, -6 or less in a short box)")
     p.add_argument("--integrator", choices=("ab2", "euler"), default="ab2", help="fix fdm/couple integrator")
     p.add_argument("--gap-update", choices=("log", "none"), default="log", help="fix fdm/couple gap_update")
     p.add_argument("--np-fluid", type=int, default=1)
@@ -162,18 +196,16 @@ def main(argv=None):
     args = p.parse_args(argv)
 
     a1 = 1.0
-    h_r = 5e-3 * a1
-    # contact springs: stiff enough that the overlap F/kn stays well below h_r, soft enough for the
-    # explicit step (docs/contact.md)
-    contact = (args.kn, args.kn, 0.5, h_r)
+    contact = paper_contact(a1, args.kn, args.kt)
+    contact_r_x0 = PAPER_CONTACT_R_X0 if args.r_x0 is None else args.r_x0
     jobs = []
     if args.full:
         args.a_over_delta, args.size = 5.0, [20.0, 12.0, 8.0]
         for ry in (args.r_y0 or [0.25, 0.5, 1.0]):
             jobs.append((1.0, ry, None))
-        jobs.append((1.4, 0.93, contact))
+        jobs.append((PAPER_CONTACT_RATIO, PAPER_CONTACT_R_Y0, contact))
     elif args.contact:
-        jobs.append((1.4, (args.r_y0 or [0.93])[0], contact))
+        jobs.append((PAPER_CONTACT_RATIO, (args.r_y0 or [PAPER_CONTACT_R_Y0])[0], contact))
     else:
         for ry in (args.r_y0 or [0.5]):
             jobs.append((1.0, ry, None))
@@ -184,9 +216,11 @@ def main(argv=None):
     for ratio, ry, cont in jobs:
         t = run_trajectory(args.workdir, ratio, ry, cont, args.a_over_delta, tuple(args.size), args.dt,
                            tol_lambda=args.tol_lambda, cutoff=args.cutoff, np_fluid=args.np_fluid, keep=args.keep,
-                           gap_update=args.gap_update, integrator=args.integrator)
+                           gap_update=args.gap_update, integrator=args.integrator,
+                           r_x0=contact_r_x0 if cont else args.r_x0)
         s = summarise(t, cont[3] / a1 if cont else None)
         s.update(ratio=ratio, r_y0=ry, contact=bool(cont), wall_seconds=t["wall_seconds"], steps=t["steps"],
+                 inner_iterations_mean=t["inner_iterations_mean"], unconverged_steps=t["unconverged_steps"],
                  dt=args.dt, integrator=args.integrator, gap_update=args.gap_update)
         results["trajectories"].append(t)
         results["summaries"].append(s)

@@ -225,6 +225,7 @@ Foam::scalar Foam::particleForcing::correct
     // Corrections are computed from u* for every particle before any is
     // applied, so that overlapping particles see the same u*.
     vectorField du(u.size(), Zero);
+    vectorField dLambda(u.size(), Zero);
     scalar sumDl2 = 0, sumL2 = 0;
     maxCoreSlip_ = 0;
 
@@ -237,9 +238,8 @@ Foam::scalar Foam::particleForcing::correct
             const label celli = cell_[e];
             const vector slip = Up + (Wp ^ r_[e]) - u[celli];
             const vector dl = Ilambda_[e]*slip/alpha_;              // Eq. (38c)
-            l[celli] += dl;
+            dLambda[celli] += dl;
             du[celli] += Iu_[e]*IuScale_[celli]*slip;               // Eq. (38d)
-            sumDl2 += magSqr(dl)*V[celli];
             if (Iu_[e] > 0.99)
             {
                 maxCoreSlip_ = max(maxCoreSlip_, mag(slip));
@@ -247,11 +247,17 @@ Foam::scalar Foam::particleForcing::correct
         }
     }
     u += du;
+    l += dLambda;
 
+    // The residual is the change of the cell's lambda, not the sum of each
+    // particle's share: where two particles overlap (I_lambda = 0.5 each) and
+    // move apart, the two shares stay finite and opposite at convergence.
     forAll(cell_, e)
     {
         // each covered cell once: weight by 1/count via Ilambda
-        sumL2 += Ilambda_[e]*magSqr(l[cell_[e]])*V[cell_[e]];
+        const label celli = cell_[e];
+        sumDl2 += Ilambda_[e]*magSqr(dLambda[celli])*V[celli];
+        sumL2 += Ilambda_[e]*magSqr(l[celli])*V[celli];
     }
 
     reduce(sumDl2, sumOp<scalar>());
