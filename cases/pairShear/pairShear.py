@@ -29,7 +29,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdm import case, output  # noqa: E402
+from fdm import case  # noqa: E402
 
 
 # The paper's contact case (section 5.3, Figs. 14-15): a2/a1 = 1.4, r^0 = (-3.48, 0.93) a1
@@ -97,20 +97,13 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
             "label           finished"]
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=dt, pair_style=pair,
                          fix_options="integrator %s gap_update %s" % (integrator, gap_update), before_run=rx, runs=loop, name="in.pairShear")
-    wall = case.run(run_dir, np_fluid=np_fluid)
-    parts = output.particles(os.path.join(run_dir, "fluid"))
-    steps_data = output.steps(os.path.join(run_dir, "fluid"))
+    wall, parts, steps_data = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     one, two = parts["tag"] == 1, parts["tag"] == 2
     rel = np.stack([parts[c][two] - parts[c][one] for c in ("x", "y", "z")], axis=1)
     rel[:, 0] -= Lx * np.round(rel[:, 0] / Lx)
     r = np.linalg.norm(rel, axis=1)
     xi = 2 * r / (a1 + a2) - 2
     gap = r - a1 - a2
-    if not keep:
-        shutil.rmtree(os.path.join(run_dir, "fluid", "constant", "polyMesh"), ignore_errors=True)
-        for d in os.listdir(os.path.join(run_dir, "fluid")):
-            if d.replace(".", "").isdigit() and d != "0":
-                shutil.rmtree(os.path.join(run_dir, "fluid", d), ignore_errors=True)
     return dict(ratio=ratio, r_y0=r_y0, contact=contact, dt=dt, integrator=integrator, gap_update=gap_update, a_over_delta=a_over_delta, size=list(size),
                 cells=box.n[0] * box.n[1] * box.n[2], steps=int(len(r)), wall_seconds=wall,
                 inner_iterations_mean=float(steps_data["innerIterations"].mean()),

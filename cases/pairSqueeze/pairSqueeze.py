@@ -24,7 +24,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdm import case, output, theory  # noqa: E402
+from fdm import case, theory  # noqa: E402
 
 XI_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
 
@@ -64,20 +64,12 @@ def run_pair(workdir, ratio, xis, subgrid, a_over_delta=4.0, L_over_a=8.0, tol_l
                                     "fix             push1 one addforce %r 0 0\n"
                                     "fix             push2 two addforce %r 0 0" % (F, -F),
                          runs=runs, name="in.pairSqueeze")
-    wall = case.run(run_dir, np_fluid=np_fluid)
-    parts = output.particles(os.path.join(run_dir, "fluid"))
-    steps = output.steps(os.path.join(run_dir, "fluid"))
+    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     U1 = parts["Ux"][parts["tag"] == 1]
     U2 = parts["Ux"][parts["tag"] == 2]
     velocity = [float(v) for v in (U1 - U2) / (F / (6 * math.pi * eta * a1))]
-    if not keep:
-        shutil.rmtree(os.path.join(run_dir, "fluid", "constant", "polyMesh"), ignore_errors=True)
     return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
                 inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
-
-
-def relative_errors(values, reference):
-    return [(v - r) / r for v, r in zip(values, reference)]
 
 
 def plot(results, path):
@@ -123,7 +115,7 @@ def main(argv=None):
     p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison runs")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(HERE, "results.json"))
-    p.add_argument("--keep", action="store_true", help="keep the meshes")
+    p.add_argument("--keep", action="store_true", help="keep the meshes and the fields")
     args = p.parse_args(argv)
     if args.full:
         args.a_over_delta, args.L_over_a = 5.0, 12.0
@@ -138,7 +130,7 @@ def main(argv=None):
         for subgrid in ([True] if args.no_reference else [True, False]):
             r = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.L_over_a, args.tol_lambda,
                          args.cutoff, args.np_fluid, args.keep)
-            r["rel_error"] = relative_errors(r["velocity"], reference)
+            r["rel_error"] = theory.relative_errors(r["velocity"], reference)
             entry["subgrid" if subgrid else "nosubgrid"] = r
             print("lambda %g, sub-grid %s: %.0f s" % (ratio, "on" if subgrid else "off", r["wall_seconds"]))
             for xi, v, ref, e in zip(args.xi, r["velocity"], reference, r["rel_error"]):

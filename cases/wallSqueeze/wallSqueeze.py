@@ -24,7 +24,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdm import case, output, theory  # noqa: E402
+from fdm import case, theory  # noqa: E402
 
 EPS_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
 
@@ -59,18 +59,10 @@ def run_wall(workdir, epss, subgrid, a_over_delta=4.0, L_over_a=8.0, H_over_a=16
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
                          before_run="fix             push all addforce 0 %r 0" % (-F), runs=runs,
                          name="in.wallSqueeze")
-    wall = case.run(run_dir, np_fluid=np_fluid)
-    parts = output.particles(os.path.join(run_dir, "fluid"))
-    steps = output.steps(os.path.join(run_dir, "fluid"))
+    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     velocity = [float(v) for v in -parts["Uy"] / (F / (6 * math.pi * eta * a))]
-    if not keep:
-        shutil.rmtree(os.path.join(run_dir, "fluid", "constant", "polyMesh"), ignore_errors=True)
     return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
                 inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
-
-
-def relative_errors(values, reference):
-    return [(v - r) / r for v, r in zip(values, reference)]
 
 
 def plot(results, path):
@@ -113,7 +105,7 @@ def main(argv=None):
     p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison run")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(HERE, "results.json"))
-    p.add_argument("--keep", action="store_true", help="keep the meshes")
+    p.add_argument("--keep", action="store_true", help="keep the meshes and the fields")
     args = p.parse_args(argv)
     if args.full:
         args.a_over_delta, args.L_over_a, args.H_over_a = 5.0, 12.0, 24.0
@@ -126,7 +118,7 @@ def main(argv=None):
     for subgrid in ([True] if args.no_reference else [True, False]):
         r = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.L_over_a, args.H_over_a, args.tol_lambda,
                      args.cutoff, args.np_fluid, args.keep)
-        r["rel_error"] = relative_errors(r["velocity"], reference)
+        r["rel_error"] = theory.relative_errors(r["velocity"], reference)
         results["subgrid" if subgrid else "nosubgrid"] = r
         print("sub-grid %s: %.0f s" % ("on" if subgrid else "off", r["wall_seconds"]))
         for eps, v, ref, e in zip(args.eps, r["velocity"], reference, r["rel_error"]):

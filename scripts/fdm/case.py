@@ -1,5 +1,6 @@
 """Writing and running coupled cases (OpenFOAM fluid/ + LIGGGHTS dem/), see docs/cases.md."""
 import os
+import shutil
 import subprocess
 import time
 
@@ -228,6 +229,23 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     if proc.returncode != 0:
         raise RuntimeError("fdmRun %s failed (exit %d):\n%s" % (case_dir, proc.returncode, proc.stdout[-4000:]))
     return wall
+
+
+def run_and_read(run_dir, np_fluid=1, keep=False):
+    """Run the coupled case in run_dir (fluid/ + dem/) and read fdmFoam's records; unless keep,
+    then delete the mesh and the time directories (fields for ParaView), which the figures do not
+    need and which are the bulk of the disk space. Returns (wall seconds, particles, steps) with
+    the arrays of output.particles and output.steps."""
+    from . import output
+    fluid = os.path.join(run_dir, "fluid")
+    wall = run(run_dir, np_fluid=np_fluid)
+    particles, steps = output.particles(fluid), output.steps(fluid)
+    if not keep:
+        shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
+        for d in os.listdir(fluid):
+            if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
+                shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+    return wall, particles, steps
 
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",

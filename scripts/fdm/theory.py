@@ -32,3 +32,8 @@ def wall_squeeze_velocity(a, eps):
     """Velocity of a sphere pushed toward a plane wall by a force F, in units of F/(6 pi eta a):
     1/X^A_wall (Brenner 1961)."""
     return resistance("squeeze", "--a", a, "--eps", eps, "--wall")["closing_velocity_normalised"]
+
+
+def relative_errors(values, reference):
+    """(value - reference) / reference, element by element."""
+    return [(v - r) / r for v, r in zip(values, reference)]
