@@ -191,7 +191,11 @@ void PairFdmSubgrid::fluidParameters()
                   ") m/s but the fluid case (0/U) at " + u + " m/s";
     }
   }
-  if (!problem.empty()) error->all(FLERR, ("pair fdm/subgrid: " + problem).c_str());
+  if (!problem.empty()) {
+    // tell the fluid solver why (it would otherwise only learn that fdmDEM stopped)
+    FixFdmCouple::abandon("fdmDEM: pair fdm/subgrid: " + problem);
+    error->all(FLERR, ("pair fdm/subgrid: " + problem).c_str());
+  }
 }
 
 void PairFdmSubgrid::init_style()

@@ -17,6 +17,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <netinet/in.h>
 #include <sstream>
 #include <sys/socket.h>
@@ -231,6 +232,60 @@ void expectContains(const std::string& text, const std::string& needle)
 }
 
 double relativeDifference(double a, double b) { return std::fabs(a - b) / std::max(1e-300, std::max(std::fabs(a), std::fabs(b))); }
+
+// Runs a scene expected to fail; returns the run, checks status and duration, and that the fluid
+// peer (if any) was told why.
+DemRun expectFailure(const std::string& name, const Scene& scene, std::function<void(FakeFluid&)> setup,
+                  const std::string& needle, bool withFluid = true, double within = 10.0, int ranks = 1)
+{
+    const std::string dir = workDir(name);
+    writeInput(dir, scene);
+    std::unique_ptr<FakeFluid> fluid;
+    if (withFluid) {
+        fluid.reset(new FakeFluid(dir));
+        if (setup) setup(*fluid);
+        fluid->start();
+    }
+    const DemRun run = runDEM(dir, ranks);
+    if (fluid) fluid->join();
+    EXPECT_NE(run.status, 0) << run.output;
+    EXPECT_NE(run.status, 124) << "timed out:\n" << run.output;
+    expectContains(run.output, "ERROR");
+    expectContains(run.output, needle);
+    EXPECT_LT(run.seconds, within) << run.output;
+    if (fluid && fluid->mode == FakeFluid::Normal) expectContains(fluid->error, needle);  // the peer was told
+    return run;
+}
+
+// Runs the scene serially and on two ranks against FakeFluid and expects every message the fluid
+// received (velocities and step records) to agree within |a - b| <= relative max(|a|, |b|) + absolute;
+// twoRankNeedle shows that the two-rank run split what it should.
+void expectSameRunOnOneAndTwoRanks(const std::string& name, const Scene& scene, const std::string& twoRankNeedle,
+                                   double relative, double absolute)
+{
+    std::vector<cpl::Message> results[2];
+    for (int ranks = 1; ranks <= 2; ++ranks) {
+        const std::string dir = workDir(name + "np" + std::to_string(ranks));
+        writeInput(dir, scene);
+        FakeFluid fluid(dir);
+        fluid.start();
+        const DemRun run = runDEM(dir, ranks);
+        fluid.join();
+        ASSERT_EQ(run.status, 0) << run.output;
+        if (ranks == 2) expectContains(run.output, twoRankNeedle);
+        results[ranks - 1] = fluid.velocities;
+        results[ranks - 1].insert(results[ranks - 1].end(), fluid.steps.begin(), fluid.steps.end());
+    }
+    ASSERT_EQ(results[0].size(), results[1].size());
+    for (size_t m = 0; m < results[0].size(); ++m) {
+        ASSERT_EQ(results[0][m].data.size(), results[1][m].data.size());
+        for (size_t k = 0; k < results[0][m].data.size(); ++k) {
+            const double a = results[0][m].data[k], b = results[1][m].data[k];
+            EXPECT_LE(std::fabs(a - b), relative * std::max(std::fabs(a), std::fabs(b)) + absolute)
+                << cpl::messageTypeName(results[0][m].type) << " " << m << " value " << k << ": " << a << " vs " << b;
+        }
+    }
+}
 
 }  // namespace
 

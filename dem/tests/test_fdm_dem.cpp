@@ -180,27 +180,8 @@ TEST(FdmDEM, MoveNoHoldsTheParticlesAndTheConnectionOutlivesARun)
 
 TEST(FdmDEM, TwoRanksGiveTheSameVelocitiesAsOne)
 {
-    const Scene scene = physicsScene();
-    std::vector<cpl::Message> results[2];
-    for (int ranks = 1; ranks <= 2; ++ranks) {
-        const std::string dir = workDir("mpi" + std::to_string(ranks));
-        writeInput(dir, scene);
-        FakeFluid fluid(dir);
-        fluid.start();
-        const DemRun run = runDEM(dir, ranks);
-        fluid.join();
-        ASSERT_EQ(run.status, 0) << run.output;
-        if (ranks == 2) expectContains(run.output, "Nlocal:    1.5 ave 2 max 1 min");  // both ranks own particles
-        results[ranks - 1] = fluid.velocities;
-        results[ranks - 1].insert(results[ranks - 1].end(), fluid.steps.begin(), fluid.steps.end());
-    }
-    ASSERT_EQ(results[0].size(), results[1].size());
-    for (size_t m = 0; m < results[0].size(); ++m) {
-        ASSERT_EQ(results[0][m].data.size(), results[1][m].data.size());
-        for (size_t k = 0; k < results[0][m].data.size(); ++k)
-            EXPECT_LE(relativeDifference(results[0][m].data[k], results[1][m].data[k]), 1e-12)
-                << cpl::messageTypeName(results[0][m].type) << " " << m << " value " << k;
-    }
+    // both ranks own particles
+    expectSameRunOnOneAndTwoRanks("mpi", physicsScene(), "Nlocal:    1.5 ave 2 max 1 min", 1e-12, 0.0);
 }
 
 TEST(FdmDEM, FileTransportAndRecordGiveTheSameRun)
@@ -229,31 +210,6 @@ TEST(FdmDEM, FileTransportAndRecordGiveTheSameRun)
 
 // ---- bad input: a clear error naming the particle or value, a non-zero exit, within seconds ----------
 
-namespace {
-// Runs a scene expected to fail; returns the run, checks status and duration, and that the fluid
-// peer (if any) was told why.
-DemRun expectFailure(const std::string& name, const Scene& scene, std::function<void(FakeFluid&)> setup,
-                  const std::string& needle, bool withFluid = true, double within = 10.0, int ranks = 1)
-{
-    const std::string dir = workDir(name);
-    writeInput(dir, scene);
-    std::unique_ptr<FakeFluid> fluid;
-    if (withFluid) {
-        fluid.reset(new FakeFluid(dir));
-        if (setup) setup(*fluid);
-        fluid->start();
-    }
-    const DemRun run = runDEM(dir, ranks);
-    if (fluid) fluid->join();
-    EXPECT_NE(run.status, 0) << run.output;
-    EXPECT_NE(run.status, 124) << "timed out:\n" << run.output;
-    expectContains(run.output, "ERROR");
-    expectContains(run.output, needle);
-    EXPECT_LT(run.seconds, within) << run.output;
-    if (fluid && fluid->mode == FakeFluid::Normal) expectContains(fluid->error, needle);  // the peer was told
-    return run;
-}
-}  // namespace
 
 TEST(FdmDEMErrors, ParticleCrossingAWall)
 {

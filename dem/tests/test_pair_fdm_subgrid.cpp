@@ -187,23 +187,7 @@ TEST(PairFdmSubgrid, TwoRanksGiveTheSameVelocitiesAsOne)
     const double shift = 4.0 - 0.5 * (scene.spheres[0].z + scene.spheres[1].z);
     scene.spheres[0].z += shift;
     scene.spheres[1].z += shift;
-    std::vector<cpl::Message> velocities[2];
-    for (int ranks = 1; ranks <= 2; ++ranks) {
-        const std::string dir = workDir("pairnp" + std::to_string(ranks));
-        writeInput(dir, scene);
-        FakeFluid fluid(dir);
-        fluid.start();
-        const DemRun run = runDEM(dir, ranks);
-        fluid.join();
-        ASSERT_EQ(run.status, 0) << run.output;
-        expectContains(run.output, "1 sub-grid pair blocks");
-        if (ranks == 2) expectContains(run.output, "1 by 1 by 2 MPI processor grid");  // split at z = 4
-        velocities[ranks - 1] = fluid.velocities;
-    }
-    ASSERT_EQ(velocities[0].size(), velocities[1].size());
-    for (size_t m = 0; m < velocities[0].size(); ++m)
-        for (size_t k = 0; k < velocities[0][m].data.size(); ++k)
-            EXPECT_NEAR(velocities[0][m].data[k], velocities[1][m].data[k], 1e-9) << "message " << m << " value " << k;
+    expectSameRunOnOneAndTwoRanks("pair", scene, "1 by 1 by 2 MPI processor grid", 1e-9, 1e-9);  // split at z = 4
 }
 
 namespace {
@@ -351,49 +335,30 @@ TEST(PairFdmSubgrid, ContactForcesAreEqualOppositeAndEnterEq31)
 
 TEST(PairFdmSubgridErrors, UndeclaredFluidWall)
 {
-    const std::string dir = workDir("undeclared");
     Scene scene = wallScene();
     scene.pairStyle = "fdm/subgrid wall yhi 0 0 0";
-    writeInput(dir, scene);
-    FakeFluid fluid(dir);
-    movingWall(fluid);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
-    EXPECT_NE(run.status, 0);
-    expectContains(run.output, "the fluid case has a no-slip wall on ylo moving at (0.3 0 0.1) m/s, not declared to "
-                               "pair_style fdm/subgrid: add 'wall ylo 0.3 0 0.1'");
+    expectFailure("undeclared", scene, movingWall,
+                  "the fluid case has a no-slip wall on ylo moving at (0.3 0 0.1) m/s, not declared to pair_style "
+                  "fdm/subgrid: add 'wall ylo 0.3 0 0.1'");
 }
 
 TEST(PairFdmSubgridErrors, WallVelocityMismatch)
 {
-    const std::string dir = workDir("mismatch");
     Scene scene = wallScene();
     scene.pairStyle = "fdm/subgrid wall ylo 0.2 0 0.1 wall yhi 0 0 0";
-    writeInput(dir, scene);
-    FakeFluid fluid(dir);
-    movingWall(fluid);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
-    EXPECT_NE(run.status, 0);
-    expectContains(run.output, "wall ylo: pair_style fdm/subgrid says it moves at (0.2 0 0.1) m/s but the fluid case "
-                               "(0/U) at (0.3 0 0.1) m/s");
+    expectFailure("mismatch", scene, movingWall,
+                  "wall ylo: pair_style fdm/subgrid says it moves at (0.2 0 0.1) m/s but the fluid case (0/U) at (0.3 0 "
+                  "0.1) m/s");
 }
 
 TEST(PairFdmSubgridErrors, WallWhereTheFluidHasASlipBoundary)
 {
-    const std::string dir = workDir("slip");
-    Scene scene = wallScene();
-    writeInput(dir, scene);
-    FakeFluid fluid(dir);
-    movingWall(fluid);
-    fluid.faceKind[3] = 2;
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
-    EXPECT_NE(run.status, 0);
-    expectContains(run.output, "pair_style fdm/subgrid declares a wall on yhi but the fluid case has a slip wall there");
+    expectFailure("slip", wallScene(),
+                  [](FakeFluid& f) {
+                      movingWall(f);
+                      f.faceKind[3] = 2;
+                  },
+                  "pair_style fdm/subgrid declares a wall on yhi but the fluid case has a slip wall there");
 }
 
 TEST(PairFdmSubgridErrors, WallOnAPeriodicBoundaryAndBadKeywords)
