@@ -111,11 +111,11 @@ def test_pair_in_shear_is_fore_aft_symmetric(tmp_path, env, pair_shear):
     assert 0 < s["min_gap_over_a1"] < 1e-3, s
 
 
-@pytest.mark.full  # about 25 minutes
+@pytest.mark.full  # about 16 minutes
 def test_pair_in_shear_minimum_gap_in_a_larger_box(tmp_path, env, pair_shear):
     # The minimum gap of the paper's smallest open trajectory (about 4e-5 a1 in a 40^3 box) needs
     # room: in the CI box (12 x 8 x 6, walls 4 a1 away) the confined pair comes to 1e-6 a1; in
-    # 20 x 12 x 10 from r_x = -6 it was measured at 3.7e-5 a1 near r_x = -0.35 (docs/validation.md).
+    # 20 x 12 x 10 from r_x = -6 it is 3.2e-5 a1 at r_x = -0.02 (docs/validation.md).
     t = pair_shear.run_trajectory(str(tmp_path), ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
                                   size=(20.0, 12.0, 10.0), dt=0.05)
     s = pair_shear.summarise(t)
@@ -151,10 +151,10 @@ def test_pair_in_shear_with_contact_leaves_on_a_higher_streamline(tmp_path, env,
     assert t["unconverged_steps"] == 0, (t["unconverged_steps"], t["inner_iterations_mean"])
 
 
-@pytest.mark.full  # about 9 minutes
+@pytest.mark.full  # about 8 minutes
 def test_pair_in_shear_contact_window_in_a_larger_box(tmp_path, env, pair_shear):
     # With the walls 6 a1 away (20 x 12 x 10) the contact window is the paper's (-1.39 <~ r_x <~ 0,
-    # 40^3 box, dt = 1e-4): measured -1.43 ... -0.04 at dt = 0.05 (docs/validation.md).
+    # 40^3 box, dt = 1e-4): measured -1.45 ... -0.01 at dt = 0.05 (docs/validation.md).
     contact = pair_shear.paper_contact()
     t = pair_shear.run_trajectory(str(tmp_path), ratio=pair_shear.PAPER_CONTACT_RATIO,
                                   r_y0=pair_shear.PAPER_CONTACT_R_Y0, r_x0=pair_shear.PAPER_CONTACT_R_X0,

@@ -155,6 +155,8 @@ def plot(results, path):
         label = "a2/a1 = %g, r_y0 = %g%s" % (t["ratio"], t["r_y0"], ", contact" if t["contact"] else "")
         axes[0].plot(t["r_x"], t["r_y"], "-", color="C%d" % i, label=label)
         axes[1].semilogy(t["r_x"], np.maximum(t["gap_over_a1"], 1e-7), "-", color="C%d" % i, label=label)
+        if t["contact"]:
+            axes[1].axhline(t["contact"][3], color="C%d" % i, ls=":", lw=1)  # h_r: below it the spheres touch
     axes[0].set_xlabel(r"$r_x/a_1$")
     axes[0].set_ylabel(r"$r_y/a_1$")
     axes[0].legend(fontsize=7)
