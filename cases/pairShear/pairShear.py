@@ -38,11 +38,13 @@ PAPER_CONTACT_RATIO, PAPER_CONTACT_R_X0, PAPER_CONTACT_R_Y0 = 1.4, -3.48, 0.93
 
 def paper_contact(a1=1.0, kn=2e4, kt=200.0):
     """(kn, kt, mu_s, h_r) of the paper's contact case: h_r = 5e-3 a1, mu_s = 0.5. The springs are
-    ours (docs/contact.md): the pair is pressed together by F_n ~ 27 N, so kn = 2e4 N/m keeps the
-    contact in the roughness layer (F_n/(kn h_r) ~ 0.27, gap ~ 3.6e-3 a1) and the surfaces part as
+    ours (docs/contact.md): the pair is pressed together by F_n = 20-28 N, so kn = 2e4 N/m keeps the
+    contact in the roughness layer (F_n/(kn h_r) = 0.2-0.27, gap 3.6e-3 to 4e-3 a1) and the surfaces part as
     soon as the load turns (softer springs let lubrication hold the pair inside h_r long after
-    r_x = 0). Both springs are within the ab2 limit at dt = 0.05: dt kn/zeta_n ~ 0.55 (zeta_n ~ 1800
-    N s/m at that gap), dt kt/zeta_t ~ 0.5."""
+    r_x = 0). Both springs are within the ab2 limit (1) at dt = 0.05: dt kn/zeta_n = 0.62 and
+    dt kt/zeta_t = 0.44, with zeta_n = 1617 and zeta_t = 22.6 N s/m the normal and slip resistances
+    of the free pair at a gap of 4e-3 a1 (Stokes drag + sub-grid block at a1/Delta = 3, computed as
+    in contactTuning's Resistance.zeta_pair_slip)."""
     return (kn, kt, 0.5, 5e-3 * a1)
 
 
