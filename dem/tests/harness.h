@@ -233,21 +233,33 @@ void expectContains(const std::string& text, const std::string& needle)
 
 double relativeDifference(double a, double b) { return std::fabs(a - b) / std::max(1e-300, std::max(std::fabs(a), std::fabs(b))); }
 
+// Writes the scene's input into dir, runs fdmDEM (serial or on `ranks` ranks) against `fluid`, set up
+// by the caller, and waits for both.
+DemRun runWithFluid(const std::string& dir, const Scene& scene, FakeFluid& fluid, int ranks = 1)
+{
+    writeInput(dir, scene);
+    fluid.start();
+    const DemRun run = runDEM(dir, ranks);
+    fluid.join();
+    return run;
+}
+
 // Runs a scene expected to fail; returns the run, checks status and duration, and that the fluid
 // peer (if any) was told why.
 DemRun expectFailure(const std::string& name, const Scene& scene, std::function<void(FakeFluid&)> setup,
                   const std::string& needle, bool withFluid = true, double within = 10.0, int ranks = 1)
 {
     const std::string dir = workDir(name);
-    writeInput(dir, scene);
     std::unique_ptr<FakeFluid> fluid;
+    DemRun run;
     if (withFluid) {
         fluid.reset(new FakeFluid(dir));
         if (setup) setup(*fluid);
-        fluid->start();
+        run = runWithFluid(dir, scene, *fluid, ranks);
+    } else {
+        writeInput(dir, scene);
+        run = runDEM(dir, ranks);
     }
-    const DemRun run = runDEM(dir, ranks);
-    if (fluid) fluid->join();
     EXPECT_NE(run.status, 0) << run.output;
     EXPECT_NE(run.status, 124) << "timed out:\n" << run.output;
     expectContains(run.output, "ERROR");
@@ -266,11 +278,8 @@ void expectSameRunOnOneAndTwoRanks(const std::string& name, const Scene& scene, 
     std::vector<cpl::Message> results[2];
     for (int ranks = 1; ranks <= 2; ++ranks) {
         const std::string dir = workDir(name + "np" + std::to_string(ranks));
-        writeInput(dir, scene);
         FakeFluid fluid(dir);
-        fluid.start();
-        const DemRun run = runDEM(dir, ranks);
-        fluid.join();
+        const DemRun run = runWithFluid(dir, scene, fluid, ranks);
         ASSERT_EQ(run.status, 0) << run.output;
         if (ranks == 2) expectContains(run.output, twoRankNeedle);
         results[ranks - 1] = fluid.velocities;

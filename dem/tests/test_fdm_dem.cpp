@@ -90,11 +90,8 @@ TEST(FdmDEM, VelocitiesAreTheAnalyticSolutionOfEq31)
 {
     const std::string dir = workDir("analytic");
     const Scene scene = physicsScene();
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     EXPECT_EQ(fluid.error, "");
     EXPECT_TRUE(fluid.finished) << "no Finish after the input";
@@ -162,12 +159,9 @@ TEST(FdmDEM, MoveNoHoldsTheParticlesAndTheConnectionOutlivesARun)
     Scene scene;
     scene.fixOptions = "move no";
     scene.runs = "run 2\nset atom 1 x 3.25\nrun 1\nrun 1";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
     fluid.iterations = 2;
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     ASSERT_EQ(fluid.steps.size(), 4u);  // one connection for three runs
     EXPECT_TRUE(fluid.finished);
@@ -190,13 +184,10 @@ TEST(FdmDEM, FileTransportAndRecordGiveTheSameRun)
     Scene scene = physicsScene();
     scene.transport = "transport file directory coupling";
     scene.fixOptions += " record coupling.record";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
     fluid.options.transport = "file";
     fluid.options.directory = dir + "/coupling";
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     const double g[3] = {0, 0, -9.81}, fext[3] = {0.5, -0.25, 0.125};
     expectAnalyticVelocities(fluid, scene, g, fext);
@@ -326,11 +317,8 @@ TEST(FdmDEMErrors, LiggghtsErrorAfterARunIsToldToTheFluid)
     const std::string dir = workDir("liggghtsError");
     Scene scene;
     scene.runs = "run 1\nthis_is_not_a_command";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     EXPECT_NE(run.status, 0);
     expectContains(run.output, "Unknown command: this_is_not_a_command");
     expectContains(fluid.error, "fdmDEM stopped before the end of its input");

@@ -126,11 +126,8 @@ TEST(PairFdmSubgrid, SubgridBlocksEnterEq31AndObeyNewtonsThirdLaw)
     scene.runs = "dump            d all custom 1 sg.dump id" + dumpColumns(12) + dumpFormat(12) +
                  "\nthermo_style    custom step f_couple[5] f_couple[6]\n"
                  "thermo          1\nrun             2";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     EXPECT_EQ(fluid.error, "");
     expectContains(run.output, "pair fdm/subgrid: sub-grid lubrication ON");
@@ -168,11 +165,8 @@ TEST(PairFdmSubgrid, LubricationNoGivesTheDiagonalSystem)
     const std::string dir = workDir("lubno");
     Scene scene = pairScene();
     scene.pairStyle = "fdm/subgrid lubrication no";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     expectContains(run.output, "sub-grid lubrication OFF (lubrication no)");
     Expected e = subgridMatrix(scene, fluid);
@@ -215,12 +209,9 @@ TEST(PairFdmSubgrid, MovingWallBlockEntersEq31)
     Scene scene = wallScene();
     scene.runs = "dump            d all custom 1 w.dump id" + dumpColumns(12) + dumpFormat(12) +
                  "\nrun             2";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
     movingWall(fluid);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     expectContains(run.output, "wall ylo at velocity (0.3 0 0.1)");
     expectContains(run.output, "0 sub-grid pair blocks, 1 wall blocks");
@@ -258,11 +249,8 @@ TEST(PairFdmSubgrid, StressletsAreFluidPlusSubgridPlusContact)
     scene.fixOptions += " stresslets yes";
     scene.runs = "dump            d all custom 1 s.dump id" + dumpColumns(25) + dumpFormat(25) +
                  "\nrun             2";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     EXPECT_EQ(fluid.demHello.textValue("stresslets"), "1");
     const Expected e = subgridMatrix(scene, fluid);
@@ -296,11 +284,8 @@ TEST(PairFdmSubgrid, ContactForcesAreEqualOppositeAndEnterEq31)
     scene.fixOptions = "move no stresslets yes";
     scene.runs = "dump            d all custom 1 c.dump id fx fy fz" + dumpColumns(25) + dumpFormat(28) +
                  "\nrun             1";
-    writeInput(dir, scene);
     FakeFluid fluid(dir);
-    fluid.start();
-    const DemRun run = runDEM(dir);
-    fluid.join();
+    const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     expectContains(run.output, "contact ON (kn 100 N/m, kt 80 N/m, mu_s 0.5, h_r 0.05 m)");
     expectContains(run.output, "1 contacts");
