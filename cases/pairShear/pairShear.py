@@ -178,18 +178,13 @@ def main(argv=None):
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--size", type=float, nargs=3, default=[12.0, 8.0, 6.0], help="Lx H Lz in units of a1")
     p.add_argument("--dt", type=float, default=0.05, help="time step in units of 1/shear rate")
-    p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
-    p.add_argument("--tol-lambda", type=float, default=1e-3)
+    case.add_run_options(p, HERE, tol_lambda=0.001, cutoff=True)
     p.add_argument("--kn", type=float, default=2e4, help="normal contact stiffness [N/m] of the --contact case")
     p.add_argument("--kt", type=float, default=200.0, help="tangential contact stiffness [N/m] of the --contact case")
     p.add_argument("--r-x0", type=float, default=None,
                    help="initial r_x / a1 (default: -3.48 with contact, the paper's Fig. 15; without, -6 or less in a short box)")
     p.add_argument("--integrator", choices=("ab2", "euler"), default="ab2", help="fix fdm/couple integrator")
     p.add_argument("--gap-update", choices=("log", "none"), default="log", help="fix fdm/couple gap_update")
-    p.add_argument("--np-fluid", type=int, default=1)
-    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
-    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
-    p.add_argument("--keep", action="store_true")
     args = p.parse_args(argv)
 
     a1 = 1.0

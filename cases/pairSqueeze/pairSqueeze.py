@@ -109,13 +109,8 @@ def main(argv=None):
     p.add_argument("--xi", type=float, nargs="+", default=XI_DEFAULT, help="reduced gaps, largest first")
     p.add_argument("--a-over-delta", type=float, default=4.0)
     p.add_argument("--L-over-a", type=float, default=8.0)
-    p.add_argument("--cutoff", type=float, default=None, help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
-    p.add_argument("--tol-lambda", type=float, default=1e-4)
-    p.add_argument("--np-fluid", type=int, default=1)
+    case.add_run_options(p, HERE, tol_lambda=0.0001, cutoff=True)
     p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison runs")
-    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
-    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
-    p.add_argument("--keep", action="store_true", help="keep the meshes and the fields")
     args = p.parse_args(argv)
     if args.full:
         args.a_over_delta, args.L_over_a = 5.0, 12.0

@@ -176,13 +176,9 @@ def main(argv=None):
                    help="lattice points in the cell, a cube: 1, 8, 27, 64 (even m: one octant computed)")
     p.add_argument("--c", type=float, nargs="+", default=[0.3], help="indicator parameter c (Eq. 36)")
     p.add_argument("--b", type=float, default=5.0, help="indicator parameter b (Eq. 37)")
-    p.add_argument("--tol-lambda", type=float, default=1e-4)
+    case.add_run_options(p, HERE, tol_lambda=0.0001)
     p.add_argument("--tol-u", type=float, default=1e-6)
     p.add_argument("--tol-p", type=float, default=5e-6)
-    p.add_argument("--np-fluid", type=int, default=1)
-    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
-    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
-    p.add_argument("--keep", action="store_true", help="keep the meshes of the runs")
     args = p.parse_args(argv)
 
     configs = []

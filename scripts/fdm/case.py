@@ -231,6 +231,19 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     return wall
 
 
+def add_run_options(parser, case_dir, tol_lambda, cutoff=False):
+    """The options every coupled case's script shares: --tol-lambda, --np-fluid, --workdir,
+    --out, --keep (and --cutoff for the cases with pair_style fdm/subgrid)."""
+    if cutoff:
+        parser.add_argument("--cutoff", type=float, default=None,
+                            help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
+    parser.add_argument("--tol-lambda", type=float, default=tol_lambda, help="fdmFoam's innerIterations tolLambda")
+    parser.add_argument("--np-fluid", type=int, default=1, help="MPI ranks of fdmFoam")
+    parser.add_argument("--workdir", default=os.path.join(case_dir, "runs"), help="where the runs are written")
+    parser.add_argument("--out", default=os.path.join(case_dir, "results.json"))
+    parser.add_argument("--keep", action="store_true", help="keep the meshes and the fields of the runs")
+
+
 def run_and_read(run_dir, np_fluid=1, keep=False):
     """Run the coupled case in run_dir (fluid/ + dem/) and read fdmFoam's records; unless keep,
     then delete the mesh and the time directories (fields for ParaView), which the figures do not
