@@ -115,7 +115,7 @@ void printPairValues(const char* name, const PairFunctionValues& v, const PairFo
     std::printf("  \"%s\": {", name);
     bool first = true;
     for (int f = 0; f < NumPairFunctions; ++f) {
-        if (!withM && (f == XM || f == YM || f == ZM)) continue;
+        if (!withM && (f == XM || f == YM || f == ZM || f == XQ)) continue;  // XQ: theory only, built with M
         for (int a = 0; a < 2; ++a)
             for (int b = 0; b < 2; ++b) {
                 double value = v.f[f][a][b];
@@ -129,8 +129,10 @@ void printPairValues(const char* name, const PairFunctionValues& v, const PairFo
 
 const char* pairNormalisation =
     "kim_karrila: Kim & Karrila scalars; 11 and 12 divided by eta times 6 pi a1 (A), 4 pi a1^2 (B, G), 8 pi a1^3 (C, H), "
-    "20/3 pi a1^3 (M), 6 pi a1^2 (P); 21 and 22 by the same with a2 (so that X21(lambda) = X12(1/lambda), paper Eq. A.4). "
-    "dimensional_over_eta: the dimensional function divided by the viscosity. XP: 1/xi and ln(1/xi) terms derived by lubrication theory, O(1) constant from the twin-multipole pressure series (docs/resistance.md).";
+    "20/3 pi a1^3 (M), 6 pi a1^2 (P), 6 pi a1^3 (Q); 21 and 22 by the same with a2 (so that X21(lambda) = X12(1/lambda), paper Eq. A.4). "
+    "dimensional_over_eta: the dimensional function divided by the viscosity. XP, XQ: pressure moments (trace of the force dipole), "
+    "s_a = -eta sum_b XP_ab d.U_b + eta sum_b XQ_ab d.E.d (paper Eq. 19); 1/xi and ln(1/xi) terms derived by lubrication theory, "
+    "O(1) constants from the twin-multipole pressure series (docs/resistance.md); XQ is a theoretical function only (no sub-grid value, paper Eq. 21).";
 
 int fullRangeOrder(const Arguments& args)
 {
@@ -163,7 +165,7 @@ int pairCommand(const Arguments& args)
     if (!subgrid && full) {
         const PairFullRangeForms forms = makeFullRangeForms(a1, a2, true, order);
         const PairFunctionValues v = fullRange(forms, xi);
-        std::printf("  \"kind\": \"theory, full range: XA, YA, YB, YC matched forms of Jeffrey & Onishi 1984 (near-field singular terms plus the far-field series to order %d with their expansion subtracted; Townsend 2023 constants), XC exact series (Jeffery 1915); XG, YG, YH, XM, YM, ZM, XP near-field forms\",\n", order);
+        std::printf("  \"kind\": \"theory, full range: XA, YA, YB, YC matched forms of Jeffrey & Onishi 1984 (near-field singular terms plus the far-field series to order %d with their expansion subtracted; Townsend 2023 constants), XC exact series (Jeffery 1915); XG, YG, YH, XM, YM, ZM, XP, XQ near-field forms\",\n", order);
         std::printf("  \"full_range_functions\": [\"XA\", \"YA\", \"YB\", \"XC\", \"YC\"], \"order\": %d,\n", order);
         printSizeRatioWarning(a2 / a1, order);
         std::printf("  \"normalisation\": \"%s\",\n", pairNormalisation);
@@ -172,7 +174,7 @@ int pairCommand(const Arguments& args)
     } else if (!subgrid) {
         const PairForms forms = makePairForms(a1, a2, true);
         const PairFunctionValues v = evaluate(forms, xi);
-        std::printf("  \"kind\": \"theory (near-field forms of Jeffrey & Onishi 1984, Jeffrey 1992, Townsend 2023)\",\n");
+        std::printf("  \"kind\": \"theory (near-field forms of Jeffrey & Onishi 1984, Jeffrey 1992, Townsend 2023; XP, XQ derived here, docs/resistance.md)\",\n");
         std::printf("  \"normalisation\": \"%s\",\n", pairNormalisation);
         printPairValues("kim_karrila", v, &forms, true, false);
         printPairValues("dimensional_over_eta", v, nullptr, true, true);

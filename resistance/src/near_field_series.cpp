@@ -13,7 +13,7 @@ namespace resistance {
 const char* pairFunctionName(PairFunction f)
 {
     static const char* names[NumPairFunctions] = {"XA", "YA", "YB", "XC", "YC", "XG",
-                                                  "YG", "YH", "XM", "YM", "ZM", "XP"};
+                                                  "YG", "YH", "XM", "YM", "ZM", "XP", "XQ"};
     return names[f];
 }
 
@@ -225,9 +225,13 @@ struct SeriesTriangle {
     // the isolated sphere), the X^P series in Kim-Karrila units (6 pi a1^2) is
     //   X11P = sum_odd a_m t^m,  X12P = -sum_even a_m t^m,  a_m = sum_{n+p+q+1=m} P_npq lambda^(p+n) / (1+lambda)^m,
     // i.e. c[m][j] = sum_{n+p=j, q=m-1-j} P(n, p, q) (t = 2/s').
-    static SeriesTriangle pressureMoment(const TripleTable& table)
+    // The same sum over the strain table (start P_200 = 1, "Pressure moment X^Q") gives X^Q with scale 10/3
+    // and the extra lambda of the odd powers (the strain at sphere 2 scales with a2, as for X^M).
+    static SeriesTriangle pressureMoment(const TripleTable& table, double scale = 1.0, bool oddShift = false)
     {
         SeriesTriangle s;
+        s.scale = scale;
+        s.oddPowerShift = oddShift;
         s.order = table.order();
         s.c.resize(s.order + 1);
         for (int k = 0; k <= s.order; ++k) {
@@ -263,7 +267,10 @@ struct SeriesTriangle {
     }
 };
 
-enum SeriesId { SeriesXA, SeriesXG, SeriesYA, SeriesYB, SeriesYG, SeriesYC, SeriesYH, SeriesXM, SeriesYM, SeriesZM, SeriesXP, NumSeries };
+// Truncation of the X^Q pressure series (the M recurrences of the strain problem, rebuilt to this order).
+const int strainPressureMomentOrder = 200;
+
+enum SeriesId { SeriesXA, SeriesXG, SeriesYA, SeriesYB, SeriesYG, SeriesYC, SeriesYH, SeriesXM, SeriesYM, SeriesZM, SeriesXP, SeriesXQ, NumSeries };
 
 // Orders: 100 as in T23's generator for A, B, C, G, H and X^M; 130 for Y^M and 200 for Z^M, whose sums
 // converge more slowly (T23 uses 130, and 150 / 200 for the even / odd Z^M sums).
@@ -296,6 +303,12 @@ struct SeriesStore {
         {
             std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(100, 2);
             s[SeriesXM] = SeriesTriangle(t->P, 2, 1.0, true);       // Ichiki et al. (105)
+        }
+        {
+            // the same strain problem to order 200 for X^Q (~1 s): its constants need the L/m^2 tail, whose level
+            // is estimated from the coefficients themselves (docs/resistance.md, truncation 100 vs 200 vs 300)
+            std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(strainPressureMomentOrder, 2);
+            s[SeriesXQ] = SeriesTriangle::pressureMoment(t->P, 10.0 / 3.0, true);  // pressure at the other centre
         }
         {
             std::unique_ptr<RecurrenceTables> t = buildAsymmetric(130, TranslationStart2);
@@ -339,6 +352,24 @@ double inverseSquareTail(int first)
     return 0.25 * (1 / x + 1 / (2 * x2) + 1 / (6 * x2 * x) - 1 / (30 * x2 * x2 * x));
 }
 
+// The part of a near-contact constant that comes from a pressure-moment series of one parity whose
+// coefficients tend to g1 + 2 g2/m - 4 g3/m^2 + (oscillating, ~m^-3) with g3 not known in closed form:
+// sum_{m <= M} (a_m - g1 - 2 g2/m) plus the tail sum_{m > M} L/m^2, L the mean of m^2 (a_m - g1 - 2 g2/m) over the
+// powers M/2 <= m <= M of that parity (L = -4 g3 up to the oscillation).  Used for X^Q (docs/resistance.md).
+double subtractedSumWithTail(const SeriesTriangle& series, double lambda, Parity parity, int M, double g1, double g2)
+{
+    const int first = (parity == Odd) ? 1 : 2, last = (parity == Odd) ? M - 1 : M;
+    double level = 0;
+    int count = 0;
+    for (int m = first; m <= last; m += 2)
+        if (2 * m >= M) {
+            level += double(m) * m * (series.normalisedTerm(m, lambda) - g1 - 2 * g2 / m);
+            ++count;
+        }
+    level /= count;
+    return subtractedSum(series, lambda, parity, M, g1, g2, 0) + level * inverseSquareTail(last + 2);
+}
+
 NearFieldForm form(double inv, double log, double c0, double xlog)
 {
     NearFieldForm f;
@@ -353,7 +384,7 @@ NearFieldForm form(double inv, double log, double c0, double xlog)
 
 double farFieldCoefficient(PairFunction family, int k, double lambda)
 {
-    const SeriesStore& store = seriesStore(false);
+    const SeriesStore& store = seriesStore(family == XQ);  // the X^Q series comes with the M recurrences
     SeriesId id;
     switch (family) {
     case XA: id = SeriesXA; break;
@@ -364,6 +395,7 @@ double farFieldCoefficient(PairFunction family, int k, double lambda)
     case YG: id = SeriesYG; break;
     case YH: id = SeriesYH; break;
     case XP: id = SeriesXP; break;
+    case XQ: id = SeriesXQ; break;
     default: throw std::invalid_argument("farFieldCoefficient: no far-field series kept for this family");
     }
     return store.s[id].normalisedTerm(k, lambda) * std::pow(2 * (1 + lambda), k);
@@ -519,6 +551,31 @@ NearFieldConstants computeNearFieldConstants(double lam, bool withM)
         const double M12 = 8 / l1_3 * (2 * g3 - subtractedSum(s, lam, Odd, 200, 0, 0, g3));
         k.f11[ZM] = form(0, 0, M11, g3);
         k.f12[ZM] = form(0, 0, l1_3 / 8 * M12, -g3);
+    }
+    // Pressure moment X^Q (trace of the force dipole from the ambient strain), Kim-Karrila with 6 pi a1^3:
+    // s1 = eta (X11Q + X12Q) d.E.d; X11Q: strain at sphere 1 (J92's X^M problem), X12Q: strain at sphere 2.
+    // Derivation and checks in docs/resistance.md, "Pressure moment X^Q":
+    //  * 1/xi: near the gap the surface of the strained sphere alpha recedes with speed a_alpha d.E.d: the
+    //    squeeze of X^P, g1 (11) and lambda g1 (12).
+    //  * ln(1/xi), as for X^P: s1 = -a1 (integral of p over sphere 1) = a1 F1.d + the two lubrication tails
+    //    (tilted surface, viscous traction), where F1.d is the X^G force (X11G, and X21G by Eq. A.3):
+    //    h1 = (2/3) g2 of X11G + w^3 - 2 w^2 = lambda (1 + 2 lambda - 9 lambda^2) / (5 (1+lambda)^3),
+    //    h2 = (2/3) lambda^2 g2 of X11G(1/lambda) + lambda (w^3 - 2 w^2) = -2 lambda^2 (2 lambda^2 - lambda + 2) / (5 (1+lambda)^3);
+    //    h1 + h2 = (1 + lambda) g2P, as Appendix C.1 requires of the singular terms.  Checked against the
+    //    series (b_m -> g + 2 h/m, test PressureMomentQ.SeriesMatchesNearField).
+    //  * O(1): the subtracted series X11Q = sum_even b_m t^m, X12Q = sum_odd b_m t^m (SeriesTriangle::pressureMoment
+    //    of the strain table) truncated at 200 with the L/m^2 tail; no xi ln(1/xi) term kept.
+    //    Near contact: even S1 = 1/xi + 3/4 (no m = 0 term here: -1), odd S1 = 1/xi + 1/4, S2 = ln(1/xi) + 2 ln 2.
+    {
+        const double g1 = 2 * l2 / l1_3;
+        const double h1 = lam * (1 + 2 * lam - 9 * l2) / (5 * l1_3);
+        const double h2 = -2 * l2 * (2 * l2 - lam + 2) / (5 * l1_3);
+        const SeriesTriangle& s = store.s[SeriesXQ];
+        const int MQ = strainPressureMomentOrder;
+        const double Q11 = -g1 / 4 + subtractedSumWithTail(s, lam, Even, MQ, g1, h1);
+        const double Q12 = lam * g1 / 4 + 2 * h2 * L + subtractedSumWithTail(s, lam, Odd, MQ, lam * g1, h2);
+        k.f11[XQ] = form(g1, h1, Q11, 0);
+        k.f12[XQ] = form(lam * g1, h2, Q12, 0);
     }
     return k;
 }

@@ -16,11 +16,13 @@ double kimKarrilaFactor(PairFunction f, double a)
     case XC: case YC: case YH: return 8 * pi * a * a * a;
     case XM: case YM: case ZM: return 20.0 / 3.0 * pi * a * a * a;
     case XP: return 6 * pi * a * a;
+    case XQ: return 6 * pi * a * a * a;  // this library's choice: C.1 reads X11Q + X12Q = (r/2a1)(X11P - X12P) + regular
     default: return 0;
     }
 }
 
-// Eq. (A.4): the functions odd under d -> -d change sign when the roles of the spheres swap.
+// Eq. (A.4): the functions odd under d -> -d change sign when the roles of the spheres swap (not X^Q:
+// Q_ab = X^Q_ab (dd - I/3) is even in d).
 static double swapSign(PairFunction f) { return (f == YB || f == XG || f == YG || f == XP) ? -1.0 : 1.0; }
 
 PairForms makePairForms(double a1, double a2, bool withM)

@@ -54,6 +54,32 @@ TEST(Cli, PairTheoryPrintsEveryFunction)
         EXPECT_NE(r.output.find(std::string("\"") + f + "\""), std::string::npos) << f;
 }
 
+// X^Q (pressure moment from the strain) is printed with the theory, as the library gives it in both units
+// (Kim-Karrila: 6 pi a^3), and not with the sub-grid functions (the paper drops the strain columns, Eq. 21).
+TEST(Cli, PairTheoryPrintsPressureMomentQ)
+{
+    const Result r = run("pair --a1 1 --a2 1.4 --xi 0.02 --theory");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("6 pi a1^3 (Q)"), std::string::npos);
+    const std::string kimKarrila = r.output.substr(0, r.output.find("\"dimensional_over_eta\""));
+    const std::string dimensional = r.output.substr(r.output.find("\"dimensional_over_eta\""));
+    const fdm::resistance::PairForms forms = fdm::resistance::makePairForms(1, 1.4, true);
+    const fdm::resistance::PairFunctionValues v = fdm::resistance::evaluate(forms, 0.02);
+    const char* index[2][2] = {{"11", "12"}, {"21", "22"}};
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+            const std::string key = std::string("XQ") + index[a][b];
+            const double value = v.f[fdm::resistance::XQ][a][b];
+            EXPECT_GT(value, 0) << key;  // strain along d pulls the gap open: s > 0 on both spheres
+            EXPECT_NEAR(field(dimensional, key), value, 1e-12 * std::fabs(value)) << key;
+            const double kk = value / (6 * M_PI * std::pow(a == 0 ? 1.0 : 1.4, 3));
+            EXPECT_NEAR(field(kimKarrila, key), kk, 1e-12 * std::fabs(kk)) << key;
+        }
+    const Result sub = run("pair --a1 1 --a2 1.4 --xi 0.02 --subgrid --delta 0.1");
+    ASSERT_EQ(sub.status, 0) << sub.output;
+    EXPECT_EQ(sub.output.find("\"XQ11\""), std::string::npos);
+}
+
 TEST(Cli, PairSubgridMatrixAndWall)
 {
     Result r = run("pair --a1 1 --a2 1.4 --xi 0.01 --subgrid --delta 0.1");

@@ -9,9 +9,9 @@
 // recurrence family, lambda-independent) and summed for each lambda (truncated as in T23's generator).
 //
 // Normalisation ("Kim & Karrila with a1", as Townsend's tables): the 11 and 12 scalars are divided by
-// 6 pi a1 (A), 4 pi a1^2 (B, G), 8 pi a1^3 (C, H), 20/3 pi a1^3 (M), 6 pi a1^2 (P, this library's
-// choice); all times the viscosity.  The 21 and 22 scalars are the 12 and 11 scalars at 1/lambda,
-// normalised with a2 (paper Eq. A.4, with its signs for B, G, P).
+// 6 pi a1 (A), 4 pi a1^2 (B, G), 8 pi a1^3 (C, H), 20/3 pi a1^3 (M), 6 pi a1^2 (P) and 6 pi a1^3 (Q) (P, Q:
+// this library's choice); all times the viscosity.  The 21 and 22 scalars are the 12 and 11 scalars at
+// 1/lambda, normalised with a2 (paper Eq. A.4, with its signs for B, G, P; Q keeps its sign).
 #ifndef FDM_RESISTANCE_NEAR_FIELD_SERIES_HPP
 #define FDM_RESISTANCE_NEAR_FIELD_SERIES_HPP
 
@@ -20,10 +20,13 @@
 namespace fdm {
 namespace resistance {
 
-// Scalar families of paper Eq. (A.1).  XP is the pressure moment (trace of the force dipole): 1/xi and
-// ln(1/xi) terms by lubrication theory, O(1) constant from the twin-multipole pressure series; no
-// xi ln(1/xi) term (docs/resistance.md).  X^Q has no slot (only its C.1 combination with X^P is used).
-enum PairFunction { XA, YA, YB, XC, YC, XG, YG, YH, XM, YM, ZM, XP, NumPairFunctions };
+// Scalar families of paper Eq. (A.1).  XP and XQ are the pressure moments (trace of the force dipole s)
+// from the translations and from the ambient strain: s_alpha = -eta sum_beta X^P_ab d.U_b + eta sum_beta
+// X^Q_ab d.E.d (paper Eq. 19, Q_ab = X^Q_ab (dd - I/3)); 1/xi and ln(1/xi) terms by lubrication theory,
+// O(1) constants from the twin-multipole pressure series; no xi ln(1/xi) term (docs/resistance.md).
+// XQ is built with the M functions (withM) and is a theoretical function only: the sub-grid model drops
+// the strain columns (paper Eq. 21), so it has no sub-grid value and no place in the blocks.
+enum PairFunction { XA, YA, YB, XC, YC, XG, YG, YH, XM, YM, ZM, XP, XQ, NumPairFunctions };
 const char* pairFunctionName(PairFunction f);
 
 // c_inv/xi + c_log ln(1/xi) + c_0 + c_xlog xi ln(1/xi)
@@ -42,8 +45,8 @@ struct NearFieldConstants {
     NearFieldForm f12[NumPairFunctions];
 };
 
-// Builds the constants.  withM: also X^M, Y^M, Z^M (the Z^M recurrence to order 200 takes ~0.5 s the
-// first time in a process; it is not needed for the sub-grid matrices).
+// Builds the constants.  withM: also X^M, Y^M, Z^M and X^Q (the Z^M recurrence to order 200 takes ~0.5 s
+// the first time in a process; they are not needed for the sub-grid matrices).
 NearFieldConstants computeNearFieldConstants(double lambda, bool withM = false);
 
 // Individual pieces, exposed for the tests and the documentation.
@@ -52,7 +55,8 @@ double hurwitzZeta3(double a);  // sum_{k>=0} (k+a)^-3, a > 0
 // Far-field series coefficient f_k(lambda) of J&O (3.15)/(9), J92, as tabulated in
 // reference/two_sphere_general_lambda/farfield_fk.csv ("XA","YA","YB","YC","XG","YG","YH"); also XP,
 // the pressure-moment series built here from the X^A table (X11P = sum_odd, X12P = -sum_even of
-// f_k/(2(1+lambda))^k t^k, t = 2/s'; docs/resistance.md, "Pressure moment X^P").
+// f_k/(2(1+lambda))^k t^k, t = 2/s'; docs/resistance.md, "Pressure moment X^P"), and XQ, the same from
+// the strain table of X^M (X11Q = sum_even, X12Q = +sum_odd; built with the M recurrences on first use).
 double farFieldCoefficient(PairFunction family, int k, double lambda);
 
 // ---------------------------------------------------------------------------------------------

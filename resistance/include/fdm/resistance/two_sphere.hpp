@@ -3,8 +3,9 @@
 // f[family][alpha][beta] follows paper Eq. (A.1): alpha = sphere feeling the force/torque/stresslet,
 // beta = sphere whose motion causes it (0 = sphere 1, 1 = sphere 2); d = (x2 - x1)/|x2 - x1|.
 // 11 and 12: the Kim-Karrila scalars at lambda = a2/a1 times 6 pi a1 (A), 4 pi a1^2 (B, G),
-// 8 pi a1^3 (C, H), 20/3 pi a1^3 (M), 6 pi a1^2 (P).  21 and 22: paper Eq. (A.4), i.e. the 12 and 11
-// scalars at 1/lambda, times the same factors built on a2, with a minus sign for B, G and P (d reverses).
+// 8 pi a1^3 (C, H), 20/3 pi a1^3 (M), 6 pi a1^2 (P), 6 pi a1^3 (Q).  21 and 22: paper Eq. (A.4), i.e. the 12
+// and 11 scalars at 1/lambda, times the same factors built on a2, with a minus sign for B, G and P (d reverses).
+// X^Q (and X^M, Y^M, Z^M) only when built withM; otherwise their values are zero.
 #ifndef FDM_RESISTANCE_TWO_SPHERE_HPP
 #define FDM_RESISTANCE_TWO_SPHERE_HPP
 
@@ -38,7 +39,7 @@ PairFunctionValues evaluate(const PairForms& forms, double xi);  // xi floored a
 
 // Full-range theory (docs/resistance.md, "Full-range forms"): X^A, Y^A, Y^B, Y^C from the matched forms
 // of J&O (near-field singular terms plus the far-field series with their own expansion subtracted),
-// X^C from its exact series (Jeffery 1915), valid at every gap; the other families (X^G, Y^G, Y^H, M, P)
+// X^C from its exact series (Jeffery 1915), valid at every gap; the other families (X^G, Y^G, Y^H, M, P, Q)
 // are the near-field forms, as in evaluate().  The near-field forms themselves (evaluate, makePairForms,
 // the sub-grid model) are unchanged.  Same layout and units as evaluate(): [family][alpha][beta],
 // dimensional / viscosity; 21 and 22 from the 1/lambda constants by Eq. (A.4).
