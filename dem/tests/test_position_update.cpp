@@ -33,6 +33,17 @@ double distance(const std::vector<double> &x, int i, int j, const double period[
 
 // Particles turning rigidly about the z axis through the origin at rate w (U = w e_z x x), with the
 // previous step's positions and velocities of the same rigid motion dt earlier.
+// Two unit spheres on the x axis at surface gap h (negative: overlapping), velocities u (6 per sphere).
+motion::Configuration unitPairOnX(double h, const std::vector<double> &u)
+{
+  motion::Configuration c;
+  c.n = 2;
+  c.radius = {1.0, 1.0};
+  c.x = {0, 0, 0, 2 + h, 0, 0};
+  c.u = u;
+  return c;
+}
+
 motion::Configuration rigidRotation(const std::vector<double> &x, const std::vector<double> &radius, double w,
                                     double dt)
 {
@@ -179,11 +190,7 @@ TEST(PositionUpdate, LimitedLogStepIsCounted)
 
 TEST(PositionUpdate, OverlappingPairIsLeftToTheStraightStep)
 {
-  motion::Configuration c;
-  c.n = 2;
-  c.radius = {1.0, 1.0};
-  c.x = {0, 0, 0, 1.999, 0, 0};
-  c.u = {0.1, 0.2, 0, 0, 0, 0, -0.1, 0, 0, 0, 0, 0};
+  const motion::Configuration c = unitPairOnX(-1e-3, {0.1, 0.2, 0, 0, 0, 0, -0.1, 0, 0, 0, 0, 0});
   std::vector<double> rate;
   const motion::Statistics stats = motion::displacementRates(c, {0, 1}, {}, 0.1, motion::Options(), rate);
   EXPECT_EQ(stats.pairGaps, 0);
@@ -305,11 +312,7 @@ TEST(PositionUpdate, ContradictoryTargetsKeepTheStraightStep)
 TEST(PositionUpdate, GapsInsideContactSpringsKeepTheStraightStep)
 {
   // h = 2e-3 < h_r = 5e-3: a contact spring holds this gap, the straight step stays
-  motion::Configuration c;
-  c.n = 2;
-  c.radius = {1.0, 1.0};
-  c.x = {0, 0, 0, 2.002, 0, 0};
-  c.u = {0.01, 0, 0, 0, 0, 0, -0.01, 0, 0, 0, 0, 0};
+  const motion::Configuration c = unitPairOnX(2e-3, {0.01, 0, 0, 0, 0, 0, -0.01, 0, 0, 0, 0, 0});
   motion::Options o;
   o.contactGap = 5e-3;
   std::vector<double> rate;
