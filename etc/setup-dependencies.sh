@@ -42,7 +42,7 @@ fi
 # ---- 2. Python packages --------------------------------------------------------------------------
 python=${FDM_PYTHON:-python3}
 pyMissing=""
-for m in numpy matplotlib pytest; do
+for m in numpy scipy matplotlib pytest; do
     "$python" -c "import $m" 2>/dev/null || pyMissing="$pyMissing $m"
 done
 if [ -n "$pyMissing" ]; then

@@ -1,0 +1,201 @@
+"""Rheology of a suspension in simple shear from the core values of a run (paper 6.1, Eqs. 51-57),
+and the Maron-Pierce fit of the viscosity over several runs (Eq. 55).
+
+    from fdm import profiles, rheology
+    series = profiles.core_series(snapshots, channel)             # one row per snapshot
+    r = rheology.shear_rheology(series, eta=1.0)                  # steady part found by MSER-m
+    r.eta_s.value, r.eta_s.error, r.n1_hat, r.sigma_c_hat[1], r.start_time
+    fit = rheology.fit_maron_pierce(phi_core, eta_s, eta_s_error) # alpha, phi_m and their errors
+    rheology.plot_viscosity("eta.png", phi_core, eta_s, eta_s_error, fit)
+
+What is computed. Axes: 1 = flow (channel.flow_axis), 2 = wall-normal (channel.wall_axis),
+3 = vorticity. Per snapshot (fdm.profiles.core_values): gamma_dot_core and the core particle
+stresses Sigma^{h,core}, Sigma^{c,core} (Eq. 53 averaged over the core). With <.> the time
+average over the steady part, Sigma^p = Sigma^h + Sigma^c, eta the fluid viscosity:
+
+    Sigma_12 = eta <gamma_dot_core> + <Sigma^p_12>                 (Eq. 51, shear component)
+    eta_s    = Sigma_12 / (eta <gamma_dot_core>) = 1 + <Sigma^p_12> / (eta <gamma_dot_core>)   (Eq. 54)
+    N1_hat   = <Sigma^p_11 - Sigma^p_22> / Sigma_12                  (Eq. 56)
+    N2_hat   = <Sigma^p_22 - Sigma^p_33> / Sigma_12
+    Sigma^c_ii_hat = <Sigma^c_ii> / Sigma_12,   i = 1, 2, 3          (Eq. 57)
+
+The normal stress differences take the particle stresses only: the -P delta of Eq. 51 cancels in
+a difference, and the fluid's Newtonian stress eta gamma_dot (e1 e2 + e2 e1) of Eq. 51 has no
+normal components (the particles' disturbance of the fluid is in their stresslets). The
+isotropic parts s^h delta/3 of S^H (Eq. 52) are kept in Sigma^h (they cancel in N1, N2, not in
+the Sigma^c_ii_hat, which are contact stresses only). Every quantity is a ratio of time averages;
+its error is the delta-method error of a ratio of means (fdm.timeseries.ratio_of_means), by block
+averaging over the snapshots. The steady part starts at the latest start found by MSER-m
+(fdm.timeseries.detect_transient) on the series that enter these averages (phi_core,
+gamma_dot_core, Sigma^p_12, Sigma^p_11 - Sigma^p_22, Sigma^p_22 - Sigma^p_33, Sigma^c_11,
+Sigma^c_22, Sigma^c_33), unless start_time is given.
+
+Maron-Pierce (Eq. 55): eta_s = alpha / (1 - phi/phi_m)^2 fitted by weighted least squares
+(scipy.optimize.curve_fit with sigma = the error bars of eta_s, absolute_sigma=True: the
+parameter covariance is that of the given error bars, not rescaled by chi^2/dof); the starting
+point from the straight line eta_s^(-1/2) = alpha^(-1/2) (1 - phi/phi_m); phi_m is bounded below
+by the largest phi of the data.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import curve_fit
+
+from . import timeseries
+from .profiles import CoreSeries, component
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A time average: value, standard error, effective number of independent samples."""
+
+    value: float
+    error: float
+    n_eff: float
+
+    @classmethod
+    def from_average(cls, avg: timeseries.Average, offset: float = 0.0) -> "Estimate":
+        return cls(float(avg.mean) + offset, float(avg.error), float(avg.n_eff))
+
+
+@dataclass(frozen=True)
+class ShearRheology:
+    """Steady simple-shear rheology of one run (module docstring): phi_core, gamma_dot_core,
+    sigma_12 (Sigma_12, stress), eta_s (Eq. 54, relative viscosity), n1_hat, n2_hat (Eq. 56),
+    sigma_c_hat (Eq. 57: 11, 22, 33); sigma_h, sigma_c (6,) the mean core particle stresses
+    (COMPONENTS order of the box axes); start_time of the steady part, steady (False if the
+    transient may last longer than half the run), n_samples averaged."""
+
+    phi_core: Estimate
+    gamma_dot_core: Estimate
+    sigma_12: Estimate
+    eta_s: Estimate
+    n1_hat: Estimate
+    n2_hat: Estimate
+    sigma_c_hat: tuple[Estimate, Estimate, Estimate]
+    sigma_h: NDArray
+    sigma_c: NDArray
+    start_time: float
+    steady: bool
+    n_samples: int
+
+
+def shear_rheology(series: CoreSeries, eta: float = 1.0, start_time: float | None = None) -> ShearRheology:
+    """Eqs. 54, 56, 57 from the core values of a run (equally spaced snapshots), time-averaged over
+    the steady part: from start_time if given, else from the start detected by MSER-m."""
+    ch = series.channel
+    i1, i2, i3 = ch.flow_axis, ch.wall_axis, ch.vorticity_axis
+    c11, c22, c33, c12 = component(i1, i1), component(i2, i2), component(i3, i3), component(i1, i2)
+    sp = series.sigma_h + series.sigma_c
+    shear = eta * series.gamma_dot
+    total12 = shear + sp[:, c12]
+    columns = np.column_stack([series.phi, series.gamma_dot, sp[:, c12], sp[:, c11] - sp[:, c22],
+                               sp[:, c22] - sp[:, c33], series.sigma_c[:, c11], series.sigma_c[:, c22],
+                               series.sigma_c[:, c33]])
+    t = series.times
+    if start_time is None:
+        tr = timeseries.detect_transient(columns, t)
+        start, steady = tr.start, tr.steady
+    else:
+        after = np.nonzero(t >= start_time)[0]
+        if len(after) == 0:
+            raise ValueError("no snapshot at or after start_time = %g" % start_time)
+        start, steady = int(after[0]), True
+    sl = slice(start, None)
+
+    def ratio(num: NDArray, den: NDArray, offset: float = 0.0) -> Estimate:
+        return Estimate.from_average(timeseries.ratio_of_means(num[sl], den[sl]), offset)
+
+    def mean(x: NDArray) -> Estimate:
+        return Estimate.from_average(timeseries.block_average(x[sl]))
+
+    return ShearRheology(
+        phi_core=mean(series.phi), gamma_dot_core=mean(series.gamma_dot), sigma_12=mean(total12),
+        eta_s=ratio(sp[:, c12], shear, offset=1.0),
+        n1_hat=ratio(sp[:, c11] - sp[:, c22], total12), n2_hat=ratio(sp[:, c22] - sp[:, c33], total12),
+        sigma_c_hat=(ratio(series.sigma_c[:, c11], total12), ratio(series.sigma_c[:, c22], total12),
+                     ratio(series.sigma_c[:, c33], total12)),
+        sigma_h=series.sigma_h[sl].mean(axis=0), sigma_c=series.sigma_c[sl].mean(axis=0),
+        start_time=float(t[start]), steady=bool(steady), n_samples=len(t) - start)
+
+
+# ---- Maron-Pierce ------------------------------------------------------------------------------
+
+def maron_pierce(phi: ArrayLike, alpha: float, phi_m: float) -> NDArray:
+    """Eq. 55: alpha / (1 - phi/phi_m)^2."""
+    return alpha / (1.0 - np.asarray(phi, dtype=float) / phi_m) ** 2
+
+
+@dataclass(frozen=True)
+class MaronPierceFit:
+    """alpha, phi_m, their standard errors and (2, 2) covariance (order alpha, phi_m); chi2 of the
+    fit and dof = points - 2. Call it on phi to evaluate the fitted Eq. 55."""
+
+    alpha: float
+    phi_m: float
+    alpha_error: float
+    phi_m_error: float
+    covariance: NDArray
+    chi2: float
+    dof: int
+
+    def __call__(self, phi: ArrayLike) -> NDArray:
+        return maron_pierce(phi, self.alpha, self.phi_m)
+
+
+def fit_maron_pierce(phi: ArrayLike, eta_s: ArrayLike, eta_s_error: ArrayLike,
+                     p0: tuple[float, float] | None = None) -> MaronPierceFit:
+    """Fit Eq. 55 to eta_s (n,) at phi (n,) (n >= 3) with standard errors eta_s_error (n,) (module
+    docstring). p0: starting (alpha, phi_m), default from the linearised fit."""
+    x = np.asarray(phi, dtype=float).reshape(-1)
+    y = np.asarray(eta_s, dtype=float).reshape(-1)
+    s = np.asarray(eta_s_error, dtype=float).reshape(-1)
+    if not (x.shape == y.shape == s.shape) or x.size < 3:
+        raise ValueError("phi, eta_s, eta_s_error must be three arrays of the same length >= 3")
+    if np.any(s <= 0) or np.any(y <= 0):
+        raise ValueError("eta_s and its errors must be positive")
+    floor = float(x.max()) * (1.0 + 1e-9)
+    if p0 is None:
+        # eta^(-1/2) = c0 + c1 phi, c0 = alpha^(-1/2), c1 = -c0/phi_m; weights from the error bars
+        v = y ** -0.5
+        sv = 0.5 * s * y ** -1.5
+        c1, c0 = np.polyfit(x, v, 1, w=1.0 / sv)
+        alpha0 = 1.0 / c0 ** 2 if c0 > 0 else 1.0
+        phim0 = -c0 / c1 if c1 < 0 and c0 > 0 else floor * 1.1
+        p0 = (alpha0, max(phim0, floor * 1.01))
+    popt, pcov = curve_fit(maron_pierce, x, y, p0=p0, sigma=s, absolute_sigma=True,
+                           bounds=([0.0, floor], [np.inf, np.inf]))
+    chi2 = float(np.sum(((y - maron_pierce(x, *popt)) / s) ** 2))
+    return MaronPierceFit(alpha=float(popt[0]), phi_m=float(popt[1]), alpha_error=float(np.sqrt(pcov[0, 0])),
+                          phi_m_error=float(np.sqrt(pcov[1, 1])), covariance=pcov, chi2=chi2, dof=x.size - 2)
+
+
+def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error: ArrayLike | None = None,
+                   fit: MaronPierceFit | None = None, phi_core_error: ArrayLike | None = None,
+                   label: str = "simulations", title: str | None = None) -> str:
+    """PNG of eta_s against phi_core with error bars and, if given, the Maron-Pierce curve
+    (Fig. 21). Returns path."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(5.5, 4.2))
+    ax = fig.subplots()
+    ax.errorbar(phi_core, eta_s, yerr=eta_s_error, xerr=phi_core_error, fmt="o", ms=5, capsize=3, label=label)
+    eta_data = np.asarray(eta_s, dtype=float)
+    if fit is not None:
+        grid = np.linspace(0.0, 0.998 * fit.phi_m, 400)
+        ax.plot(grid, fit(grid), "--", label=r"Maron-Pierce $\alpha$ = %.3f $\pm$ %.3f, $\phi_m$ = %.3f $\pm$ %.3f"
+                % (fit.alpha, fit.alpha_error, fit.phi_m, fit.phi_m_error))
+    ax.set_yscale("log")
+    low = min(eta_data.min(), fit.alpha if fit is not None else eta_data.min())
+    ax.set_ylim(0.7 * low, 3.0 * eta_data.max())
+    ax.set_xlabel(r"$\phi_{core}$")
+    ax.set_ylabel(r"$\eta_s$")
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path
