@@ -23,7 +23,7 @@ the squared error is
 
 i.e. the lag-1 covariance of adjacent block means, which the plateau test lets through at the
 level of its noise, is included: it removes the O(tau/block) bias of the plain estimate (on AR(1)
-series with rho = 0.9 and 2^14 samples the plain plateau value is 10 % low on average, this one
+series with rho = 0.9 and 2^14 samples the plain plateau value is 9 % low on average, this one
 within 1 %). The effective number of independent samples is n_eff = var(x)/error^2 (var with
 n - 1), the statistical inefficiency g = n/n_eff. If no level passes the test (series shorter than
 a few correlation times), the coarsest usable level is taken and `plateau` is False: the error is
