@@ -40,6 +40,9 @@ def test_one_sphere_planes_bins_and_integral():
     # bins: the halves of the sphere, nothing elsewhere
     b = P.profiles_in_bins(s, ch, [-3, -1, 0, 1, 3])
     assert np.allclose(b.phi, [0, ball(1) / 2 / 20, ball(1) / 2 / 20, 0], rtol=1e-14, atol=1e-16)
+    # slab volumes: caps by the textbook formula
+    v = P.slab_volumes([0.0, 0.3], [1.0, 1.0], [-3.0, 0.0, 0.5], [-0.6, 3.0, 0.5])
+    assert np.allclose(v, [[cap(1, 0.4), ball(1) / 2, 0], [cap(1, 0.1), ball(1) - cap(1, 0.7), 0]], rtol=1e-13)
     # the integral of phi over the channel / L_y = phi_bulk
     assert P.volume_fraction(s, ch) == pytest.approx(ball(1) / 120, rel=1e-14)
     assert P.bulk_volume_fraction(s, ch) == pytest.approx(ball(1) / 120, rel=1e-14)
@@ -317,6 +320,12 @@ def test_transient_of_several_series_is_the_latest():
     assert both.start == T.detect_transient(slow).start > T.detect_transient(fast).start
     with pytest.raises(ValueError):
         T.detect_transient(np.ones(10))
+    with pytest.raises(ValueError):
+        T.detect_transient(np.r_[np.ones(100), np.nan])
+    # a drift over the whole run: no steady part
+    drift = np.linspace(0, 1, 1000) + 0.05 * ar1(1000, 0.5, rng)
+    assert not T.detect_transient(drift).steady
+    assert T.detect_transient(slow).steady
 
 
 # ---- rheology ----------------------------------------------------------------------------------

@@ -232,6 +232,8 @@ def detect_transient(x: ArrayLike, times: ArrayLike | None = None, factor: float
     n = data.shape[0]
     if n < 4 * MIN_BLOCKS:
         raise ValueError("detect_transient needs at least %d samples, got %d" % (4 * MIN_BLOCKS, n))
+    if not np.all(np.isfinite(data)):
+        raise ValueError("detect_transient: the series has nan or infinite samples")
     t = np.arange(n, dtype=float) if times is None else np.asarray(times, dtype=float)
     if t.shape != (n,):
         raise ValueError("times has shape %s, expected (%d,)" % (t.shape, n))
