@@ -7,7 +7,8 @@
 // generator, shared/reference/two_sphere_general_lambda) entering the derived coefficients, and the
 // independent twin-multipole series of the pressure, (c) continuity with the leading 1/xi term, with the
 // far-field (Stokeslet) pressure and with the sphere-wall limit.
-#include "fdm/resistance/near_field_series.hpp"
+#include "fdm/resistance/far_field_series.hpp"
+#include "fdm/resistance/near_field_constants.hpp"
 #include "fdm/resistance/sphere_wall.hpp"
 #include "fdm/resistance/two_sphere.hpp"
 #include "reference_data.hpp"
@@ -108,7 +109,7 @@ TEST(PressureMoment, FarFieldIsStokesletPressure)
     }
 }
 
-// The O(1) constants: the subtracted series truncated at 100 with a tail estimate (near_field_series.cpp).
+// The O(1) constants: the subtracted series truncated at 100 with a tail estimate (near_field_constants.cpp).
 // Recomputed here from the public series at truncation 80 with the same procedure: they must agree to 1e-3
 // (measured 4e-4; 100 against 200: 7e-4 at lambda = 10, below 2e-4 for lambda <= 2).  Also the values at
 // lambda = 1 (regression, 1e-4).
