@@ -2,9 +2,9 @@
 //   X11P = g1/xi + g2P ln(1/xi) + c0_11,   X12P = -g1/xi - g2P ln(1/xi) + c0_12   (Kim-Karrila, 6 pi a1^2),
 // g1 of X^A, g2P = g2 + w^3 - 2 w^2 = lambda (1 - 4 lambda) / (5 (1+lambda)^2), w = lambda/(1+lambda)
 // (derivation in docs/resistance.md, "Pressure moment X^P").  No published X^P numbers were available
-// here (Jeffrey, Morris & Brady 1993 is not in shared/reference): the checks are (a) the size-ratio
-// relations of paper Eq. (A.4) and the physics of sphere 2, (b) the published g1, g2 of X^A (Townsend's
-// generator, shared/reference/two_sphere_general_lambda) entering the derived coefficients, and the
+// here (Jeffrey, Morris & Brady 1993 is not among the project's reference data): the checks are (a) the
+// size-ratio relations of paper Eq. (A.4) and the physics of sphere 2, (b) the published g1, g2 of X^A
+// (Townsend's generator, tests/data/two_sphere_general_lambda) entering the derived coefficients, and the
 // independent twin-multipole series of the pressure, (c) continuity with the leading 1/xi term, with the
 // far-field (Stokeslet) pressure and with the sphere-wall limit.
 #include "fdm/resistance/far_field_series.hpp"

@@ -3,8 +3,8 @@
 //   X11Q = g1/xi + h1 ln(1/xi) + c0_11,   X12Q = lambda g1/xi + h2 ln(1/xi) + c0_12,
 //   h1 = lambda (1 + 2 lambda - 9 lambda^2) / (5 (1+lambda)^3),  h2 = -2 lambda^2 (2 lambda^2 - lambda + 2) / (5 (1+lambda)^3)
 // (derivation in docs/resistance.md, "Pressure moment X^Q").  No published X^Q numbers were available here
-// (Jeffrey, Morris & Brady 1993 is not in shared/reference).  The checks: (a) the singular terms from the
-// published X^G coefficients (Townsend's generator) and the lubrication tails of X^P; (b) the independent
+// (Jeffrey, Morris & Brady 1993 is not among the project's reference data).  The checks: (a) the singular
+// terms from the published X^G coefficients (Townsend's generator) and the lubrication tails of X^P; (b) the independent
 // twin-multipole series of the pressure (J92's strain problem) reproduces them; (c) the far field against
 // the single-sphere strain and Stokes solutions; (d) Appendix C.1: the theory's third term of Eq. (20),
 // (X11Q + X12Q) - (r/2a1)(X11P - X12P), has no singular term, seen in the series alone; (e) Eq. (A.4);

@@ -15,8 +15,8 @@
 namespace fdm {
 namespace resistance {
 
-// Far-field series coefficient f_k(lambda) of J&O (3.15)/(9), J92, as tabulated in
-// reference/two_sphere_general_lambda/farfield_fk.csv ("XA","YA","YB","YC","XG","YG","YH"); also XP,
+// Far-field series coefficient f_k(lambda) of J&O (3.15)/(9), J92, as tabulated by T23's generator (test data
+// two_sphere_general_lambda/farfield_fk.csv: "XA","YA","YB","YC","XG","YG","YH"); also XP,
 // the pressure-moment series built here from the X^A table (X11P = sum_odd, X12P = -sum_even of
 // f_k/(2(1+lambda))^k t^k, t = 2/s'; docs/resistance.md, "Pressure moment X^P"), and XQ, the same from
 // the strain table of X^M (X11Q = sum_even, X12Q = +sum_odd; built with the M recurrences on first use).
