@@ -11,7 +11,7 @@
    (they enter F^c of Eq. 32). The sub-grid blocks are not forces: they are the matrix R^SG of
    Eq. (31), which fix fdm/couple solves implicitly. The fix asks for them once per time step
    (collectBlocks) with the viscosity and mesh size the fluid solver announced at the handshake;
-   the resistance functions come from the project's resistance library (resistance/). */
+   the resistance functions come from the project's resistance library (dem/resistance/). */
 
 #ifndef FDM_PAIR_FDM_SUBGRID_H
 #define FDM_PAIR_FDM_SUBGRID_H

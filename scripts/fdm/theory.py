@@ -1,5 +1,5 @@
 """Theoretical references from the project's resistance library, through its command-line tool
-fdmResistance (resistance/, docs/resistance.md): one source of resistance functions for the solver,
+fdmResistance (dem/resistance/, docs/resistance.md): one source of resistance functions for the solver,
 the tests and the post-processing."""
 import json
 import os

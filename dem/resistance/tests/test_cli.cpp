@@ -115,7 +115,7 @@ TEST(Cli, RejectsBadInput)
     EXPECT_EQ(run("squeeze --a1 1 --a2 1 --xi 0.1 --near --order 150").status, 2);
 }
 
-// pair --theory --full: same layout, full-range values.  Townsend's table (README of shared/reference):
+// pair --theory --full: same layout, full-range values.  Townsend's table (tests/data/two_sphere_townsend):
 // lambda = 1, s' = 3: XA11 = 1.36847960 (Lamb's method, where the near-field form is 3 % off).
 TEST(Cli, PairTheoryFullPrintsFullRangeValues)
 {
@@ -208,5 +208,5 @@ TEST(Cli, SqueezeTowardWall)
         EXPECT_NEAR(squeeze(arguments), reflections, 1e-5) << arguments;
     }
     const Result r = run("squeeze --a 1 --eps 0.001 --wall");
-    EXPECT_NEAR(field(r.output, "XA_kim_karrila"), 1002.35, 0.01) << r.output;  // shared/reference README
+    EXPECT_NEAR(field(r.output, "XA_kim_karrila"), 1002.35, 0.01) << r.output;  // Fzt at h/a = 1.001, tests/data/sphere_wall/WallSphereResTab.csv
 }

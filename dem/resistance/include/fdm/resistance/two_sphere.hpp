@@ -9,7 +9,8 @@
 #ifndef FDM_RESISTANCE_TWO_SPHERE_HPP
 #define FDM_RESISTANCE_TWO_SPHERE_HPP
 
-#include "fdm/resistance/near_field_series.hpp"
+#include "fdm/resistance/full_range_forms.hpp"
+#include "fdm/resistance/near_field_constants.hpp"
 
 #include <map>
 #include <utility>

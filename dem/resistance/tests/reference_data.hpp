@@ -1,5 +1,6 @@
-// Readers for the shared reference numbers (shared/reference, see its README.md).  A missing folder or
-// file throws, so the test that needs it FAILS with the path in the message (it never skips).
+// Readers for the tests' reference numbers, kept in the repository under dem/resistance/tests/data (sources
+// and users of each file in its README.md).  A missing folder or file throws, so the test that needs it
+// FAILS with the path in the message (it never skips).
 #ifndef FDM_RESISTANCE_TESTS_REFERENCE_DATA_HPP
 #define FDM_RESISTANCE_TESTS_REFERENCE_DATA_HPP
 
@@ -13,7 +14,7 @@
 
 namespace reference {
 
-inline std::string folder() { return FDM_REFERENCE_DIR; }
+inline std::string folder() { return FDM_TEST_DATA_DIR; }
 
 inline bool folderExists()
 {
@@ -24,8 +25,8 @@ inline bool folderExists()
 inline std::string path(const std::string& relative)
 {
     if (!folderExists())
-        throw std::runtime_error("reference folder missing: " + folder() +
-                                 " (the repository must sit beside shared/; see shared/reference/README.md)");
+        throw std::runtime_error("reference data folder missing: " + folder() +
+                                 " (dem/resistance/tests/data in the repository)");
     const std::string p = folder() + "/" + relative;
     std::ifstream in(p.c_str());
     if (!in) throw std::runtime_error("reference file missing or unreadable: " + p);

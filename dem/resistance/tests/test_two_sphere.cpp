@@ -1,4 +1,4 @@
-// Two-sphere theoretical functions against the shared reference numbers (shared/reference/README.md):
+// Two-sphere theoretical functions against the reference numbers in tests/data (sources in its README.md):
 // Townsend's tabulated scalars (Pecnut/stokesian-dynamics), his generator's general-lambda constants,
 // and the reciprocity / size-ratio relations of paper Eqs. (A.3)-(A.4).
 #include "fdm/resistance/resistance.hpp"
@@ -25,10 +25,10 @@ const NearFieldConstants& constantsWithM(double lambda)
 
 }  // namespace
 
-TEST(ReferenceData, SharedFolderIsPresent)
+TEST(ReferenceData, FolderIsPresent)
 {
     EXPECT_TRUE(reference::folderExists()) << "missing " << reference::folder()
-                                           << ": the repository must sit beside shared/ (tests need its numbers)";
+                                           << ": the tests' reference numbers (dem/resistance/tests/data in the repository)";
 }
 
 // Townsend's table (near-field part, s' <= 2.02) for lambda = 0.1, 1, 10: every function within 1e-3

@@ -1,6 +1,6 @@
-// Sphere-wall functions against the shared reference numbers (shared/reference/sphere_wall): the exact
-// bipolar-coordinate table (haloless/StupidCFD WallSphereResTab.csv), Goldman-Cox-Brenner (1967) and
-// Chaoui-Feuillebois (2003).
+// Sphere-wall functions against the reference numbers in tests/data/sphere_wall (sources in
+// tests/data/README.md): the exact bipolar-coordinate table (haloless/StupidCFD WallSphereResTab.csv),
+// Goldman-Cox-Brenner (1967) and Chaoui-Feuillebois (2003).
 #include "fdm/resistance/resistance.hpp"
 #include "reference_data.hpp"
 

@@ -2,12 +2,13 @@
 //   X11P = g1/xi + g2P ln(1/xi) + c0_11,   X12P = -g1/xi - g2P ln(1/xi) + c0_12   (Kim-Karrila, 6 pi a1^2),
 // g1 of X^A, g2P = g2 + w^3 - 2 w^2 = lambda (1 - 4 lambda) / (5 (1+lambda)^2), w = lambda/(1+lambda)
 // (derivation in docs/resistance.md, "Pressure moment X^P").  No published X^P numbers were available
-// here (Jeffrey, Morris & Brady 1993 is not in shared/reference): the checks are (a) the size-ratio
-// relations of paper Eq. (A.4) and the physics of sphere 2, (b) the published g1, g2 of X^A (Townsend's
-// generator, shared/reference/two_sphere_general_lambda) entering the derived coefficients, and the
+// here (Jeffrey, Morris & Brady 1993 is not among the project's reference data): the checks are (a) the
+// size-ratio relations of paper Eq. (A.4) and the physics of sphere 2, (b) the published g1, g2 of X^A
+// (Townsend's generator, tests/data/two_sphere_general_lambda) entering the derived coefficients, and the
 // independent twin-multipole series of the pressure, (c) continuity with the leading 1/xi term, with the
 // far-field (Stokeslet) pressure and with the sphere-wall limit.
-#include "fdm/resistance/near_field_series.hpp"
+#include "fdm/resistance/far_field_series.hpp"
+#include "fdm/resistance/near_field_constants.hpp"
 #include "fdm/resistance/sphere_wall.hpp"
 #include "fdm/resistance/two_sphere.hpp"
 #include "reference_data.hpp"
@@ -108,7 +109,7 @@ TEST(PressureMoment, FarFieldIsStokesletPressure)
     }
 }
 
-// The O(1) constants: the subtracted series truncated at 100 with a tail estimate (near_field_series.cpp).
+// The O(1) constants: the subtracted series truncated at 100 with a tail estimate (near_field_constants.cpp).
 // Recomputed here from the public series at truncation 80 with the same procedure: they must agree to 1e-3
 // (measured 4e-4; 100 against 200: 7e-4 at lambda = 10, below 2e-4 for lambda <= 2).  Also the values at
 // lambda = 1 (regression, 1e-4).

@@ -3,13 +3,14 @@
 //   X11Q = g1/xi + h1 ln(1/xi) + c0_11,   X12Q = lambda g1/xi + h2 ln(1/xi) + c0_12,
 //   h1 = lambda (1 + 2 lambda - 9 lambda^2) / (5 (1+lambda)^3),  h2 = -2 lambda^2 (2 lambda^2 - lambda + 2) / (5 (1+lambda)^3)
 // (derivation in docs/resistance.md, "Pressure moment X^Q").  No published X^Q numbers were available here
-// (Jeffrey, Morris & Brady 1993 is not in shared/reference).  The checks: (a) the singular terms from the
-// published X^G coefficients (Townsend's generator) and the lubrication tails of X^P; (b) the independent
+// (Jeffrey, Morris & Brady 1993 is not among the project's reference data).  The checks: (a) the singular
+// terms from the published X^G coefficients (Townsend's generator) and the lubrication tails of X^P; (b) the independent
 // twin-multipole series of the pressure (J92's strain problem) reproduces them; (c) the far field against
 // the single-sphere strain and Stokes solutions; (d) Appendix C.1: the theory's third term of Eq. (20),
 // (X11Q + X12Q) - (r/2a1)(X11P - X12P), has no singular term, seen in the series alone; (e) Eq. (A.4);
 // (f) truncation of the O(1) constants and regression values.
-#include "fdm/resistance/near_field_series.hpp"
+#include "fdm/resistance/far_field_series.hpp"
+#include "fdm/resistance/near_field_constants.hpp"
 #include "fdm/resistance/two_sphere.hpp"
 #include "reference_data.hpp"
 
@@ -226,7 +227,7 @@ TEST(PressureMomentQ, SizeRatioInversion)
     }
 }
 
-// (f) The O(1) constants (series truncated at 200, L/m^2 tail, near_field_series.cpp), recomputed here from the
+// (f) The O(1) constants (series truncated at 200, L/m^2 tail, near_field_constants.cpp), recomputed here from the
 // public series at truncation 100 with the same procedure.  Measured 100 vs 200: 1.6e-3 (lambda <= 2), 6.7e-3
 // (lambda = 10); 200 vs 300 (offline): 3e-4 and 1.9e-3.  Bounds 2.5e-3 and 1e-2.  Regression values at lambda = 1
 // and 1.4 (docs/resistance.md table): bound 5e-4, the truncation uncertainty of the tabulated values.
