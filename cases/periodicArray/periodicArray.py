@@ -75,7 +75,7 @@ fix             couple all fdm/couple portfile ../fluid/coupling.port move no
 
 def run_configuration(workdir, L_over_a, a_over_delta, n_positions, b=5.0, c=0.3, tol_lambda=1e-4,
                       tol_first=None, n_max=2000, tol_u=1e-6, tol_p=5e-6, np_fluid=1,
-                      pseudo_time_factor=1.0, direction=0, points=None, keep=False):
+                      pseudo_time_factor=1.0, direction=0, points=None, keep=False, acceleration="anderson"):
     a = 1.0
     delta = a / a_over_delta
     L = L_over_a * a
@@ -100,7 +100,8 @@ def run_configuration(workdir, L_over_a, a_over_delta, n_positions, b=5.0, c=0.3
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=nu, rho=rho, grad_p0=tuple(gradient),
                           indicator=(b, c), tol_lambda=tol_lambda, n_max=n_max,
                           first_step=(tol_first if tol_first else tol_lambda / 10, n_max * 4),
-                          tol_u=tol_u, tol_p=tol_p, n_particles=1, pseudo_time_factor=pseudo_time_factor)
+                          tol_u=tol_u, tol_p=tol_p, n_particles=1, pseudo_time_factor=pseudo_time_factor,
+                          acceleration=acceleration)
     lines = []
     for i, (x, y, z) in enumerate(pts):
         if i > 0:
@@ -198,7 +199,8 @@ def main(argv=None):
     for cfg in configs:
         r = run_configuration(args.workdir, cfg["L_over_a"], args.a_over_delta, cfg["n_positions"],
                               b=args.b, c=cfg["c"], tol_lambda=args.tol_lambda, tol_u=args.tol_u,
-                              tol_p=args.tol_p, np_fluid=args.np_fluid, keep=args.keep)
+                              tol_p=args.tol_p, np_fluid=args.np_fluid, keep=args.keep,
+                              acceleration=args.acceleration)
         print("L/a %-5g a/Delta %-3g c %-4g positions %-3d  K = %.6f  K_Hasimoto = %.6f  error %+.3f %%"
               "  sigma_K %.4f  inner iterations %s  %.1f s"
               % (r["L_over_a"], r["a_over_delta"], r["c"], r["n_positions"], r["K"], r["K_hasimoto"],

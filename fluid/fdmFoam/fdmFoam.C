@@ -29,6 +29,8 @@ Usage
 #include "uniformCartesianMesh.H"
 #include "particleForcing.H"
 #include "fluidCoupling.H"
+#include "andersonAcceleration.H"
+#include "innerConvergence.H"
 #include <chrono>
 
 namespace
@@ -73,6 +75,14 @@ int main(int argc, char *argv[])
 
     #include "createOutput.H"
 
+    // The inner iteration's acceleration and its stopping test
+    andersonAcceleration anderson
+    (
+        andersonDepth, alphaLambda, alphaLambda/grid.delta()
+    );
+    innerConvergence convergence;
+    scalarList radii;
+
     scalar fluidTime = 0, particleTime = 0, outputTime = 0;
     label nStepsDone = 0, nInnerTotal = 0;
     const double runStart = wallClock();
@@ -104,20 +114,36 @@ int main(int argc, char *argv[])
         stepParticleTime += wallClock() - stepStart;
 
         const bool firstStep = (nStepsDone == 0);
-        const scalar tol = firstStep ? tolLambdaFirst : tolLambda;
         const label nMax = firstStep ? nInnerMaxFirst : nInnerMax;
+        convergence.reset
+        (
+            firstStep ? tolVelocityFirst : tolVelocity,
+            firstStep ? tolLambdaFirst : tolLambda
+        );
+        anderson.reset();       // the map has changed with the positions
+        radii.setSize(stepParticles.size());
+        forAll(stepParticles, pi)
+        {
+            radii[pi] = stepParticles[pi].radius;
+        }
 
         label innerIteration = 0;
         scalar residual = GREAT, bestResidual = GREAT;
         bool converged = false;
         List<scalar> integrals, velocities;
+        scalarField state;
 
         while (true)
         {
             ++innerIteration;
+            double t0 = wallClock();
+            if (accelerate)
+            {
+                state = anderson.pack(U, lambda, p);
+            }
+            convergence.startIteration(U);
 
             // Step 3: fluid sub-problem
-            double t0 = wallClock();
             {
                 #include "UEqn.H"
                 while (piso.correct())
@@ -161,16 +187,30 @@ int main(int argc, char *argv[])
                   + " (try a smaller pseudoTimeFactor in constant/fdmProperties)"
                 );
             }
+            convergence.endIteration(U, velocities, radii, residual);
             if (reportIterations)
             {
                 Info<< "    inner " << innerIteration << " residual lambda "
-                    << residual << endl;
+                    << residual << " flow change "
+                    << convergence.flowChange() << " particle change "
+                    << convergence.particleChange() << " velocity error "
+                    << convergence.errorEstimate() << endl;
             }
 
-            converged = innerIteration >= nInnerMin && residual <= tol;
+            converged = innerIteration >= nInnerMin && convergence.converged();
             if (converged || innerIteration >= nMax)
             {
                 break;
+            }
+
+            // Step 7 with Anderson acceleration: the next iterate mixes the
+            // last ones (andersonAcceleration.H)
+            if (accelerate)
+            {
+                t0 = wallClock();
+                anderson.accelerate(state, U, lambda, p);
+                forcing.truncateLambda(lambda);
+                stepFluidTime += wallClock() - t0;
             }
         }
 
@@ -203,6 +243,7 @@ int main(int argc, char *argv[])
         const label remaining = max(label(0), coupling.lastStep() - coupling.step());
         Info<< "Step " << coupling.step() << " t = " << runTime.timeName()
             << "  inner " << innerIteration << "  residual lambda " << residual
+            << "  velocity error " << convergence.errorEstimate()
             << (converged ? "" : " (NOT converged)")
             << "  | fluid " << stepFluidTime << " s, particles "
             << stepParticleTime << " s, exchange " << stepExchangeTime
@@ -211,9 +252,12 @@ int main(int argc, char *argv[])
         if (!converged)
         {
             WarningInFunction
-                << "time step " << coupling.step() << ": lambda residual "
-                << residual << " above tolLambda " << tol << " after "
-                << innerIteration << " inner iterations (nMax)" << endl;
+                << "time step " << coupling.step() << ": not converged after "
+                << innerIteration << " inner iterations (nMax): velocity "
+                << "error " << convergence.errorEstimate() << " (tolVelocity "
+                << convergence.tolVelocity() << "), lambda residual "
+                << residual << " (tolLambda " << convergence.tolLambda()
+                << ")" << endl;
         }
     }
 

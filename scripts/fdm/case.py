@@ -52,8 +52,9 @@ class Box:
 def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicator=(5.0, 0.3),
                      tol_lambda=1e-4, n_max=500, n_min=1, first_step=None, tol_u=1e-6, tol_p=5e-6,
                      pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
-                     n_correctors=2, extra_fdm=""):
-    """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/)."""
+                     n_correctors=2, extra_fdm="", acceleration="anderson"):
+    """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/). acceleration: the inner
+    iteration's, "anderson" (default) or "none" (the plain iteration of paper 4.3), docs/fluid.md."""
     x0, y0, z0 = box.lo
     x1, y1, z1 = box.hi
     names = ("x", "y", "z")
@@ -183,6 +184,7 @@ innerIterations
     tolLambda   %(tol).17g;
     nMin        %(nmin)d;
     nMax        %(nmax)d;%(first)s
+    acceleration %(accel)s;
 }
 coupling
 {
@@ -196,7 +198,8 @@ coupling
 %(extra)s
 """ % dict(b=indicator[0], c=indicator[1], grad=foam_vector(grad_p0), ptf=pseudo_time_factor,
            ptfo=pseudo_time_factor if pseudo_time_factor_outside is None else pseudo_time_factor_outside,
-           np=n_particles, tol=tol_lambda, nmin=n_min, nmax=n_max, first=first, extra=extra_fdm))
+           np=n_particles, tol=tol_lambda, nmin=n_min, nmax=n_max, first=first, extra=extra_fdm,
+           accel=acceleration))
 
     foam_file(os.path.join(case_dir, "0/U"), "volVectorField", """
 dimensions      [0 1 -1 0 0 0 0];
@@ -232,12 +235,14 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
 
 
 def add_run_options(parser, case_dir, tol_lambda, cutoff=False):
-    """The options every coupled case's script shares: --tol-lambda, --np-fluid, --workdir,
-    --out, --keep (and --cutoff for the cases with pair_style fdm/subgrid)."""
+    """The options every coupled case's script shares: --tol-lambda, --acceleration, --np-fluid,
+    --workdir, --out, --keep (and --cutoff for the cases with pair_style fdm/subgrid)."""
     if cutoff:
         parser.add_argument("--cutoff", type=float, default=None,
                             help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
     parser.add_argument("--tol-lambda", type=float, default=tol_lambda, help="fdmFoam's innerIterations tolLambda")
+    parser.add_argument("--acceleration", choices=("anderson", "none"), default="anderson",
+                        help="fdmFoam's inner-iteration acceleration (none: the plain iteration of paper 4.3)")
     parser.add_argument("--np-fluid", type=int, default=1, help="MPI ranks of fdmFoam")
     parser.add_argument("--workdir", default=os.path.join(case_dir, "runs"), help="where the runs are written")
     parser.add_argument("--out", default=os.path.join(case_dir, "results.json"))

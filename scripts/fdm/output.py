@@ -4,7 +4,8 @@ import os
 import numpy as np
 
 STEP_COLUMNS = ("step time innerIterations residualLambda converged meanUx meanUy meanUz "
-                "lambdaForceX lambdaForceY lambdaForceZ fluidSeconds particleSeconds exchangeSeconds maxCoreSlip").split()
+                "lambdaForceX lambdaForceY lambdaForceZ fluidSeconds particleSeconds exchangeSeconds maxCoreSlip "
+                "velocityError").split()
 PARTICLE_COLUMNS = "step tag x y z radius Ux Uy Uz Wx Wy Wz Fx Fy Fz Tx Ty Tz Vu".split()
 
 
@@ -14,6 +15,9 @@ def _read(path, columns):
     data = np.loadtxt(path, comments="#", ndmin=2)
     if data.size == 0:
         raise ValueError("%s has no records" % path)
+    if columns is STEP_COLUMNS and data.shape[1] == len(columns) - 1:
+        # records of fdmFoam before the velocity error was written
+        data = np.hstack([data, np.full((data.shape[0], 1), np.nan)])
     if data.shape[1] != len(columns):
         raise ValueError("%s has %d columns, expected %d (%s)" % (path, data.shape[1], len(columns),
                                                                   " ".join(columns)))

@@ -124,7 +124,12 @@ P_SHIFT = 0.1   # kinematic pressure level [m2/s2] for the trace check
 def write_case(root, faces_y, u_nonuniform=False):
     box = case.Box((0, 0, 0), BOX_SIZE, DELTA, faces=("cyclic", faces_y, "cyclic"))
     fluid = os.path.join(root, "fluid")
-    case.write_fluid_case(fluid, box, nu=NU, rho=RHO, tol_lambda=1e-6, n_max=3000, n_particles=1)
+    # The plain iteration (acceleration none): the pressure-level check compares two runs whose
+    # pressure solves differ at the linear solvers' tolerance; the accelerated iteration carries that
+    # difference into F, T and S at ~1e-6 of the scale, which is the iteration, not the definitions
+    # checked here.
+    case.write_fluid_case(fluid, box, nu=NU, rho=RHO, tol_lambda=1e-6, n_max=3000, n_particles=1,
+                          acceleration="none")
     if u_nonuniform:
         # yHigh: fixedValue with a velocity that varies from face to face
         n = box.n[0] * box.n[2]

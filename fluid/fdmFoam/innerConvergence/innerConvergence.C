@@ -1,0 +1,108 @@
+#include "innerConvergence.H"
+
+const Foam::scalar Foam::innerConvergence::rhoMin_ = 0.5;
+const Foam::scalar Foam::innerConvergence::rhoMax_ = 0.98;
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::innerConvergence::innerConvergence()
+:
+    tolVelocity_(0),
+    tolLambda_(0),
+    lambdaResidual_(GREAT),
+    flowChange_(GREAT),
+    particleChange_(GREAT),
+    errorEstimate_(GREAT)
+{}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+void Foam::innerConvergence::reset(scalar tolVelocity, scalar tolLambda)
+{
+    tolVelocity_ = tolVelocity;
+    tolLambda_ = tolLambda;
+    changes_.clear();
+    previousVelocities_.clear();
+    lambdaResidual_ = flowChange_ = particleChange_ = errorEstimate_ = GREAT;
+}
+
+
+void Foam::innerConvergence::startIteration(const volVectorField& U)
+{
+    if (tolVelocity_ > 0)
+    {
+        flowBefore_ = U.primitiveField();
+    }
+}
+
+
+void Foam::innerConvergence::endIteration
+(
+    const volVectorField& U,
+    const List<scalar>& velocities,
+    const scalarList& radii,
+    scalar lambdaResidual
+)
+{
+    lambdaResidual_ = lambdaResidual;
+    if (tolVelocity_ <= 0)
+    {
+        return;
+    }
+
+    const vectorField& u = U.primitiveField();
+    const scalar uMax = max(gMax(mag(u)), VSMALL);
+    flowChange_ =
+        Foam::sqrt(gSum(magSqr(u - flowBefore_)))
+       /max(Foam::sqrt(gSum(magSqr(u))), VSMALL);
+
+    // The first inner iteration of a step has no previous velocities of
+    // this step to compare with: its change counts as large.
+    particleChange_ = GREAT;
+    if (previousVelocities_.size() == velocities.size())
+    {
+        particleChange_ = 0;
+        forAll(radii, p)
+        {
+            for (direction d = 0; d < 3; ++d)
+            {
+                particleChange_ = max
+                (
+                    particleChange_,
+                    max
+                    (
+                        mag(velocities[6*p + d] - previousVelocities_[6*p + d]),
+                        radii[p]
+                       *mag(velocities[6*p + 3 + d] - previousVelocities_[6*p + 3 + d])
+                    )/uMax
+                );
+            }
+        }
+    }
+    previousVelocities_ = velocities;
+
+    const label k = changes_.size();
+    changes_.append(max(flowChange_, particleChange_));
+
+    // Mean contraction over the last four iterations (two early in the
+    // step): the accelerated iteration is not monotone from one iteration
+    // to the next
+    scalar rho = rhoMax_;
+    const label span = min(k, label(4));
+    if (span >= 2 && changes_[k - span] > 0)
+    {
+        rho = Foam::pow(changes_[k]/changes_[k - span], 1.0/span);
+    }
+    rho = min(max(rho, rhoMin_), rhoMax_);
+    const scalar last = k >= 1 ? max(changes_[k], changes_[k - 1]) : changes_[k];
+    errorEstimate_ = last*rho/(1 - rho);
+}
+
+
+bool Foam::innerConvergence::converged() const
+{
+    const bool velocityOk = tolVelocity_ <= 0 || errorEstimate_ <= tolVelocity_;
+    const bool lambdaOk = tolLambda_ <= 0 || lambdaResidual_ <= tolLambda_;
+    return velocityOk && lambdaOk;
+}
