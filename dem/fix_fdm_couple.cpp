@@ -267,35 +267,25 @@ void FixFdmCouple::fail(const std::string &message)
   error->one(FLERR, ("fdm/couple: " + message).c_str());
 }
 
-std::string FixFdmCouple::checkFluidHello(const cpl::Message &hello) const
+std::string FixFdmCouple::checkFluidHello(const cpl::FluidHello &hello) const
 {
-  using cpl::protocolVersion;
-  if (hello.count != 1 || hello.width < cpl::layout::helloFluidWidth)
-    return "malformed Hello from the fluid solver (" + std::to_string(hello.count) + " records of " +
-           std::to_string(hello.width) + " values)";
-  const long version = std::lround(hello.textNumber("version"));
-  if (version != protocolVersion)
-    return "coupling protocol version mismatch: fdmFoam speaks " + std::to_string(version) + ", fdmDEM speaks " +
-           std::to_string(protocolVersion);
-  const double *r = &hello.data[0];
-  const long long nExpected = std::llround(r[0]);
-  if (nExpected >= 0 && nExpected != natoms_)
-    return "the fluid case expects " + std::to_string(nExpected) + " particles (constant/fdmProperties nParticles) "
-           "but the LIGGGHTS input has " + std::to_string(natoms_);
-  if (!(r[1] > 0) || !(r[2] > 0) || !(r[3] > 0) || !(r[cpl::layout::hfViscosity] > 0))
-    return "the fluid solver sent a non-positive alpha_lambda (" + fmt(r[1]) + " s), rho_f (" + fmt(r[2]) +
-           " kg/m3), mesh size (" + fmt(r[3]) + " m) or viscosity (" + fmt(r[cpl::layout::hfViscosity]) + " Pa s)";
+  if (hello.nParticlesExpected >= 0 && hello.nParticlesExpected != natoms_)
+    return "the fluid case expects " + std::to_string(hello.nParticlesExpected) + " particles (constant/fdmProperties "
+           "nParticles) but the LIGGGHTS input has " + std::to_string(natoms_);
+  if (!(hello.alphaLambda > 0) || !(hello.rhoFluid > 0) || !(hello.delta > 0) || !(hello.viscosity > 0))
+    return "the fluid solver sent a non-positive alpha_lambda (" + fmt(hello.alphaLambda) + " s), rho_f (" +
+           fmt(hello.rhoFluid) + " kg/m3), mesh size (" + fmt(hello.delta) + " m) or viscosity (" +
+           fmt(hello.viscosity) + " Pa s)";
   const char *axis = "xyz";
   for (int d = 0; d < 3; d++) {
-    const double lo = r[4 + 2*d], hi = r[5 + 2*d];
+    const double lo = hello.lo[d], hi = hello.hi[d];
     const double tolerance = 1e-9 * std::max(std::fabs(domain->prd[d]), std::fabs(hi - lo));
     if (!(std::fabs(lo - domain->boxlo[d]) <= tolerance) || !(std::fabs(hi - domain->boxhi[d]) <= tolerance))
       return std::string(1, axis[d]) + " extent: LIGGGHTS box " + fmt(domain->boxlo[d]) + " .. " +
              fmt(domain->boxhi[d]) + " but OpenFOAM mesh " + fmt(lo) + " .. " + fmt(hi);
-    const bool fluidPeriodic = r[10 + d] != 0;
-    if (fluidPeriodic != (domain->periodicity[d] != 0))
+    if (hello.periodic[d] != (domain->periodicity[d] != 0))
       return std::string(1, axis[d]) + " boundary: LIGGGHTS " + (domain->periodicity[d] ? "periodic (p)" :
-             "not periodic") + " but the OpenFOAM mesh " + (fluidPeriodic ? "has cyclic patches" : "has no cyclic patches") +
+             "not periodic") + " but the OpenFOAM mesh " + (hello.periodic[d] ? "has cyclic patches" : "has no cyclic patches") +
              " in " + axis[d];
   }
   return "";
@@ -313,26 +303,28 @@ void FixFdmCouple::connectAndHandshake()
                                         ", port file " + options_.portFile)).c_str());
       connection_ = cpl::connect(options_);
       std::atexit(tellPeerWeStopped);
-      cpl::Message hello = cpl::makeMessage(cpl::MessageType::Hello, 0, 0, 1, cpl::layout::helloDemWidth,
-          "role=dem version=" + std::to_string(cpl::protocolVersion) + " dt=" + fmt(update->dt) +
-          " lastStep=" + std::to_string((long long) update->laststep) + " stresslets=" + (stresslets_ ? "1" : "0"));
-      double *r = &hello.data[0];
-      r[0] = natoms_;
+      cpl::DemHello hello;
+      hello.dt = update->dt;
+      hello.lastStep = update->laststep;
+      hello.stresslets = stresslets_;
+      hello.nParticles = natoms_;
       for (int d = 0; d < 3; d++) {
-        r[1 + 2*d] = domain->boxlo[d];
-        r[2 + 2*d] = domain->boxhi[d];
-        r[7 + d] = domain->periodicity[d];
+        hello.lo[d] = domain->boxlo[d];
+        hello.hi[d] = domain->boxhi[d];
+        hello.periodic[d] = domain->periodicity[d] != 0;
       }
-      connection_->send(hello);
-      const cpl::Message reply = connection_->receive(cpl::MessageType::Hello);
+      connection_->send(hello.toMessage());
+      const cpl::FluidHello reply = cpl::FluidHello::fromMessage(connection_->receive(cpl::MessageType::Hello));
       problem = checkFluidHello(reply);
       if (problem.empty()) {
-        alphaLambda_ = reply.at(0, 1);
-        rhoFluid_ = reply.at(0, 2);
-        delta_ = reply.at(0, 3);
-        viscosity_ = reply.at(0, cpl::layout::hfViscosity);
-        for (int face = 0; face < 6; face++)
-          for (int c = 0; c < 4; c++) fluidFaces_[face][c] = reply.at(0, cpl::layout::hfFaceBase + cpl::layout::faceWidth * face + c);
+        alphaLambda_ = reply.alphaLambda;
+        rhoFluid_ = reply.rhoFluid;
+        delta_ = reply.delta;
+        viscosity_ = reply.viscosity;
+        for (int face = 0; face < 6; face++) {
+          fluidFaces_[face][0] = reply.faces[face].kind;
+          for (int d = 0; d < 3; d++) fluidFaces_[face][1 + d] = reply.faces[face].velocity[d];
+        }
         if (screen)
           fprintf(screen, "fdm/couple: connected (%s): %d particles, alpha_lambda %g s, rho_f %g kg/m3, "
                   "viscosity %g Pa s, mesh size %g m\n", connection_->describe().c_str(), natoms_, alphaLambda_,
@@ -624,25 +616,28 @@ void FixFdmCouple::initial_integrate(int)
   }
 }
 
-cpl::Message FixFdmCouple::makeStep(const std::vector<Particle> &particles) const
+cpl::Step FixFdmCouple::makeStep(const std::vector<Particle> &particles) const
 {
-  using namespace cpl::layout;
-  cpl::Message step = cpl::makeMessage(cpl::MessageType::Step, update->ntimestep, 0, natoms_, stepWidth,
-      "dt=" + fmt(update->dt) + " lastStep=" + std::to_string((long long) update->laststep));
+  cpl::Step step;
+  step.step = update->ntimestep;
+  step.dt = update->dt;
+  step.lastStep = update->laststep;
+  step.particles.resize(natoms_);
+  const bool solved = currentVelocity_.size() == size_t(6) * natoms_;
   for (int p = 0; p < natoms_; p++) {
     const Particle &q = particles[p];
-    step.at(p, sTag) = p + 1;
+    cpl::StepParticle &out = step.particles[p];
+    out.tag = p + 1;
     for (int d = 0; d < 3; d++) {
       // LIGGGHTS wraps periodic coordinates only when it re-neighbours: the fluid gets them in the box
       double x = q.x[d];
       if (domain->periodicity[d]) x -= domain->prd[d] * std::floor((x - domain->boxlo[d]) / domain->prd[d]);
-      step.at(p, sX + d) = x;
+      out.x[d] = x;
       // the last solved velocities U_n (v may hold this step's Adams-Bashforth displacement rate)
-      const bool solved = currentVelocity_.size() == size_t(6) * natoms_;
-      step.at(p, sUx + d) = solved ? currentVelocity_[size_t(6) * p + d] : q.v[d];
-      step.at(p, sWx + d) = solved ? currentVelocity_[size_t(6) * p + 3 + d] : q.omega[d];
+      out.velocity.U[d] = solved ? currentVelocity_[size_t(6) * p + d] : q.v[d];
+      out.velocity.omega[d] = solved ? currentVelocity_[size_t(6) * p + 3 + d] : q.omega[d];
     }
-    step.at(p, sRadius) = q.radius;
+    out.radius = q.radius;
   }
   return step;
 }
@@ -726,22 +721,23 @@ void FixFdmCouple::collectSubgrid()
   sys.analysed = false;
 }
 
-void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const cpl::Message &integrals)
+void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const cpl::Integrals &integrals)
 {
   // Eq. (31): [ (rho_f/rho_p) J / alpha_lambda + R^SG ] u = F_tot, unknowns (U, Omega) per particle
   // by tag. (rho_f/rho_p) M_p = rho_f Vu and (rho_f/rho_p) J_p = rho_f Ju come from the fluid's
   // indicator function I_u; F_tot (Eq. 32) = the fluid integral + buoyant weight + everything
   // LIGGGHTS put in f and torque (contacts, fix addforce, ...: F^c + F^ext) + the moving walls'
   // term of Eq. (D.6). R^SG was assembled for this step by collectSubgrid().
-  using namespace cpl::layout;
   System &sys = *system_;
   const int N = natoms_;
   Eigen::VectorXd rhs(6 * N), guess(6 * N), diagonal(6 * N);
   for (int p = 0; p < N; p++) {
     const Particle &q = particles[p];
-    const double Vu = integrals.at(p, iVu), Ju = integrals.at(p, iJu);
-    for (int f = 0; f < integralsWidth; f++)
-      if (!std::isfinite(integrals.at(p, f)))
+    const cpl::ParticleIntegrals &in = integrals.particles[p];
+    const double Vu = in.Vu, Ju = in.Ju;
+    const double values[8] = {Vu, Ju, in.fluid.F[0], in.fluid.F[1], in.fluid.F[2], in.fluid.T[0], in.fluid.T[1], in.fluid.T[2]};
+    for (int f = 0; f < 8; f++)
+      if (!std::isfinite(values[f]))
         fail("the fluid solver sent a non-finite integral for particle " + tagName(p) + " at " + point(q.x) +
              " (field " + std::to_string(f) + " of [Vu, Ju, F, T]) at step " + std::to_string(integrals.step) +
              ", inner iteration " + std::to_string(integrals.iteration));
@@ -753,8 +749,8 @@ void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const
     for (int d = 0; d < 3; d++) {
       diagonal(6*p + d) = rhoFluid_ * Vu / alphaLambda_;
       diagonal(6*p + 3 + d) = rhoFluid_ * Ju / alphaLambda_;
-      rhs(6*p + d) = integrals.at(p, iFx + d) + buoyantFraction * q.mass * gravity_[d] + q.f[d];
-      rhs(6*p + 3 + d) = integrals.at(p, iTx + d) + q.torque[d];
+      rhs(6*p + d) = in.fluid.F[d] + buoyantFraction * q.mass * gravity_[d] + q.f[d];
+      rhs(6*p + 3 + d) = in.fluid.T[d] + q.torque[d];
     }
   }
   rhs += sys.wallRhs;
@@ -796,23 +792,27 @@ void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const
       const int p = k / 6;
       fail("the velocity of particle " + tagName(p) + " at " + point(particles[p].x) + " is not finite (Eq. 31): "
            "its force " + point(particles[p].f) + ", torque " + point(particles[p].torque) + ", fluid integrals Vu " +
-           fmt(integrals.at(p, iVu)) + " Ju " + fmt(integrals.at(p, iJu)));
+           fmt(integrals.particles[p].Vu) + " Ju " + fmt(integrals.particles[p].Ju));
     }
     solution_[k] = u(k);
   }
 }
 
-cpl::Message FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &particles) const
+cpl::Integrals FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &particles) const
 {
   // transport none: "integrals" of an isolated sphere in a fluid at rest, so that Eq. (31) reads
   // [diag(6 pi eta a, 8 pi eta a^3) + R^SG] u = F^c + F^ext + buoyant weight
-  using namespace cpl::layout;
   const double pi = 3.14159265358979323846;
-  cpl::Message m = cpl::makeMessage(cpl::MessageType::Integrals, update->ntimestep, 1, natoms_, integralsWidth);
+  cpl::Integrals m;
+  m.step = update->ntimestep;
+  m.iteration = 1;
+  m.particles.resize(natoms_);
   for (int p = 0; p < natoms_; p++) {
     const double a = particles[p].radius;
-    m.at(p, iVu) = 6 * pi * viscosity_ * a * alphaLambda_ / rhoFluid_;
-    m.at(p, iJu) = 8 * pi * viscosity_ * a * a * a * alphaLambda_ / rhoFluid_;
+    cpl::ParticleIntegrals &in = m.particles[p];
+    in.Vu = 6 * pi * viscosity_ * a * alphaLambda_ / rhoFluid_;
+    in.Ju = 8 * pi * viscosity_ * a * a * a * alphaLambda_ / rhoFluid_;
+    for (int d = 0; d < 3; d++) in.fluid.F[d] = in.fluid.T[d] = 0.0;
   }
   return m;
 }
@@ -861,21 +861,21 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   }
 }
 
-void FixFdmCouple::storeStepDone(const cpl::Message &done)
+void FixFdmCouple::storeStepDone(const cpl::StepDone &done)
 {
-  const uint32_t width = stresslets_ ? cpl::layout::stepDoneStressWidth : cpl::layout::stepDoneWidth;
-  if (int(done.count) != natoms_ || done.width != width)
-    fail("the fluid solver ended step " + std::to_string(done.step) + " with forces for " + std::to_string(done.count) +
-         " particles (" + std::to_string(done.width) + " values each) where " + std::to_string(natoms_) +
-         " particles (" + std::to_string(width) + " values) were expected");
   for (int p = 0; p < natoms_; p++) {
-    for (int c = 0; c < 6; c++) hydro_[size_t(6) * p + c] = done.at(p, c);
-    if (stresslets_)
-      for (int c = 0; c < 7; c++) fluidStress_[size_t(7) * p + c] = done.at(p, cpl::layout::dSxx + c);
+    for (int d = 0; d < 3; d++) {
+      hydro_[size_t(6) * p + d] = done.forces[p].F[d];
+      hydro_[size_t(6) * p + 3 + d] = done.forces[p].T[d];
+    }
+    if (stresslets_) {
+      for (int c = 0; c < 6; c++) fluidStress_[size_t(7) * p + c] = done.stresslets[p].S[c];
+      fluidStress_[size_t(7) * p + 6] = done.stresslets[p].trace;
+    }
   }
-  lastIterations_ = int(std::lround(done.textNumber("iterations")));
-  lastResidual_ = done.textNumber("residual");
-  if (done.textValue("converged") != "1") notConverged_++;
+  lastIterations_ = int(done.iterations);
+  lastResidual_ = done.residual;
+  if (!done.converged) notConverged_++;
 }
 
 void FixFdmCouple::final_integrate()
@@ -893,7 +893,7 @@ void FixFdmCouple::final_integrate()
 
   if (comm->me == 0 && !hasFluid()) {
     t0 = MPI_Wtime();
-    const cpl::Message integrals = noFluidIntegrals(particles);
+    const cpl::Integrals integrals = noFluidIntegrals(particles);
     solveVelocities(particles, integrals);
     for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
       hydro_[k] = -system_->diagonal(k) * solution_[k];
@@ -905,7 +905,7 @@ void FixFdmCouple::final_integrate()
     const bigint step = update->ntimestep;
     try {
       t0 = MPI_Wtime();
-      connection_->send(makeStep(particles));
+      connection_->send(makeStep(particles).toMessage());
       while (true) {
         const cpl::Message m = connection_->receive();
         double t1 = MPI_Wtime();
@@ -917,21 +917,25 @@ void FixFdmCouple::final_integrate()
           fail(std::string("coupling: the fluid solver sent ") + cpl::messageTypeName(m.type) + " of step " +
                std::to_string(m.step) + " during step " + std::to_string((long long) step));
         if (m.type == cpl::MessageType::StepDone) {
-          storeStepDone(m);
+          storeStepDone(cpl::StepDone::fromMessage(m, stresslets_, natoms_));
           subgridResults(particles);
           run_.solve += MPI_Wtime() - t1;
           break;
         }
-        if (int(m.count) != natoms_ || m.width != cpl::layout::integralsWidth)
-          fail("coupling: the fluid solver sent integrals for " + std::to_string(m.count) + " particles (" +
-               std::to_string(m.width) + " values each), LIGGGHTS has " + std::to_string(natoms_) + " (8 values)");
-        solveVelocities(particles, m);
-        cpl::Message reply = cpl::makeMessage(cpl::MessageType::Velocities, m.step, m.iteration, natoms_,
-                                              cpl::layout::velocitiesWidth);
-        reply.data = solution_;
+        const cpl::Integrals integrals = cpl::Integrals::fromMessage(m, natoms_);
+        solveVelocities(particles, integrals);
+        cpl::Velocities reply;
+        reply.step = integrals.step;
+        reply.iteration = integrals.iteration;
+        reply.particles.resize(natoms_);
+        for (int p = 0; p < natoms_; p++)
+          for (int d = 0; d < 3; d++) {
+            reply.particles[p].U[d] = solution_[size_t(6) * p + d];
+            reply.particles[p].omega[d] = solution_[size_t(6) * p + 3 + d];
+          }
         t0 = MPI_Wtime();
         run_.solve += t0 - t1;
-        connection_->send(reply);
+        connection_->send(reply.toMessage());
       }
     } catch (const std::exception &e) {
       fail(e.what());
@@ -1117,7 +1121,9 @@ void FixFdmCouple::finishAll(LAMMPS *lmp)
 {
   if (lmp->comm->me != 0 || !connection_) return;
   try {
-    connection_->send(cpl::makeMessage(cpl::MessageType::Finish, lmp->update->ntimestep, 0, 0, 0));
+    cpl::Finish finish;
+    finish.step = lmp->update->ntimestep;
+    connection_->send(finish.toMessage());
   } catch (const std::exception &e) {
     if (lmp->screen) fprintf(lmp->screen, "fdm/couple: WARNING: could not tell the fluid solver to finish: %s\n",
                              e.what());

@@ -82,16 +82,16 @@ class FixFdmCouple : public Fix {
 
   void checkAtoms();
   void connectAndHandshake();
-  std::string checkFluidHello(const fdm::coupler::Message &hello) const;
+  std::string checkFluidHello(const fdm::coupler::FluidHello &hello) const;
   void gather(std::vector<Particle> &particles);
   std::string checkConfiguration(const std::vector<Particle> &particles, bool checkOverlaps) const;
   std::string findOverlap(const std::vector<Particle> &particles) const;
-  fdm::coupler::Message makeStep(const std::vector<Particle> &particles) const;
+  fdm::coupler::Step makeStep(const std::vector<Particle> &particles) const;
   void collectSubgrid();
-  void solveVelocities(const std::vector<Particle> &particles, const fdm::coupler::Message &integrals);
+  void solveVelocities(const std::vector<Particle> &particles, const fdm::coupler::Integrals &integrals);
   void subgridResults(const std::vector<Particle> &particles);
-  fdm::coupler::Message noFluidIntegrals(const std::vector<Particle> &particles) const;
-  void storeStepDone(const fdm::coupler::Message &done);
+  fdm::coupler::Integrals noFluidIntegrals(const std::vector<Particle> &particles) const;
+  void storeStepDone(const fdm::coupler::StepDone &done);
   void planNextMove(const std::vector<Particle> &particles);
   void scatter();
   void fillPerAtomArray();

@@ -160,7 +160,9 @@ Message decode(const unsigned char* bytes, size_t size)
 void Transport::sendError(const std::string& why) noexcept
 {
     try {
-        send(makeMessage(MessageType::Error, 0, 0, 0, 0, why));
+        Error e;
+        e.text = why;
+        send(e.toMessage());
     } catch (...) {
     }
 }

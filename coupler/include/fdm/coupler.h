@@ -63,6 +63,11 @@ namespace layout {
     //   text: "role=dem version=<v> dt=<s> lastStep=<n> stresslets=<0|1>"
     //   (stresslets=1: the DEM side wants the FDM stresslets in StepDone)
     //   one record: [nParticles, xlo, xhi, ylo, yhi, zlo, zhi, periodicX, periodicY, periodicZ]
+    enum HelloDemField {
+        hdNParticles = 0,
+        hdXlo = 1,        // xlo, xhi, ylo, yhi, zlo, zhi at hdXlo + 2d, hdXlo + 2d + 1
+        hdPeriodic = 7    // periodic in direction d at hdPeriodic + d
+    };
     // Hello from the fluid side. text: "role=fluid version=<v>"
     //   one record, 38 values:
     //    0      nParticlesExpected (-1 = any)
@@ -129,6 +134,138 @@ namespace layout {
 class CouplerError : public std::runtime_error {
 public:
     explicit CouplerError(const std::string& what) : std::runtime_error(what) {}
+};
+
+// ---- Typed messages -----------------------------------------------------------------------------
+// One struct per message: toMessage() packs it, fromMessage() checks the type, the record count and
+// width and unpacks it, throwing a CouplerError that names the message and the sizes. They are the
+// only code that indexes records (with the layout above): the two codes use these. A negative
+// expectedCount accepts any number of particles.
+
+// Hello from the particle code (fdmDEM).
+struct DemHello {
+    int version = protocolVersion;
+    double dt = 0;             // DEM time step [s] (sent with 10 significant digits)
+    long long lastStep = 0;    // last step of the current run
+    bool stresslets = false;   // StepDone must carry the FDM stresslets
+    long long nParticles = 0;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the box [m]
+    bool periodic[3] = {false, false, false};
+
+    Message toMessage() const;
+    // stresslets= is required and read tolerantly: 0|1 as any number, true/false, yes/no, on/off.
+    static DemHello fromMessage(const Message& m);
+};
+
+// One face of the box as the fluid case bounds it (fluid Hello).
+struct BoxFace {
+    int kind = layout::bOther;                 // layout::BoundaryKind
+    double velocity[3] = {0, 0, 0};            // wall velocity [m/s] (kind bWall), else 0
+};
+
+// Hello from the fluid solver (fdmFoam).
+struct FluidHello {
+    int version = protocolVersion;
+    long long nParticlesExpected = -1;         // -1: any
+    double alphaLambda = 0;                    // [s]
+    double rhoFluid = 0;                       // [kg/m3]
+    double delta = 0;                          // mesh size [m]
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    bool periodic[3] = {false, false, false};
+    double viscosity = 0;                      // eta = rho_f nu [Pa s]
+    BoxFace faces[layout::nFaces];             // xlo, xhi, ylo, yhi, zlo, zhi
+
+    Message toMessage() const;
+    static FluidHello fromMessage(const Message& m);
+};
+
+// Per particle: rigid-body velocity (Step, Velocities).
+struct RigidVelocity {
+    double U[3];
+    double omega[3];
+};
+
+// Per particle: force and torque (Integrals, StepDone).
+struct ForceTorque {
+    double F[3];
+    double T[3];
+};
+
+// Step: the particles of DEM time step `step`, by tag 1..N.
+struct StepParticle {
+    long long tag;
+    double x[3];
+    double radius;
+    RigidVelocity velocity;
+};
+struct Step {
+    uint64_t step = 0;
+    double dt = 0;                             // [s] (sent with 10 significant digits)
+    long long lastStep = 0;
+    std::vector<StepParticle> particles;
+
+    Message toMessage() const;
+    static Step fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// Integrals of inner iteration `iteration` (Eqs. 32, 38): Vu, Ju and the fluid part of F^tot.
+struct ParticleIntegrals {
+    double Vu, Ju;
+    ForceTorque fluid;
+};
+struct Integrals {
+    uint64_t step = 0;
+    uint32_t iteration = 0;
+    std::vector<ParticleIntegrals> particles;
+
+    Message toMessage() const;
+    static Integrals fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// Velocities: the solution of Eq. (31) for inner iteration `iteration`.
+struct Velocities {
+    uint64_t step = 0;
+    uint32_t iteration = 0;
+    std::vector<RigidVelocity> particles;
+
+    Message toMessage() const;
+    static Velocities fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// The FDM stresslet of Eq. (12) [N m]: traceless S (xx xy xz yy yz zz) and the trace s.
+struct Stresslet {
+    double S[6];
+    double trace;
+};
+
+// StepDone: the inner iterations of `step` ended; hydrodynamic force and torque (Eq. 7) and, if the
+// DEM Hello asked for them, the stresslets.
+struct StepDone {
+    uint64_t step = 0;
+    uint32_t iterations = 0;
+    double residual = 0;                       // lambda residual of the last inner iteration
+    bool converged = false;
+    std::vector<ForceTorque> forces;
+    std::vector<Stresslet> stresslets;         // empty, or one per particle
+
+    Message toMessage() const;                 // stepDoneStressWidth wide if stresslets are given
+    static StepDone fromMessage(const Message& m, bool withStresslets, long expectedCount = -1);
+};
+
+// Finish: no more steps.
+struct Finish {
+    uint64_t step = 0;
+
+    Message toMessage() const;
+    static Finish fromMessage(const Message& m);
+};
+
+// Error: the sender stops; text says why.
+struct Error {
+    std::string text;
+
+    Message toMessage() const;
+    static Error fromMessage(const Message& m);
 };
 
 struct Options {
