@@ -13,10 +13,6 @@
 #include "modify.h"
 #include "update.h"
 
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -75,22 +71,6 @@ void FixFdmCouple::Timing::add(const Timing &t)
   gapFallbacks += t.gapFallbacks;
   gapSweepsMax = std::max(gapSweepsMax, t.gapSweepsMax);
 }
-
-// Eq. (31) on rank 0 for one time step.
-struct FixFdmCouple::System {
-  Eigen::SparseMatrix<double> matrix;  // (rho_f/rho_p) J/alpha_lambda + R^SG
-  std::vector<int> diagonalIndex;      // position of entry (k, k) in matrix.valuePtr()
-  std::vector<double> subgridDiagonal; // R^SG(k, k)
-  Eigen::VectorXd wallRhs;             // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
-  Eigen::VectorXd diagonal;            // (rho_f/rho_p) J/alpha_lambda of the last inner iteration
-  std::vector<double> pairs, walls;    // the gathered blocks (stress rows used after the step)
-  int pairRecord, wallRecord;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                           Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double> > ldlt;
-  bool analysed;
-  System() : pairRecord(0), wallRecord(0), analysed(false) {}
-};
 
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   Fix(lmp, narg, arg), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
@@ -658,144 +638,89 @@ void gatherOnRoot(const std::vector<double> &local, std::vector<double> &all, MP
 }
 }  // namespace
 
-void FixFdmCouple::collectSubgrid()
+void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
 {
   // Every rank builds the sub-grid blocks of its own pairs and wall gaps from its neighbour list;
-  // rank 0 collects them and assembles R^SG once for the step (paper section 4.4.2).
-  std::vector<double> pairs, walls;
+  // rank 0 collects them and assembles Eq. (31) once for the step (paper section 4.4.2).
+  std::vector<double> pairs, walls, allPairs, allWalls;
   long contacts = 0;
   if (pair_) {
     pair_->collectBlocks(stresslets_, pairs, walls);
     contacts = pair_->contactsLast();
   }
-  if (!system_) system_.reset(new System);
-  System &sys = *system_;
-  gatherOnRoot(pairs, sys.pairs, world, comm->me, comm->nprocs);
-  gatherOnRoot(walls, sys.walls, world, comm->me, comm->nprocs);
+  gatherOnRoot(pairs, allPairs, world, comm->me, comm->nprocs);
+  gatherOnRoot(walls, allWalls, world, comm->me, comm->nprocs);
   MPI_Reduce(&contacts, &contacts_, 1, MPI_LONG, MPI_SUM, 0, world);
   if (comm->me != 0) return;
 
-  const int N = natoms_;
-  sys.pairRecord = PairFdmSubgrid::pairRecord + (stresslets_ ? PairFdmSubgrid::pairStressRecord : 0);
-  sys.wallRecord = PairFdmSubgrid::wallRecord + (stresslets_ ? PairFdmSubgrid::wallStressRecord : 0);
-  pairBlocks_ = long(sys.pairs.size() / sys.pairRecord);
-  wallBlocks_ = long(sys.walls.size() / sys.wallRecord);
-  std::vector<Eigen::Triplet<double> > triplets;
-  triplets.reserve(size_t(6) * N + size_t(144) * pairBlocks_ + size_t(36) * wallBlocks_);
-  for (int k = 0; k < 6 * N; k++) triplets.push_back(Eigen::Triplet<double>(k, k, 0.0));  // the diagonal, always
-  sys.wallRhs = Eigen::VectorXd::Zero(6 * N);
-  auto index = [&](double tag) {
-    const long t = std::lround(tag);
-    if (t < 1 || t > N) fail("pair fdm/subgrid sent a block for particle ID " + std::to_string(t));
-    return int(t - 1);
-  };
-  for (long b = 0; b < pairBlocks_; b++) {
-    const double *rec = &sys.pairs[size_t(b) * sys.pairRecord];
-    const int base[2] = {6 * index(rec[0]), 6 * index(rec[1])};
-    const double *R = rec + 2;
-    for (int i = 0; i < 12; i++)
-      for (int j = 0; j < 12; j++)
-        triplets.push_back(Eigen::Triplet<double>(base[i / 6] + i % 6, base[j / 6] + j % 6, R[12 * i + j]));
-  }
-  for (long b = 0; b < wallBlocks_; b++) {
-    const double *rec = &sys.walls[size_t(b) * sys.wallRecord];
-    const int base = 6 * index(rec[0]);
-    const double *R = rec + 1, *rhs = rec + 37;
-    for (int i = 0; i < 6; i++) {
-      for (int j = 0; j < 6; j++) triplets.push_back(Eigen::Triplet<double>(base + i, base + j, R[6 * i + j]));
-      sys.wallRhs(base + i) += rhs[i];  // F = -R_w (U - U_w, Omega): the wall velocity is a force
+  std::vector<fdm::ParticleVelocitySystem::Particle> loads(natoms_);
+  for (int p = 0; p < natoms_; p++) {
+    const Particle &q = particles[p];
+    fdm::ParticleVelocitySystem::Particle &l = loads[p];
+    for (int d = 0; d < 3; d++) {
+      l.x[d] = q.x[d];
+      l.force[d] = q.f[d];
+      l.torque[d] = q.torque[d];
     }
+    l.radius = q.radius;
+    l.mass = q.mass;
+    l.density = q.density;
   }
-  sys.matrix.resize(6 * N, 6 * N);
-  sys.matrix.setFromTriplets(triplets.begin(), triplets.end());
-  sys.matrix.makeCompressed();
-  sys.diagonalIndex.assign(size_t(6) * N, -1);
-  sys.subgridDiagonal.assign(size_t(6) * N, 0.0);
-  for (int k = 0; k < 6 * N; k++)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(sys.matrix, k); it; ++it)
-      if (it.row() == k) {
-        sys.diagonalIndex[k] = int(&it.valueRef() - sys.matrix.valuePtr());
-        sys.subgridDiagonal[k] = it.value();
-      }
-  sys.diagonal = Eigen::VectorXd::Zero(6 * N);
-  sys.analysed = false;
+  try {
+    if (!system_) {
+      fdm::ParticleVelocitySystem::Settings settings;
+      settings.solver = directSolver_ ? fdm::ParticleVelocitySystem::ldlt : fdm::ParticleVelocitySystem::cg;
+      settings.tolerance = tolerance_;
+      settings.alphaLambda = alphaLambda_;
+      settings.rhoFluid = rhoFluid_;
+      for (int d = 0; d < 3; d++) settings.gravity[d] = gravity_[d];
+      settings.stresslets = stresslets_;
+      system_.reset(new fdm::ParticleVelocitySystem(settings));
+    }
+    system_->assemble(std::move(loads), std::move(allPairs), std::move(allWalls));
+  } catch (const fdm::ParticleVelocitySystem::Error &e) {
+    fail(e.what());
+  }
+  pairBlocks_ = system_->pairBlocks();
+  wallBlocks_ = system_->wallBlocks();
 }
 
-void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const cpl::Integrals &integrals)
+std::string FixFdmCouple::systemProblem(const fdm::ParticleVelocitySystem::Error &e, uint64_t step,
+                                        uint32_t iteration) const
 {
-  // Eq. (31): [ (rho_f/rho_p) J / alpha_lambda + R^SG ] u = F_tot, unknowns (U, Omega) per particle
-  // by tag. (rho_f/rho_p) M_p = rho_f Vu and (rho_f/rho_p) J_p = rho_f Ju come from the fluid's
-  // indicator function I_u; F_tot (Eq. 32) = the fluid integral + buoyant weight + everything
-  // LIGGGHTS put in f and torque (contacts, fix addforce, ...: F^c + F^ext) + the moving walls'
-  // term of Eq. (D.6). R^SG was assembled for this step by collectSubgrid().
-  System &sys = *system_;
-  const int N = natoms_;
-  Eigen::VectorXd rhs(6 * N), guess(6 * N), diagonal(6 * N);
-  for (int p = 0; p < N; p++) {
-    const Particle &q = particles[p];
-    const cpl::ParticleIntegrals &in = integrals.particles[p];
-    const double Vu = in.Vu, Ju = in.Ju;
-    const double values[8] = {Vu, Ju, in.fluid.F[0], in.fluid.F[1], in.fluid.F[2], in.fluid.T[0], in.fluid.T[1], in.fluid.T[2]};
-    for (int f = 0; f < 8; f++)
-      if (!std::isfinite(values[f]))
-        fail("the fluid solver sent a non-finite integral for particle " + tagName(p) + " at " + point(q.x) +
-             " (field " + std::to_string(f) + " of [Vu, Ju, F, T]) at step " + std::to_string(integrals.step) +
-             ", inner iteration " + std::to_string(integrals.iteration));
-    if (!(Vu > 0) || !(Ju > 0))
-      fail("particle " + tagName(p) + " at " + point(q.x) + " with radius " + fmt(q.radius) +
-           ": the fluid's indicator function gives it no volume (Vu " + fmt(Vu) + ", Ju " + fmt(Ju) +
-           "): is it smaller than a mesh cell (" + fmt(delta_) + ")?");
-    const double buoyantFraction = 1.0 - rhoFluid_ / q.density;  // (rho_p - rho_f)/rho_p
-    for (int d = 0; d < 3; d++) {
-      diagonal(6*p + d) = rhoFluid_ * Vu / alphaLambda_;
-      diagonal(6*p + 3 + d) = rhoFluid_ * Ju / alphaLambda_;
-      rhs(6*p + d) = in.fluid.F[d] + buoyantFraction * q.mass * gravity_[d] + q.f[d];
-      rhs(6*p + 3 + d) = in.fluid.T[d] + q.torque[d];
-    }
-  }
-  rhs += sys.wallRhs;
-  const bool diagonalChanged = diagonal != sys.diagonal;
-  sys.diagonal = diagonal;
-  double *values = sys.matrix.valuePtr();
-  for (int k = 0; k < 6 * N; k++) values[sys.diagonalIndex[k]] = sys.subgridDiagonal[k] + diagonal(k);
-  for (int k = 0; k < 6 * N; k++) guess(k) = solution_[k];  // warm start: the previous inner iteration
+  // what the system cannot know: the mesh size, and when
+  if (e.kind == fdm::ParticleVelocitySystem::Error::noVolume)
+    return std::string(e.what()) + ": is it smaller than a mesh cell (" + fmt(delta_) + ")?";
+  if (e.kind == fdm::ParticleVelocitySystem::Error::fluidValue)
+    return std::string(e.what()) + " at step " + std::to_string(step) + ", inner iteration " + std::to_string(iteration);
+  return e.what();
+}
 
-  Eigen::VectorXd u;
-  long iterations = 1;
-  if (directSolver_) {
-    // the matrix only changes with the positions: one factorisation per step
-    if (!sys.analysed) {
-      sys.ldlt.analyzePattern(sys.matrix);
-      sys.analysed = true;
+void FixFdmCouple::solveVelocities(const cpl::Integrals &integrals)
+{
+  // Eq. (31) for the integrals of one inner iteration (particle_velocity_system.h)
+  const int N = natoms_;
+  std::vector<double> Vu(N), Ju(N), fluid(size_t(6) * N);
+  for (int p = 0; p < N; p++) {
+    const cpl::ParticleIntegrals &in = integrals.particles[p];
+    Vu[p] = in.Vu;
+    Ju[p] = in.Ju;
+    for (int d = 0; d < 3; d++) {
+      fluid[size_t(6) * p + d] = in.fluid.F[d];
+      fluid[size_t(6) * p + 3 + d] = in.fluid.T[d];
     }
-    if (diagonalChanged) sys.ldlt.factorize(sys.matrix);
-    if (sys.ldlt.info() != Eigen::Success)
-      fail("the particle velocity system (Eq. 31) could not be factorised (LDLT): is the sub-grid matrix indefinite?");
-    u = sys.ldlt.solve(rhs);
-  } else {
-    sys.cg.setTolerance(tolerance_);
-    sys.cg.setMaxIterations(std::max(1000, 6 * N));
-    sys.cg.compute(sys.matrix);
-    u = sys.cg.solveWithGuess(rhs, guess);
-    iterations = long(sys.cg.iterations());
-    if (sys.cg.info() != Eigen::Success && !(sys.cg.error() < 1e-6))
-      fail("the particle velocity system (Eq. 31) did not converge: relative residual " + fmt(sys.cg.error()) +
-           " after " + std::to_string(sys.cg.iterations()) + " conjugate-gradient iterations (" +
-           std::to_string(pairBlocks_) + " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
   }
+  try {
+    system_->setVolumes(Vu, Ju);
+    solution_ = system_->solve(fluid);
+  } catch (const fdm::ParticleVelocitySystem::Error &e) {
+    fail(systemProblem(e, integrals.step, integrals.iteration));
+  }
+  const long iterations = system_->lastIterations();
   run_.solves++;
   run_.solverIterations += iterations;
   run_.solverIterationsMax = std::max(run_.solverIterationsMax, iterations);
   solverIterations_ = std::max(solverIterations_, iterations);
-  for (int k = 0; k < 6 * N; k++) {
-    if (!std::isfinite(u(k))) {
-      const int p = k / 6;
-      fail("the velocity of particle " + tagName(p) + " at " + point(particles[p].x) + " is not finite (Eq. 31): "
-           "its force " + point(particles[p].f) + ", torque " + point(particles[p].torque) + ", fluid integrals Vu " +
-           fmt(integrals.particles[p].Vu) + " Ju " + fmt(integrals.particles[p].Ju));
-    }
-    solution_[k] = u(k);
-  }
 }
 
 cpl::Integrals FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &particles) const
@@ -821,43 +746,14 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
 {
   // rank 0, after the last inner iteration: the sub-grid force and torque (Eq. 21 and D.6) and,
   // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
-  System &sys = *system_;
-  const int N = natoms_;
-  const Eigen::Map<const Eigen::VectorXd> u(solution_.data(), 6 * N);
-  const Eigen::VectorXd forces = sys.wallRhs - sys.matrix * u + sys.diagonal.cwiseProduct(u);
-  for (int k = 0; k < 6 * N; k++) subgrid_[k] = forces(k);
+  subgrid_ = system_->subgridForces();
   if (!stresslets_) return;
-  for (int p = 0; p < N; p++) {
+  std::vector<double> hydrodynamic = fluidStress_;  // 7 per particle
+  system_->addSubgridStresslets(hydrodynamic);
+  for (int p = 0; p < natoms_; p++) {
     double *out = &stress_[size_t(13) * p];
-    for (int c = 0; c < 7; c++) out[c] = fluidStress_[size_t(7) * p + c];
+    for (int c = 0; c < 7; c++) out[c] = hydrodynamic[size_t(7) * p + c];
     for (int c = 0; c < 6; c++) out[7 + c] = particles[p].contactStress[c];
-  }
-  for (size_t b = 0; b < sys.pairs.size() / sys.pairRecord; b++) {
-    const double *rec = &sys.pairs[b * sys.pairRecord];
-    const int p[2] = {int(std::lround(rec[0])) - 1, int(std::lround(rec[1])) - 1};
-    const double *rows = rec + PairFdmSubgrid::pairRecord;  // 14 x 12: S_1 (6), S_2 (6), s_1, s_2
-    double velocity[12];
-    for (int k = 0; k < 6; k++) {
-      velocity[k] = solution_[size_t(6) * p[0] + k];
-      velocity[6 + k] = solution_[size_t(6) * p[1] + k];
-    }
-    for (int row = 0; row < 14; row++) {
-      double value = 0;
-      for (int k = 0; k < 12; k++) value -= rows[12 * row + k] * velocity[k];
-      const int who = row < 12 ? row / 6 : row - 12;
-      const int component = row < 12 ? row % 6 : 6;
-      stress_[size_t(13) * p[who] + component] += value;
-    }
-  }
-  for (size_t b = 0; b < sys.walls.size() / sys.wallRecord; b++) {
-    const double *rec = &sys.walls[b * sys.wallRecord];
-    const int p = int(std::lround(rec[0])) - 1;
-    const double *rows = rec + PairFdmSubgrid::wallRecord, *wallTerm = rows + 42;  // 7 x 6, then 7
-    for (int row = 0; row < 7; row++) {
-      double value = wallTerm[row];
-      for (int k = 0; k < 6; k++) value -= rows[6 * row + k] * solution_[size_t(6) * p + k];
-      stress_[size_t(13) * p + row] += value;
-    }
   }
 }
 
@@ -888,13 +784,12 @@ void FixFdmCouple::final_integrate()
   run_.gatherScatter += MPI_Wtime() - t0;
   t0 = MPI_Wtime();
   solverIterations_ = 0;
-  collectSubgrid();
+  assembleSystem(particles);
   run_.solve += MPI_Wtime() - t0;
 
   if (comm->me == 0 && !hasFluid()) {
     t0 = MPI_Wtime();
-    const cpl::Integrals integrals = noFluidIntegrals(particles);
-    solveVelocities(particles, integrals);
+    solveVelocities(noFluidIntegrals(particles));
     for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
       hydro_[k] = -system_->diagonal(k) * solution_[k];
     subgridResults(particles);
@@ -923,7 +818,7 @@ void FixFdmCouple::final_integrate()
           break;
         }
         const cpl::Integrals integrals = cpl::Integrals::fromMessage(m, natoms_);
-        solveVelocities(particles, integrals);
+        solveVelocities(integrals);
         cpl::Velocities reply;
         reply.step = integrals.step;
         reply.iteration = integrals.iteration;
@@ -975,13 +870,7 @@ void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
 
   std::vector<int> closePairs;
   std::vector<motion::Wall> walls;
-  if (gapUpdate_ && system_) {
-    const System &sys = *system_;
-    for (size_t b = 0; sys.pairRecord > 0 && b < sys.pairs.size() / sys.pairRecord; b++) {
-      closePairs.push_back(int(std::lround(sys.pairs[b * sys.pairRecord])) - 1);
-      closePairs.push_back(int(std::lround(sys.pairs[b * sys.pairRecord + 1])) - 1);
-    }
-  }
+  if (gapUpdate_ && system_) closePairs = system_->closePairs();
   if (gapUpdate_ && pair_)
     for (const PairFdmSubgrid::Wall &w : pair_->walls())
       walls.push_back(motion::Wall{w.axis, w.side, w.side == 0 ? domain->boxlo[w.axis] : domain->boxhi[w.axis]});

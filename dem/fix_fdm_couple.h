@@ -24,6 +24,7 @@
 
 #include "fix.h"
 #include "fdm/coupler.h"
+#include "particle_velocity_system.h"
 #include "position_update.h"
 
 #include <memory>
@@ -87,8 +88,9 @@ class FixFdmCouple : public Fix {
   std::string checkConfiguration(const std::vector<Particle> &particles, bool checkOverlaps) const;
   std::string findOverlap(const std::vector<Particle> &particles) const;
   fdm::coupler::Step makeStep(const std::vector<Particle> &particles) const;
-  void collectSubgrid();
-  void solveVelocities(const std::vector<Particle> &particles, const fdm::coupler::Integrals &integrals);
+  void assembleSystem(const std::vector<Particle> &particles);
+  void solveVelocities(const fdm::coupler::Integrals &integrals);
+  std::string systemProblem(const fdm::ParticleVelocitySystem::Error &e, uint64_t step, uint32_t iteration) const;
   void subgridResults(const std::vector<Particle> &particles);
   fdm::coupler::Integrals noFluidIntegrals(const std::vector<Particle> &particles) const;
   void storeStepDone(const fdm::coupler::StepDone &done);
@@ -141,11 +143,8 @@ class FixFdmCouple : public Fix {
   double **perAtom_;
   int perAtomColumns_;
 
-  // Eq. (31) on rank 0, for the current time step: the matrix is assembled once per step (the
-  // positions do not move during the inner iterations); only its diagonal and the right-hand
-  // side change from one inner iteration to the next.
-  struct System;
-  std::unique_ptr<System> system_;
+  // Eq. (31) on rank 0 (particle_velocity_system.h): assembled once per step, solved every inner iteration.
+  std::unique_ptr<fdm::ParticleVelocitySystem> system_;
   std::vector<double> subgrid_;    // 6N: F^SG, T^SG of the last step, by tag
   std::vector<double> stress_;     // 13N: S^h (6), s^h, S^c (6) of the last step, by tag
   long solverIterations_, solverIterationsMax_, pairBlocks_, wallBlocks_, contacts_;

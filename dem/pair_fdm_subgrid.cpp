@@ -4,6 +4,7 @@
 
 #include "fix_contact_history_fdm.h"
 #include "fix_fdm_couple.h"
+#include "particle_velocity_system.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -487,7 +488,7 @@ void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, 
       pairs.push_back(tag[i]);
       pairs.push_back(tag[j]);
       pairs.insert(pairs.end(), &block.R[0][0], &block.R[0][0] + 144);
-      if (withStress) pairs.insert(pairs.end(), &block.stress[0][0], &block.stress[0][0] + pairStressRecord);
+      if (withStress) pairs.insert(pairs.end(), &block.stress[0][0], &block.stress[0][0] + fdm::subgrid::pairStressRecord);
     }
   }
   res::WallBlock wallBlock;

@@ -48,12 +48,8 @@ class PairFdmSubgrid : public Pair {
     double velocity[3];
   };
 
-  // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0.
-  // Pair record: [tag1, tag2, R (12x12, row-major, unknowns U1 W1 U2 W2)] + stress rows (14x12) if
-  // withStress. Wall record: [tag, R (6x6), rhs R[:,0:3] U_w (6)] + stress rows (7x6) and their
-  // wall-velocity term (7) if withStress. R already contains the viscosity (F = -R u).
-  static const int pairRecord = 2 + 144, pairStressRecord = 14 * 12;
-  static const int wallRecord = 1 + 36 + 6, wallStressRecord = 7 * 6 + 7;
+  // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0, in
+  // the records of fdm::subgrid (particle_velocity_system.h), with their stress rows if withStress.
   void collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls);
 
   bool lubricationActive() const { return lubrication_ && model_; }
