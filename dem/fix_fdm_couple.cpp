@@ -2,6 +2,7 @@
 // See fix_fdm_couple.h for what it does and docs/dem.md for its use.
 #include "fix_fdm_couple.h"
 
+#include "coupling_session.h"
 #include "pair_fdm_subgrid.h"
 
 #include "atom.h"
@@ -23,18 +24,6 @@
 using namespace LAMMPS_NS;
 namespace cpl = fdm::coupler;
 
-std::unique_ptr<cpl::Transport> FixFdmCouple::connection_;
-bool FixFdmCouple::connected_ = false;
-int FixFdmCouple::sessionParticles_ = 0;
-double FixFdmCouple::alphaLambda_ = 0.0;
-double FixFdmCouple::rhoFluid_ = 0.0;
-double FixFdmCouple::delta_ = 0.0;
-double FixFdmCouple::viscosity_ = 0.0;
-double FixFdmCouple::fluidFaces_[6][4] = {{0}};
-FixFdmCouple::Timing FixFdmCouple::total_;
-int FixFdmCouple::runs_ = 0;
-double FixFdmCouple::sessionStart_ = 0.0;
-
 namespace {
 
 // Per-atom values gathered to rank 0: tag, then the fields of Particle (the contact stresslet
@@ -51,29 +40,10 @@ std::string fmt(double x)
 std::string point(const double *x) { return "(" + fmt(x[0]) + ", " + fmt(x[1]) + ", " + fmt(x[2]) + ")"; }
 std::string tagName(int index) { return std::to_string(index + 1); }
 
-// If LIGGGHTS stops on an error (error->all exits), tell the fluid solver why it lost its peer
-// rather than leave it to guess from a closed socket.
-void tellPeerWeStopped();
-
 }  // namespace
 
-void FixFdmCouple::Timing::add(const Timing &t)
-{
-  solve += t.solve;
-  exchange += t.exchange;
-  gatherScatter += t.gatherScatter;
-  steps += t.steps;
-  solves += t.solves;
-  solverIterations += t.solverIterations;
-  solverIterationsMax = std::max(solverIterationsMax, t.solverIterationsMax);
-  gapTargets += t.gapTargets;
-  gapLimited += t.gapLimited;
-  gapFallbacks += t.gapFallbacks;
-  gapSweepsMax = std::max(gapSweepsMax, t.gapSweepsMax);
-}
-
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
-  Fix(lmp, narg, arg), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
+  Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), solverIterationsMax_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0)
@@ -88,7 +58,9 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   size_peratom_cols = 12;
   peratom_freq = 1;
   gravity_[0] = gravity_[1] = gravity_[2] = 0.0;
-  options_.name = "fluid solver fdmFoam";
+  CouplingSession::Request request;
+  cpl::Options &options = request.options;
+  options.name = "fluid solver fdmFoam";
 
   for (int i = 3; i < narg; i++) {
     const std::string key = arg[i];
@@ -97,17 +69,17 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       return arg[i + n];
     };
     if (key == "transport") {
-      options_.transport = value(1);
-      if (options_.transport != "socket" && options_.transport != "file" && options_.transport != "none")
-        error->all(FLERR, ("fix fdm/couple: transport " + options_.transport + " is not socket, file or none").c_str());
+      options.transport = value(1);
+      if (options.transport != "socket" && options.transport != "file" && options.transport != "none")
+        error->all(FLERR, ("fix fdm/couple: transport " + options.transport + " is not socket, file or none").c_str());
       i++;
-    } else if (key == "host") { options_.host = value(1); i++; }
-    else if (key == "port") { options_.port = force->inumeric(FLERR, value(1)); i++; }
-    else if (key == "portfile") { options_.portFile = value(1); i++; }
-    else if (key == "directory") { options_.directory = value(1); i++; }
-    else if (key == "connect_timeout") { options_.connectTimeout = force->numeric(FLERR, value(1)); i++; }
-    else if (key == "timeout") { options_.receiveTimeout = force->numeric(FLERR, value(1)); i++; }
-    else if (key == "record") { options_.recordFile = value(1); i++; }
+    } else if (key == "host") { options.host = value(1); i++; }
+    else if (key == "port") { options.port = force->inumeric(FLERR, value(1)); i++; }
+    else if (key == "portfile") { options.portFile = value(1); i++; }
+    else if (key == "directory") { options.directory = value(1); i++; }
+    else if (key == "connect_timeout") { options.connectTimeout = force->numeric(FLERR, value(1)); i++; }
+    else if (key == "timeout") { options.receiveTimeout = force->numeric(FLERR, value(1)); i++; }
+    else if (key == "record") { options.recordFile = value(1); i++; }
     else if (key == "gravity") {
       for (int d = 0; d < 3; d++) gravity_[d] = force->numeric(FLERR, value(d + 1));
       i += 3;
@@ -117,13 +89,13 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       move_ = (v == "yes");
       i++;
     } else if (key == "viscosity") {
-      noFluidViscosity_ = force->numeric(FLERR, value(1));
+      request.viscosity = force->numeric(FLERR, value(1));
       i++;
     } else if (key == "mesh") {
-      noFluidMesh_ = force->numeric(FLERR, value(1));
+      request.meshSize = force->numeric(FLERR, value(1));
       i++;
     } else if (key == "fluid_density") {
-      noFluidDensity_ = force->numeric(FLERR, value(1));
+      request.fluidDensity = force->numeric(FLERR, value(1));
       i++;
     } else if (key == "integrator") {
       const std::string v = value(1);
@@ -156,21 +128,25 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   }
   perAtomColumns_ = stresslets_ ? 25 : 12;
   size_peratom_cols = perAtomColumns_;
-  if (options_.transport == "none" && (!(noFluidViscosity_ > 0) || !(noFluidMesh_ > 0) || !(noFluidDensity_ > 0)))
+  if (options.transport == "none" && (!(request.viscosity > 0) || !(request.meshSize > 0) || !(request.fluidDensity > 0)))
     error->all(FLERR, "fix fdm/couple transport none (DEM only, no fluid) needs viscosity eta [Pa s] and mesh Delta [m] "
                       "(the sub-grid model's mesh size), both positive; fluid_density (default 1000 kg/m3) too");
-  if (options_.transport == "none" && stresslets_)
+  if (options.transport == "none" && stresslets_)
     error->all(FLERR, "fix fdm/couple: stresslets need the fluid solver (not with transport none)");
-  if (options_.transport == "socket" && (options_.port <= 0 || options_.port > 65535) && options_.portFile.empty())
+  if (options.transport == "socket" && (options.port <= 0 || options.port > 65535) && options.portFile.empty())
     error->all(FLERR, "fix fdm/couple: give the fluid solver's port (port P) or its port file (portfile F)");
-  if (options_.transport == "file" && options_.directory.empty())
+  if (options.transport == "file" && options.directory.empty())
     error->all(FLERR, "fix fdm/couple: transport file needs directory D");
-  if (!(options_.connectTimeout > 0) || !(options_.receiveTimeout > 0))
+  if (!(options.connectTimeout > 0) || !(options.receiveTimeout > 0))
     error->all(FLERR, "fix fdm/couple: connect_timeout and timeout must be positive (seconds)");
+  request.stresslets = stresslets_;
+  hasFluid_ = options.transport != "none";
+  session_.attach(this, request);
 }
 
 FixFdmCouple::~FixFdmCouple()
 {
+  session_.detach(this);
   memory->destroy(perAtom_);
 }
 
@@ -179,24 +155,9 @@ int FixFdmCouple::setmask()
   return FixConst::INITIAL_INTEGRATE | FixConst::FINAL_INTEGRATE;
 }
 
-void FixFdmCouple::checkAtoms()
-{
-  if (!atom->sphere_flag || !atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag ||
-      !atom->density_flag)
-    error->all(FLERR, "fix fdm/couple requires atom_style sphere (radius, mass, density, omega, torque)");
-  if (atom->map_style != 1) error->all(FLERR, "fix fdm/couple requires atom_modify map array");
-  if (!atom->tag_enable) error->all(FLERR, "fix fdm/couple requires atom IDs (tags)");
-  if (atom->natoms > 100000000)
-    error->all(FLERR, "fix fdm/couple: more than 10^8 particles are not supported by the coupling messages");
-  if (atom->natoms > 0 && atom->map_tag_max != atom->natoms)
-    error->all(FLERR, ("fix fdm/couple requires atom IDs 1..N without gaps: there are " +
-                       std::to_string((long long) atom->natoms) + " atoms but the largest ID is " +
-                       std::to_string(atom->map_tag_max) + " (use reset_atom_ids or renumber the data file)").c_str());
-}
-
 void FixFdmCouple::init()
 {
-  checkAtoms();
+  session_.checkAtoms(lmp);
   atomsAtInit_ = int(atom->natoms);
   pair_ = dynamic_cast<PairFdmSubgrid *>(force->pair_match("fdm/subgrid", 1));
   if (pair_) pair_->requestContactStress(stresslets_);
@@ -223,104 +184,15 @@ void FixFdmCouple::init()
 
 void FixFdmCouple::allAgree(const std::string &problemOnRank0)
 {
-  // The problem is known on rank 0 only; every rank must call error->all.
-  int length = int(problemOnRank0.size());
-  MPI_Bcast(&length, 1, MPI_INT, 0, world);
-  if (length == 0) return;
-  std::vector<char> text(problemOnRank0.begin(), problemOnRank0.end());
-  text.resize(size_t(length) + 1, '\0');
-  MPI_Bcast(text.data(), length, MPI_CHAR, 0, world);
-  if (comm->me == 0 && connection_) {
-    connection_->sendError("fdmDEM: " + problemOnRank0);
-    connection_.reset();
-  }
-  error->all(FLERR, (std::string("fdm/couple: ") + text.data()).c_str());
+  // The problem is known on rank 0 only; every rank must stop (and the fluid is told why).
+  session_.stopIf(lmp, problemOnRank0);
 }
 
 void FixFdmCouple::fail(const std::string &message)
 {
   // rank 0, in the middle of a step (the other ranks wait in MPI_Bcast): error->one aborts them all
-  if (connection_) {
-    connection_->sendError("fdmDEM: " + message);
-    connection_.reset();
-  }
+  session_.abandon("fdmDEM: " + message);
   error->one(FLERR, ("fdm/couple: " + message).c_str());
-}
-
-std::string FixFdmCouple::checkFluidHello(const cpl::FluidHello &hello) const
-{
-  if (hello.nParticlesExpected >= 0 && hello.nParticlesExpected != natoms_)
-    return "the fluid case expects " + std::to_string(hello.nParticlesExpected) + " particles (constant/fdmProperties "
-           "nParticles) but the LIGGGHTS input has " + std::to_string(natoms_);
-  if (!(hello.alphaLambda > 0) || !(hello.rhoFluid > 0) || !(hello.delta > 0) || !(hello.viscosity > 0))
-    return "the fluid solver sent a non-positive alpha_lambda (" + fmt(hello.alphaLambda) + " s), rho_f (" +
-           fmt(hello.rhoFluid) + " kg/m3), mesh size (" + fmt(hello.delta) + " m) or viscosity (" +
-           fmt(hello.viscosity) + " Pa s)";
-  const char *axis = "xyz";
-  for (int d = 0; d < 3; d++) {
-    const double lo = hello.lo[d], hi = hello.hi[d];
-    const double tolerance = 1e-9 * std::max(std::fabs(domain->prd[d]), std::fabs(hi - lo));
-    if (!(std::fabs(lo - domain->boxlo[d]) <= tolerance) || !(std::fabs(hi - domain->boxhi[d]) <= tolerance))
-      return std::string(1, axis[d]) + " extent: LIGGGHTS box " + fmt(domain->boxlo[d]) + " .. " +
-             fmt(domain->boxhi[d]) + " but OpenFOAM mesh " + fmt(lo) + " .. " + fmt(hi);
-    if (hello.periodic[d] != (domain->periodicity[d] != 0))
-      return std::string(1, axis[d]) + " boundary: LIGGGHTS " + (domain->periodicity[d] ? "periodic (p)" :
-             "not periodic") + " but the OpenFOAM mesh " + (hello.periodic[d] ? "has cyclic patches" : "has no cyclic patches") +
-             " in " + axis[d];
-  }
-  return "";
-}
-
-void FixFdmCouple::connectAndHandshake()
-{
-  std::string problem;
-  if (comm->me == 0) {
-    try {
-      if (screen)
-        fprintf(screen, "fdm/couple: connecting to fdmFoam (%s%s)\n", options_.transport.c_str(),
-                options_.transport == "file" ? (" in " + options_.directory).c_str() :
-                (" " + options_.host + (options_.portFile.empty() ? ":" + std::to_string(options_.port) :
-                                        ", port file " + options_.portFile)).c_str());
-      connection_ = cpl::connect(options_);
-      std::atexit(tellPeerWeStopped);
-      cpl::DemHello hello;
-      hello.dt = update->dt;
-      hello.lastStep = update->laststep;
-      hello.stresslets = stresslets_;
-      hello.nParticles = natoms_;
-      for (int d = 0; d < 3; d++) {
-        hello.lo[d] = domain->boxlo[d];
-        hello.hi[d] = domain->boxhi[d];
-        hello.periodic[d] = domain->periodicity[d] != 0;
-      }
-      connection_->send(hello.toMessage());
-      const cpl::FluidHello reply = cpl::FluidHello::fromMessage(connection_->receive(cpl::MessageType::Hello));
-      problem = checkFluidHello(reply);
-      if (problem.empty()) {
-        alphaLambda_ = reply.alphaLambda;
-        rhoFluid_ = reply.rhoFluid;
-        delta_ = reply.delta;
-        viscosity_ = reply.viscosity;
-        for (int face = 0; face < 6; face++) {
-          fluidFaces_[face][0] = reply.faces[face].kind;
-          for (int d = 0; d < 3; d++) fluidFaces_[face][1 + d] = reply.faces[face].velocity[d];
-        }
-        if (screen)
-          fprintf(screen, "fdm/couple: connected (%s): %d particles, alpha_lambda %g s, rho_f %g kg/m3, "
-                  "viscosity %g Pa s, mesh size %g m\n", connection_->describe().c_str(), natoms_, alphaLambda_,
-                  rhoFluid_, viscosity_, delta_);
-      }
-    } catch (const std::exception &e) {
-      problem = e.what();
-    }
-  }
-  allAgree(problem);
-  MPI_Bcast(&alphaLambda_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&rhoFluid_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&delta_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&viscosity_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&fluidFaces_[0][0], 24, MPI_DOUBLE, 0, world);
-  sessionStart_ = MPI_Wtime();
 }
 
 void FixFdmCouple::gather(std::vector<Particle> &particles)
@@ -476,59 +348,14 @@ std::string FixFdmCouple::findOverlap(const std::vector<Particle> &p) const
          (pairs > 1 ? " (" + std::to_string(pairs) + " overlapping pairs in all)" : std::string());
 }
 
-void FixFdmCouple::ensureConnected()
-{
-  if (connected_) return;
-  // Counted before this setup's re-partitioning (at init(), or earlier when the pair style asks):
-  // LIGGGHTS silently drops an atom put outside a non-periodic face, and gather() must name it.
-  if (atomsAtInit_ == 0) checkAtoms();  // asked by the pair style, before this fix's init()
-  sessionParticles_ = atomsAtInit_ > 0 ? atomsAtInit_ : int(atom->natoms);  // told to the fluid, for the session
-  natoms_ = sessionParticles_;
-  if (hasFluid()) {
-    connectAndHandshake();
-  } else {
-    // DEM only: Eq. (31) with each particle's isolated Stokes resistance in place of the fluid's
-    // (alpha_lambda = 1 s makes rho_f Vu / alpha_lambda = 6 pi eta a, see noFluidIntegrals)
-    viscosity_ = noFluidViscosity_;
-    delta_ = noFluidMesh_;
-    rhoFluid_ = noFluidDensity_;
-    alphaLambda_ = 1.0;
-    for (int face = 0; face < 6; face++) {
-      fluidFaces_[face][0] = domain->periodicity[face / 2] ? facePeriodic : faceNoFluid;
-      for (int d = 0; d < 3; d++) fluidFaces_[face][1 + d] = 0.0;
-    }
-    if (comm->me == 0 && screen)
-      fprintf(screen, "fdm/couple: transport none: DEM only, no fluid solver; each particle feels its isolated "
-              "Stokes drag (viscosity %g Pa s) plus the pair style's forces and sub-grid lubrication (mesh size %g m)\n",
-              viscosity_, delta_);
-    sessionStart_ = MPI_Wtime();
-  }
-  connected_ = true;
-}
-
-const char *FixFdmCouple::faceKindName(int kind)
-{
-  switch (kind) {
-    case facePeriodic: return "a periodic (cyclic) boundary";
-    case faceWall: return "a no-slip wall";
-    case faceSlip: return "a slip wall";
-  }
-  return "another kind of boundary";
-}
-
-void FixFdmCouple::fluidFace(int face, int &kind, double velocity[3]) const
-{
-  kind = int(std::lround(fluidFaces_[face][0]));
-  for (int d = 0; d < 3; d++) velocity[d] = fluidFaces_[face][1 + d];
-}
-
 void FixFdmCouple::setup(int)
 {
   // Called before every run (not with 'run N pre no'): connect once, then check the particles
   // wherever the input has put them since (set atom ... between runs).
-  const bool firstSetup = !connected_;
-  ensureConnected();
-  natoms_ = sessionParticles_;
+  const bool firstSetup = !session_.connected();
+  // the count of init(): LIGGGHTS may have dropped an atom since, which gather() must name
+  session_.ensureConnected(lmp, atomsAtInit_);
+  natoms_ = session_.particles();
   // fewer atoms than announced: gather() names the particle LIGGGHTS lost
   if (atom->natoms > natoms_ || atom->map_tag_max > natoms_)
     allAgree("the particles changed since the coupling started: " + std::to_string((long long) atom->natoms) +
@@ -671,8 +498,8 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
       fdm::ParticleVelocitySystem::Settings settings;
       settings.solver = directSolver_ ? fdm::ParticleVelocitySystem::ldlt : fdm::ParticleVelocitySystem::cg;
       settings.tolerance = tolerance_;
-      settings.alphaLambda = alphaLambda_;
-      settings.rhoFluid = rhoFluid_;
+      settings.alphaLambda = session_.alphaLambda();
+      settings.rhoFluid = session_.rhoFluid();
       for (int d = 0; d < 3; d++) settings.gravity[d] = gravity_[d];
       settings.stresslets = stresslets_;
       system_.reset(new fdm::ParticleVelocitySystem(settings));
@@ -690,7 +517,7 @@ std::string FixFdmCouple::systemProblem(const fdm::ParticleVelocitySystem::Error
 {
   // what the system cannot know: the mesh size, and when
   if (e.kind == fdm::ParticleVelocitySystem::Error::noVolume)
-    return std::string(e.what()) + ": is it smaller than a mesh cell (" + fmt(delta_) + ")?";
+    return std::string(e.what()) + ": is it smaller than a mesh cell (" + fmt(session_.meshSize()) + ")?";
   if (e.kind == fdm::ParticleVelocitySystem::Error::fluidValue)
     return std::string(e.what()) + " at step " + std::to_string(step) + ", inner iteration " + std::to_string(iteration);
   return e.what();
@@ -728,6 +555,7 @@ cpl::Integrals FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &parti
   // transport none: "integrals" of an isolated sphere in a fluid at rest, so that Eq. (31) reads
   // [diag(6 pi eta a, 8 pi eta a^3) + R^SG] u = F^c + F^ext + buoyant weight
   const double pi = 3.14159265358979323846;
+  const double eta = session_.viscosity(), alpha = session_.alphaLambda(), rho = session_.rhoFluid();
   cpl::Integrals m;
   m.step = update->ntimestep;
   m.iteration = 1;
@@ -735,8 +563,8 @@ cpl::Integrals FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &parti
   for (int p = 0; p < natoms_; p++) {
     const double a = particles[p].radius;
     cpl::ParticleIntegrals &in = m.particles[p];
-    in.Vu = 6 * pi * viscosity_ * a * alphaLambda_ / rhoFluid_;
-    in.Ju = 8 * pi * viscosity_ * a * a * a * alphaLambda_ / rhoFluid_;
+    in.Vu = 6 * pi * eta * a * alpha / rho;
+    in.Ju = 8 * pi * eta * a * a * a * alpha / rho;
     for (int d = 0; d < 3; d++) in.fluid.F[d] = in.fluid.T[d] = 0.0;
   }
   return m;
@@ -787,7 +615,7 @@ void FixFdmCouple::final_integrate()
   assembleSystem(particles);
   run_.solve += MPI_Wtime() - t0;
 
-  if (comm->me == 0 && !hasFluid()) {
+  if (comm->me == 0 && !hasFluid_) {
     t0 = MPI_Wtime();
     solveVelocities(noFluidIntegrals(particles));
     for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
@@ -796,13 +624,14 @@ void FixFdmCouple::final_integrate()
     lastIterations_ = 1;
     run_.solve += MPI_Wtime() - t0;
   } else if (comm->me == 0) {
-    if (!connection_) fail("the connection to the fluid solver is closed");
+    cpl::Transport *connection = session_.transport();
+    if (!connection) fail("the connection to the fluid solver is closed");
     const bigint step = update->ntimestep;
     try {
       t0 = MPI_Wtime();
-      connection_->send(makeStep(particles).toMessage());
+      connection->send(makeStep(particles).toMessage());
       while (true) {
-        const cpl::Message m = connection_->receive();
+        const cpl::Message m = connection->receive();
         double t1 = MPI_Wtime();
         run_.exchange += t1 - t0;
         if (m.type != cpl::MessageType::Integrals && m.type != cpl::MessageType::StepDone)
@@ -830,7 +659,7 @@ void FixFdmCouple::final_integrate()
           }
         t0 = MPI_Wtime();
         run_.solve += t0 - t1;
-        connection_->send(reply.toMessage());
+        connection->send(reply.toMessage());
       }
     } catch (const std::exception &e) {
       fail(e.what());
@@ -977,8 +806,7 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
 void FixFdmCouple::post_run()
 {
   const double now = MPI_Wtime();
-  total_.add(run_);
-  runs_++;
+  session_.addRun(run_.steps, run_.solve, run_.exchange, run_.gatherScatter);
   printTiming("of this run", run_, now - runStart_, 1);
   notConverged_ = 0;
   // a following 'run N pre no' skips setup(): its timing starts here
@@ -991,8 +819,8 @@ double FixFdmCouple::compute_vector(int n)
   switch (n) {
     case 0: return lastIterations_;
     case 1: return lastResidual_;
-    case 2: return total_.solve + run_.solve;
-    case 3: return total_.exchange + run_.exchange;
+    case 2: return session_.totalSolve() + run_.solve;
+    case 3: return session_.totalExchange() + run_.exchange;
     case 4: return solverIterations_;
     case 5: return pairBlocks_;
     case 6: return wallBlocks_;
@@ -1006,41 +834,3 @@ double FixFdmCouple::memory_usage()
   return double(nmax_) * perAtomColumns_ * sizeof(double) + double(solution_.size() + hydro_.size()) * sizeof(double);
 }
 
-void FixFdmCouple::finishAll(LAMMPS *lmp)
-{
-  if (lmp->comm->me != 0 || !connection_) return;
-  try {
-    cpl::Finish finish;
-    finish.step = lmp->update->ntimestep;
-    connection_->send(finish.toMessage());
-  } catch (const std::exception &e) {
-    if (lmp->screen) fprintf(lmp->screen, "fdm/couple: WARNING: could not tell the fluid solver to finish: %s\n",
-                             e.what());
-  }
-  connection_->close();
-  connection_.reset();
-  const double wall = MPI_Wtime() - sessionStart_, percent = wall > 0 ? 100.0 / wall : 0.0;
-  char line[512];
-  std::snprintf(line, sizeof line,
-                "fdm/couple timing total (%d run%s, %ld steps, %.4g s coupled): particle solve %.4g s (%.1f %%), "
-                "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%)\n",
-                runs_, runs_ == 1 ? "" : "s", total_.steps, wall, total_.solve, total_.solve * percent,
-                total_.exchange, total_.exchange * percent, total_.gatherScatter, total_.gatherScatter * percent);
-  if (lmp->screen) fputs(line, lmp->screen);
-  if (lmp->logfile) fputs(line, lmp->logfile);
-}
-
-namespace {
-void tellPeerWeStopped()
-{
-  FixFdmCouple::abandon("fdmDEM stopped before the end of its input (a LIGGGHTS error? see the fdmDEM log)");
-}
-}  // namespace
-
-void FixFdmCouple::abandon(const std::string &why)
-{
-  if (!connection_) return;
-  connection_->sendError(why);
-  connection_->close();
-  connection_.reset();
-}

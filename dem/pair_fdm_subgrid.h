@@ -10,8 +10,10 @@
    The contact forces go into f and torque at every force evaluation, like any LIGGGHTS pair style
    (they enter F^c of Eq. 32). The sub-grid blocks are not forces: they are the matrix R^SG of
    Eq. (31), which fix fdm/couple solves implicitly. The fix asks for them once per time step
-   (collectBlocks) with the viscosity and mesh size the fluid solver announced at the handshake;
-   the resistance functions come from the project's resistance library (resistance/). */
+   (collectBlocks); the viscosity and mesh size are those the fluid solver announced at the
+   handshake, asked of the coupling session (coupling_session.h), which also says which box faces
+   are the fluid case's walls. The resistance functions come from the project's resistance library
+   (resistance/). */
 
 #ifndef FDM_PAIR_FDM_SUBGRID_H
 #define FDM_PAIR_FDM_SUBGRID_H
@@ -84,7 +86,7 @@ class PairFdmSubgrid : public Pair {
   double kn_, kt_, mu_, hr_;
   std::vector<Wall> walls_;
 
-  // from the fluid solver (via fix fdm/couple) at the handshake
+  // from the fluid solver at the handshake (coupling session)
   double viscosity_, meshSize_;
   std::unique_ptr<fdm::resistance::SubgridModel> model_, wallModel_;  // pairs, walls
 
