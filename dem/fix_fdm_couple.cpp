@@ -515,30 +515,40 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
 std::string FixFdmCouple::systemProblem(const fdm::ParticleVelocitySystem::Error &e, uint64_t step,
                                         uint32_t iteration) const
 {
-  // what the system cannot know: the mesh size, and when
+  // what the system cannot know: the mesh size, and when (iteration 0: the step's Volumes)
   if (e.kind == fdm::ParticleVelocitySystem::Error::noVolume)
     return std::string(e.what()) + ": is it smaller than a mesh cell (" + fmt(session_.meshSize()) + ")?";
   if (e.kind == fdm::ParticleVelocitySystem::Error::fluidValue)
-    return std::string(e.what()) + " at step " + std::to_string(step) + ", inner iteration " + std::to_string(iteration);
+    return std::string(e.what()) + " at step " + std::to_string(step) +
+           (iteration > 0 ? ", inner iteration " + std::to_string(iteration) : std::string());
   return e.what();
+}
+
+void FixFdmCouple::setVolumes(const cpl::Volumes &volumes)
+{
+  // Eq. (31)'s diagonal and its factorisation, once per time step (Vu, Ju depend only on the positions)
+  std::vector<double> Vu(natoms_), Ju(natoms_);
+  for (int p = 0; p < natoms_; p++) {
+    Vu[p] = volumes.particles[p].Vu;
+    Ju[p] = volumes.particles[p].Ju;
+  }
+  try {
+    system_->setVolumes(Vu, Ju);
+  } catch (const fdm::ParticleVelocitySystem::Error &e) {
+    fail(systemProblem(e, volumes.step, 0));
+  }
 }
 
 void FixFdmCouple::solveVelocities(const cpl::Integrals &integrals)
 {
   // Eq. (31) for the integrals of one inner iteration (particle_velocity_system.h)
-  const int N = natoms_;
-  std::vector<double> Vu(N), Ju(N), fluid(size_t(6) * N);
-  for (int p = 0; p < N; p++) {
-    const cpl::ParticleIntegrals &in = integrals.particles[p];
-    Vu[p] = in.Vu;
-    Ju[p] = in.Ju;
+  std::vector<double> fluid(size_t(6) * natoms_);
+  for (int p = 0; p < natoms_; p++)
     for (int d = 0; d < 3; d++) {
-      fluid[size_t(6) * p + d] = in.fluid.F[d];
-      fluid[size_t(6) * p + 3 + d] = in.fluid.T[d];
+      fluid[size_t(6) * p + d] = integrals.particles[p].F[d];
+      fluid[size_t(6) * p + 3 + d] = integrals.particles[p].T[d];
     }
-  }
   try {
-    system_->setVolumes(Vu, Ju);
     solution_ = system_->solve(fluid);
   } catch (const fdm::ParticleVelocitySystem::Error &e) {
     fail(systemProblem(e, integrals.step, integrals.iteration));
@@ -550,22 +560,19 @@ void FixFdmCouple::solveVelocities(const cpl::Integrals &integrals)
   solverIterations_ = std::max(solverIterations_, iterations);
 }
 
-cpl::Integrals FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &particles) const
+cpl::Volumes FixFdmCouple::noFluidVolumes(const std::vector<Particle> &particles) const
 {
-  // transport none: "integrals" of an isolated sphere in a fluid at rest, so that Eq. (31) reads
+  // transport none: "volumes" of an isolated sphere in a fluid at rest, so that Eq. (31) reads
   // [diag(6 pi eta a, 8 pi eta a^3) + R^SG] u = F^c + F^ext + buoyant weight
   const double pi = 3.14159265358979323846;
   const double eta = session_.viscosity(), alpha = session_.alphaLambda(), rho = session_.rhoFluid();
-  cpl::Integrals m;
+  cpl::Volumes m;
   m.step = update->ntimestep;
-  m.iteration = 1;
   m.particles.resize(natoms_);
   for (int p = 0; p < natoms_; p++) {
     const double a = particles[p].radius;
-    cpl::ParticleIntegrals &in = m.particles[p];
-    in.Vu = 6 * pi * eta * a * alpha / rho;
-    in.Ju = 8 * pi * eta * a * a * a * alpha / rho;
-    for (int d = 0; d < 3; d++) in.fluid.F[d] = in.fluid.T[d] = 0.0;
+    m.particles[p].Vu = 6 * pi * eta * a * alpha / rho;
+    m.particles[p].Ju = 8 * pi * eta * a * a * a * alpha / rho;
   }
   return m;
 }
@@ -617,7 +624,12 @@ void FixFdmCouple::final_integrate()
 
   if (comm->me == 0 && !hasFluid_) {
     t0 = MPI_Wtime();
-    solveVelocities(noFluidIntegrals(particles));
+    setVolumes(noFluidVolumes(particles));
+    cpl::Integrals atRest;  // no fluid: no fluid force
+    atRest.step = update->ntimestep;
+    atRest.iteration = 1;
+    atRest.particles.assign(natoms_, cpl::ForceTorque());
+    solveVelocities(atRest);
     for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
       hydro_[k] = -system_->diagonal(k) * solution_[k];
     subgridResults(particles);
@@ -627,19 +639,34 @@ void FixFdmCouple::final_integrate()
     cpl::Transport *connection = session_.transport();
     if (!connection) fail("the connection to the fluid solver is closed");
     const bigint step = update->ntimestep;
+    // the next message of this step from the fluid, of the expected type
+    auto receive = [&](bool volumes) {
+      const cpl::Message m = connection->receive();
+      const bool expected = volumes ? m.type == cpl::MessageType::Volumes :
+                            m.type == cpl::MessageType::Integrals || m.type == cpl::MessageType::StepDone;
+      if (!expected)
+        fail(std::string("coupling: expected ") + (volumes ? "Volumes" : "Integrals or StepDone") +
+             " from the fluid solver, got " + cpl::messageTypeName(m.type) + " (step " +
+             std::to_string((long long) step) + ")");
+      if (m.step != uint64_t(step))
+        fail(std::string("coupling: the fluid solver sent ") + cpl::messageTypeName(m.type) + " of step " +
+             std::to_string(m.step) + " during step " + std::to_string((long long) step));
+      return m;
+    };
     try {
       t0 = MPI_Wtime();
       connection->send(makeStep(particles).toMessage());
+      // Protocol 3: Vu and Ju once per step, before the first Integrals
+      const cpl::Message volumes = receive(true);
+      double t1 = MPI_Wtime();
+      run_.exchange += t1 - t0;
+      setVolumes(cpl::Volumes::fromMessage(volumes, natoms_));
+      t0 = MPI_Wtime();
+      run_.solve += t0 - t1;
       while (true) {
-        const cpl::Message m = connection->receive();
-        double t1 = MPI_Wtime();
+        const cpl::Message m = receive(false);
+        t1 = MPI_Wtime();
         run_.exchange += t1 - t0;
-        if (m.type != cpl::MessageType::Integrals && m.type != cpl::MessageType::StepDone)
-          fail(std::string("coupling: expected Integrals or StepDone from the fluid solver, got ") +
-               cpl::messageTypeName(m.type) + " (step " + std::to_string((long long) step) + ")");
-        if (m.step != uint64_t(step))
-          fail(std::string("coupling: the fluid solver sent ") + cpl::messageTypeName(m.type) + " of step " +
-               std::to_string(m.step) + " during step " + std::to_string((long long) step));
         if (m.type == cpl::MessageType::StepDone) {
           storeStepDone(cpl::StepDone::fromMessage(m, stresslets_, natoms_));
           subgridResults(particles);

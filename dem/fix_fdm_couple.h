@@ -70,10 +70,11 @@ class FixFdmCouple : public Fix {
   std::string findOverlap(const std::vector<Particle> &particles) const;
   fdm::coupler::Step makeStep(const std::vector<Particle> &particles) const;
   void assembleSystem(const std::vector<Particle> &particles);
+  void setVolumes(const fdm::coupler::Volumes &volumes);
   void solveVelocities(const fdm::coupler::Integrals &integrals);
   std::string systemProblem(const fdm::ParticleVelocitySystem::Error &e, uint64_t step, uint32_t iteration) const;
   void subgridResults(const std::vector<Particle> &particles);
-  fdm::coupler::Integrals noFluidIntegrals(const std::vector<Particle> &particles) const;
+  fdm::coupler::Volumes noFluidVolumes(const std::vector<Particle> &particles) const;
   void storeStepDone(const fdm::coupler::StepDone &done);
   void planNextMove(const std::vector<Particle> &particles);
   void scatter();

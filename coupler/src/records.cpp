@@ -252,16 +252,36 @@ Step Step::fromMessage(const Message& m, long expectedCount)
     return s;
 }
 
+Message Volumes::toMessage() const
+{
+    using namespace layout;
+    Message m = makeMessage(MessageType::Volumes, step, 0, uint32_t(particles.size()), volumesWidth);
+    for (size_t p = 0; p < particles.size(); ++p) {
+        m.data[p * volumesWidth + volVu] = particles[p].Vu;
+        m.data[p * volumesWidth + volJu] = particles[p].Ju;
+    }
+    return m;
+}
+
+Volumes Volumes::fromMessage(const Message& m, long expectedCount)
+{
+    using namespace layout;
+    expectShape(m, MessageType::Volumes, "Volumes", volumesWidth, expectedCount, " (step " + std::to_string(m.step) + ")");
+    Volumes v;
+    v.step = m.step;
+    v.particles.resize(m.count);
+    for (size_t p = 0; p < v.particles.size(); ++p) {
+        v.particles[p].Vu = m.data[p * volumesWidth + volVu];
+        v.particles[p].Ju = m.data[p * volumesWidth + volJu];
+    }
+    return v;
+}
+
 Message Integrals::toMessage() const
 {
     using namespace layout;
     Message m = makeMessage(MessageType::Integrals, step, iteration, uint32_t(particles.size()), integralsWidth);
-    for (size_t p = 0; p < particles.size(); ++p) {
-        double* r = &m.data[p * integralsWidth];
-        r[iVu] = particles[p].Vu;
-        r[iJu] = particles[p].Ju;
-        putForce(r, particles[p].fluid, iFx, iTx);
-    }
+    for (size_t p = 0; p < particles.size(); ++p) putForce(&m.data[p * integralsWidth], particles[p], iFx, iTx);
     return m;
 }
 
@@ -273,12 +293,7 @@ Integrals Integrals::fromMessage(const Message& m, long expectedCount)
     in.step = m.step;
     in.iteration = m.iteration;
     in.particles.resize(m.count);
-    for (size_t p = 0; p < in.particles.size(); ++p) {
-        const double* r = &m.data[p * integralsWidth];
-        in.particles[p].Vu = r[iVu];
-        in.particles[p].Ju = r[iJu];
-        in.particles[p].fluid = getForce(r, iFx, iTx);
-    }
+    for (size_t p = 0; p < in.particles.size(); ++p) in.particles[p] = getForce(&m.data[p * integralsWidth], iFx, iTx);
     return in;
 }
 

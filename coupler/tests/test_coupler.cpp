@@ -145,9 +145,12 @@ TEST(Message, TextValues)
     expectCouplerError([&] { bad.textNumber("dt"); }, {"dt=abc", "not a number"});
 }
 
-TEST(Message, LayoutOfProtocol2)
+TEST(Message, LayoutOfProtocol3)
 {
-    EXPECT_EQ(protocolVersion, 2);
+    EXPECT_EQ(protocolVersion, 3);
+    EXPECT_EQ(layout::volumesWidth, 2);  // protocol 3: Vu, Ju once per step ...
+    EXPECT_EQ(layout::integralsWidth, 6);  // ... F, T every inner iteration
+    EXPECT_EQ(uint16_t(MessageType::Volumes), 8);
     EXPECT_EQ(layout::helloDemWidth, 10u);
     EXPECT_EQ(layout::helloFluidWidth, 38u);
     EXPECT_EQ(layout::hfViscosity, 13);
@@ -182,7 +185,7 @@ TEST(Message, FluidHelloOfProtocol2RoundTrips)
     EXPECT_EQ(back.type, MessageType::Hello);
     EXPECT_EQ(back.count, 1u);
     EXPECT_EQ(back.width, 38u);
-    EXPECT_EQ(back.textNumber("version"), 2);
+    EXPECT_EQ(back.textNumber("version"), protocolVersion);
     EXPECT_EQ(back.data, m.data);
     EXPECT_EQ(back.at(0, 2), 1000);                      // the first 13 fields unchanged
     EXPECT_EQ(back.at(0, 12), 1);
@@ -411,18 +414,39 @@ TEST(TypedMessages, StepRoundTrips)
     EXPECT_EQ(Step::fromMessage(overTheWire(s)).dt, 0.3333333333);
 }
 
+TEST(TypedMessages, VolumesRoundTrip)
+{
+    Volumes v;
+    v.step = 7;
+    for (int p = 0; p < 3; ++p) {
+        ParticleVolume q;
+        q.Vu = value(2 * p);
+        q.Ju = value(2 * p + 1);
+        v.particles.push_back(q);
+    }
+    const Message m = overTheWire(v);
+    EXPECT_EQ(m.type, MessageType::Volumes);
+    EXPECT_EQ(m.width, uint32_t(layout::volumesWidth));
+    EXPECT_EQ(m.at(2, layout::volJu), value(5));
+    const Volumes b = Volumes::fromMessage(m, 3);
+    EXPECT_EQ(b.step, 7u);
+    for (int p = 0; p < 3; ++p) {
+        EXPECT_EQ(b.particles[p].Vu, v.particles[p].Vu);
+        EXPECT_EQ(b.particles[p].Ju, v.particles[p].Ju);
+    }
+    expectCouplerError([&] { Volumes::fromMessage(m, 4); }, {"Volumes (step 7)", "3 records of 2 values", "4 records of 2"});
+}
+
 TEST(TypedMessages, IntegralsRoundTrip)
 {
     Integrals in;
     in.step = 7;
     in.iteration = 3;
     for (int p = 0; p < 2; ++p) {
-        ParticleIntegrals q;
-        q.Vu = value(p);
-        q.Ju = value(p + 1);
+        ForceTorque q;
         for (int d = 0; d < 3; ++d) {
-            q.fluid.F[d] = value(10 * p + d);
-            q.fluid.T[d] = value(10 * p + 3 + d);
+            q.F[d] = value(10 * p + d);
+            q.T[d] = value(10 * p + 3 + d);
         }
         in.particles.push_back(q);
     }
@@ -432,14 +456,11 @@ TEST(TypedMessages, IntegralsRoundTrip)
     const Integrals b = Integrals::fromMessage(m, 2);
     EXPECT_EQ(b.step, 7u);
     EXPECT_EQ(b.iteration, 3u);
-    for (int p = 0; p < 2; ++p) {
-        EXPECT_EQ(b.particles[p].Vu, in.particles[p].Vu);
-        EXPECT_EQ(b.particles[p].Ju, in.particles[p].Ju);
+    for (int p = 0; p < 2; ++p)
         for (int d = 0; d < 3; ++d) {
-            EXPECT_EQ(b.particles[p].fluid.F[d], in.particles[p].fluid.F[d]);
-            EXPECT_EQ(b.particles[p].fluid.T[d], in.particles[p].fluid.T[d]);
+            EXPECT_EQ(b.particles[p].F[d], in.particles[p].F[d]);
+            EXPECT_EQ(b.particles[p].T[d], in.particles[p].T[d]);
         }
-    }
 }
 
 TEST(TypedMessages, VelocitiesRoundTrip)
@@ -533,10 +554,10 @@ TEST(TypedMessages, FinishAndErrorRoundTrip)
 
 TEST(TypedMessages, MalformedSizesAreRefusedNamingTheMessageAndTheSizes)
 {
-    // width: an Integrals record of 5 values
-    Message m = makeMessage(MessageType::Integrals, 4, 2, 3, 5);
+    // width: an Integrals record of 8 values (protocol 2's)
+    Message m = makeMessage(MessageType::Integrals, 4, 2, 3, 8);
     expectCouplerError([&] { Integrals::fromMessage(m); },
-                       {"Integrals (step 4, iteration 2)", "3 records of 5 values",
+                       {"Integrals (step 4, iteration 2)", "3 records of 8 values",
                         "of " + std::to_string(layout::integralsWidth) + " were expected"});
     // count: 2 particles where 3 were announced
     m = makeMessage(MessageType::Velocities, 4, 2, 2, layout::velocitiesWidth);
@@ -569,10 +590,12 @@ TEST(Socket, PingPongOfAWholeTimeStep)
 {
     SocketPair pair;
     EXPECT_NE(pair.dem->describe().find("socket 127.0.0.1:"), std::string::npos);
-    pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=2 stresslets=1"));
-    EXPECT_EQ(pair.fluid->receive(MessageType::Hello).text, "role=dem version=2 stresslets=1");
+    pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=3 stresslets=1"));
+    EXPECT_EQ(pair.fluid->receive(MessageType::Hello).text, "role=dem version=3 stresslets=1");
     pair.dem->send(makeMessage(MessageType::Step, 1, 0, 2, layout::stepWidth));
     EXPECT_EQ(pair.fluid->receive(MessageType::Step).step, 1u);
+    pair.fluid->send(makeMessage(MessageType::Volumes, 1, 0, 2, layout::volumesWidth));
+    EXPECT_EQ(pair.dem->receive(MessageType::Volumes).width, uint32_t(layout::volumesWidth));
     for (uint32_t k = 1; k <= 5; ++k) {
         pair.fluid->send(sample(1, k));
         const Message in = pair.dem->receive(MessageType::Integrals);
@@ -965,8 +988,10 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     std::remove(record.c_str());
     {
         SocketPair pair(Options(), record);
-        pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=2 stresslets=1"));
+        pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=3 stresslets=1"));
         pair.fluid->receive();
+        pair.fluid->send(makeMessage(MessageType::Volumes, 12, 0, 2, layout::volumesWidth));
+        pair.dem->receive();
         pair.fluid->send(sample(12, 3));
         pair.dem->receive();
     }
@@ -980,7 +1005,8 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     EXPECT_NE(out.find("dem -> fluid Hello"), std::string::npos) << out;
     EXPECT_NE(out.find("fluid -> dem   Integrals  step 12 iteration 3"), std::string::npos) << out;
     EXPECT_NE(out.find("0.75"), std::string::npos) << out;  // 1/1 - 0.25, first value
-    EXPECT_NE(out.find("2 messages"), std::string::npos) << out;
+    EXPECT_NE(out.find("fluid -> dem   Volumes    step 12 iteration 0  2 x 2"), std::string::npos) << out;
+    EXPECT_NE(out.find("3 messages"), std::string::npos) << out;
 
     {
         std::ofstream f(record.c_str(), std::ios::app | std::ios::binary);
@@ -990,5 +1016,5 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     out.clear();
     while (std::fgets(buf, sizeof buf, p)) out += buf;
     EXPECT_NE(0, WEXITSTATUS(pclose(p)));
-    EXPECT_NE(out.find("(message 3): truncated"), std::string::npos) << out;
+    EXPECT_NE(out.find("(message 4): truncated"), std::string::npos) << out;
 }

@@ -1,6 +1,6 @@
 // The test harness of the particle side: writes a LIGGGHTS input, runs the real fdmDEM (serial or
 // mpirun) as a child process, and plays the fluid solver's part of the coupling protocol with
-// scripted integrals (a harness for the particle side, not a fluid solver).
+// scripted volumes and integrals (a harness for the particle side, not a fluid solver).
 #ifndef FDM_DEM_TEST_HARNESS_H
 #define FDM_DEM_TEST_HARNESS_H
 
@@ -114,7 +114,7 @@ DemRun runDEM(const std::string& dir, int ranks = 1)
 // ---- the scripted fluid peer ------------------------------------------------------------------------
 
 struct FakeFluid {
-    enum Mode { Normal, DieAfterStep, ErrorAfterStep, WrongTypeAfterStep, ZeroVolume, NaNIntegral };
+    enum Mode { Normal, DieAfterStep, ErrorAfterStep, WrongTypeAfterStep, ZeroVolume, NaNIntegral, ShortVolumes };
     Mode mode = Normal;
     cpl::Options options;
     long nExpected = -1;
@@ -129,7 +129,8 @@ struct FakeFluid {
     // what happened
     cpl::DemHello demHello;
     std::vector<cpl::Step> steps;
-    std::vector<cpl::Integrals> integrals;
+    std::vector<cpl::Volumes> volumes;       // one per step
+    std::vector<cpl::Integrals> integrals;   // one per inner iteration
     std::vector<cpl::Velocities> velocities;
     std::vector<cpl::StepDone> stepDones;
     bool finished = false;
@@ -160,27 +161,43 @@ struct FakeFluid {
     }
     void join() { thread.join(); }
 
-    // Deterministic, particle- and iteration-dependent integrals (all SI).
+    // Deterministic, particle- and step-dependent volumes and particle- and iteration-dependent
+    // integrals (all SI).
     static double volume(double a) { return 4.0 / 3.0 * pi * a * a * a; }
+    cpl::Volumes makeVolumes(const cpl::Step& step) const
+    {
+        cpl::Volumes m;
+        m.step = step.step;
+        m.particles.resize(step.particles.size());
+        for (size_t p = 0; p < step.particles.size(); ++p) {
+            const double a = step.particles[p].radius;
+            m.particles[p].Vu = volume(a) * (1.0 + 0.01 * double(step.step));
+            m.particles[p].Ju = 0.4 * a * a * m.particles[p].Vu;
+        }
+        if (mode == ZeroVolume) m.particles[1].Vu = 0.0;
+        if (mode == ShortVolumes) m.particles.pop_back();
+        return m;
+    }
     cpl::Integrals makeIntegrals(const cpl::Step& step, uint32_t k) const
     {
         cpl::Integrals m;
         m.step = step.step;
         m.iteration = k;
         m.particles.resize(step.particles.size());
-        for (size_t p = 0; p < step.particles.size(); ++p) {
-            const double a = step.particles[p].radius;
-            cpl::ParticleIntegrals& in = m.particles[p];
-            in.Vu = volume(a) * (1.0 + 0.01 * k);
-            in.Ju = 0.4 * a * a * in.Vu;
+        for (size_t p = 0; p < step.particles.size(); ++p)
             for (int d = 0; d < 3; ++d) {
-                in.fluid.F[d] = 0.1 * (p + 1) * (d + 1) * k - 0.3 + 0.01 * double(step.step);
-                in.fluid.T[d] = 0.02 * (p + 2) * (3 - d) - 0.05 * k;
+                m.particles[p].F[d] = 0.1 * (p + 1) * (d + 1) * k - 0.3 + 0.01 * double(step.step);
+                m.particles[p].T[d] = 0.02 * (p + 2) * (3 - d) - 0.05 * k;
             }
-        }
-        if (mode == ZeroVolume && k == 2) m.particles[1].Vu = 0.0;
-        if (mode == NaNIntegral && k == 2) m.particles[2].fluid.F[1] = std::nan("");
+        if (mode == NaNIntegral && k == 2) m.particles[2].F[1] = std::nan("");
         return m;
+    }
+    // The Volumes of the step an Integrals or Velocities message belongs to.
+    const cpl::ParticleVolume& volumeOf(uint64_t step, size_t particle) const
+    {
+        for (const cpl::Volumes& v : volumes)
+            if (v.step == step) return v.particles.at(particle);
+        throw std::runtime_error("harness: no Volumes of step " + std::to_string(step));
     }
     static double hydro(uint32_t p, int c, uint64_t step) { return 10.0 * (p + 1) + c + 0.5 * double(step); }
 
@@ -220,6 +237,12 @@ struct FakeFluid {
             }
             if (mode == WrongTypeAfterStep) {
                 t->send(cpl::makeMessage(cpl::MessageType::Velocities, step.step, 1, m.count, 6));
+                t->receive();  // the DEM's Error
+                return;
+            }
+            volumes.push_back(makeVolumes(step));  // protocol 3: once per step, before the first Integrals
+            t->send(volumes.back().toMessage());
+            if (mode == ShortVolumes) {
                 t->receive();  // the DEM's Error
                 return;
             }

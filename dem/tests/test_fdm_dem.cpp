@@ -47,11 +47,12 @@ void expectAnalyticVelocities(const FakeFluid& fluid, const Scene& scene, const 
             const Sphere& s = scene.spheres[p];
             const double mass = s.density * FakeFluid::volume(s.radius);
             const double buoyant = (s.density - fluid.rhoFluid) / s.density * mass;
-            const cpl::ParticleIntegrals& q = in.particles[p];
+            const cpl::ForceTorque& q = in.particles[p];
+            const cpl::ParticleVolume& v = fluid.volumeOf(in.step, p);
             const cpl::RigidVelocity& u = out.particles[p];
             for (int d = 0; d < 3; ++d) {
-                const double U = fluid.alphaLambda * (q.fluid.F[d] + buoyant * g[d] + fext[d]) / (fluid.rhoFluid * q.Vu);
-                const double W = fluid.alphaLambda * q.fluid.T[d] / (fluid.rhoFluid * q.Ju);
+                const double U = fluid.alphaLambda * (q.F[d] + buoyant * g[d] + fext[d]) / (fluid.rhoFluid * v.Vu);
+                const double W = fluid.alphaLambda * q.T[d] / (fluid.rhoFluid * v.Ju);
                 EXPECT_LT(relativeDifference(u.U[d], U), 1e-12)
                     << "particle " << p + 1 << " U" << "xyz"[d] << " step " << out.step << " iteration " << out.iteration
                     << ": " << u.U[d] << " vs " << U;
@@ -98,6 +99,7 @@ TEST(FdmDEM, VelocitiesAreTheAnalyticSolutionOfEq31)
     const double g[3] = {0, 0, -9.81}, fext[3] = {0.5, -0.25, 0.125};
     expectAnalyticVelocities(fluid, scene, g, fext);
     ASSERT_EQ(fluid.steps.size(), 2u);
+    EXPECT_EQ(fluid.volumes.size(), 2u);     // once per step
     EXPECT_EQ(fluid.velocities.size(), 6u);  // 2 steps x 3 inner iterations
 
     // Hello: N, box, periodicity, dt
@@ -189,12 +191,13 @@ TEST(FdmDEM, FileTransportAndRecordGiveTheSameRun)
     ASSERT_EQ(run.status, 0) << run.output;
     const double g[3] = {0, 0, -9.81}, fext[3] = {0.5, -0.25, 0.125};
     expectAnalyticVelocities(fluid, scene, g, fext);
-    // the record holds the whole conversation: 2 Hello, 2 Step, 6 Integrals, 6 Velocities, 2 StepDone, Finish
+    // the record holds the whole conversation: 2 Hello, 2 Step, 2 Volumes, 6 Integrals, 6 Velocities,
+    // 2 StepDone, Finish
     std::ifstream in((dir + "/coupling.record").c_str(), std::ios::binary);
     std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     size_t at = 0, n = 0;
     while (at + cpl::headerSize <= b.size()) { at += cpl::encodedSize(&b[at]); ++n; }
-    EXPECT_EQ(n, 19u);
+    EXPECT_EQ(n, 21u);
 }
 
 // ---- bad input: a clear error naming the particle or value, a non-zero exit, within seconds ----------
@@ -334,7 +337,7 @@ TEST(FdmDEMErrors, FluidSendsAnUnexpectedMessage)
 {
     Scene scene;
     expectFailure("wrongType", scene, [](FakeFluid& f) { f.mode = FakeFluid::WrongTypeAfterStep; },
-                  "expected Integrals or StepDone from the fluid solver, got Velocities (step 1)");
+                  "expected Volumes from the fluid solver, got Velocities (step 1)");
 }
 
 TEST(FdmDEMErrors, FluidSendsGarbage)
@@ -357,6 +360,13 @@ TEST(FdmDEMErrors, ParticleWithNoFluidVolume)
     Scene scene;
     expectFailure("zeroVolume", scene, [](FakeFluid& f) { f.mode = FakeFluid::ZeroVolume; },
                   "particle 2 at (6, 5, 3.5) with radius 0.7: the fluid's indicator function gives it no volume (Vu 0");
+}
+
+TEST(FdmDEMErrors, VolumesOfTheWrongSize)
+{
+    Scene scene;
+    expectFailure("shortVolumes", scene, [](FakeFluid& f) { f.mode = FakeFluid::ShortVolumes; },
+                  "Volumes (step 1) has 2 records of 2 values (4 in all) where 3 records of 2 were expected");
 }
 
 TEST(FdmDEMErrors, NonFiniteIntegral)

@@ -70,10 +70,10 @@ void expectSolution(const FakeFluid& fluid, const Scene& scene, const Expected& 
         Eigen::VectorXd F = e.wallRhs;
         for (int p = 0; p < n; ++p)
             for (int d = 0; d < 3; ++d) {
-                A(6 * p + d, 6 * p + d) += fluid.rhoFluid * in.particles[p].Vu / fluid.alphaLambda;
-                A(6 * p + 3 + d, 6 * p + 3 + d) += fluid.rhoFluid * in.particles[p].Ju / fluid.alphaLambda;
-                F(6 * p + d) += in.particles[p].fluid.F[d];
-                F(6 * p + 3 + d) += in.particles[p].fluid.T[d];
+                A(6 * p + d, 6 * p + d) += fluid.rhoFluid * fluid.volumeOf(in.step, p).Vu / fluid.alphaLambda;
+                A(6 * p + 3 + d, 6 * p + 3 + d) += fluid.rhoFluid * fluid.volumeOf(in.step, p).Ju / fluid.alphaLambda;
+                F(6 * p + d) += in.particles[p].F[d];
+                F(6 * p + 3 + d) += in.particles[p].T[d];
             }
         const Eigen::VectorXd u = A.ldlt().solve(F);
         const std::vector<double> got = flat(out);
@@ -304,8 +304,8 @@ TEST(PairFdmSubgrid, ContactForcesAreEqualOppositeAndEnterEq31)
     const cpl::Velocities& out = fluid.velocities.back();
     for (int p = 0; p < 2; ++p)
         for (int d = 0; d < 3; ++d) {
-            const double U = fluid.alphaLambda * (in.particles[p].fluid.F[d] + rows[p][1 + d]) /
-                             (fluid.rhoFluid * in.particles[p].Vu);
+            const double U = fluid.alphaLambda * (in.particles[p].F[d] + rows[p][1 + d]) /
+                             (fluid.rhoFluid * fluid.volumeOf(in.step, p).Vu);
             EXPECT_NEAR(out.particles[p].U[d], U, 1e-10 * std::fabs(U) + 1e-14);
         }
     // contact stresslet, Eq. (52): S^c_p = 1/2 a_p/(a_1+a_2) (F ⊗ x + x ⊗ F), x = x_p' - x_p

@@ -20,11 +20,14 @@ namespace coupler {
 // version is refused at the handshake with both versions in the message.
 // 2: fluid Hello gains the viscosity and the box faces' boundaries; DEM Hello asks for
 //    stresslets; StepDone may carry them (for the sub-grid lubrication pair style).
-const uint16_t protocolVersion = 2;
+// 3: Vu and Ju (they depend only on the positions) go once per time step in the new Volumes
+//    message, before the first Integrals; Integrals keep F and T only (6 values per particle).
+const uint16_t protocolVersion = 3;
 
 enum class MessageType : uint16_t {
     Hello      = 1,  // handshake, once per connection, each side sends one
     Step       = 2,  // DEM -> fluid: particle positions/radii/velocities, once per time step
+    Volumes    = 8,  // fluid -> DEM: Vu, Ju of every particle, once per time step (protocol 3)
     Integrals  = 3,  // fluid -> DEM: per-particle integrals of Eq. (38), every inner iteration
     Velocities = 4,  // DEM -> fluid: rigid velocities (U_p, Omega_p), every inner iteration
     StepDone   = 5,  // fluid -> DEM: inner iterations converged, hydrodynamic force/torque
@@ -103,12 +106,16 @@ namespace layout {
     // Step: one record per particle, ordered by tag (tags 1..N). text: "dt=<s> lastStep=<n>"
     enum StepField { sTag, sX, sY, sZ, sRadius, sUx, sUy, sUz, sWx, sWy, sWz, stepWidth };
 
-    // Integrals: one record per particle (same order as Step), all in SI units:
+    // Volumes: once per time step, after Step and before the first Integrals; one record per
+    // particle (same order as Step), from the fluid's indicator function I_u:
     //   Vu = int I_u dV                               -> (rho_f/rho_p) M_p = rho_f Vu
     //   Ju = int I_u (2/3)|x-x_p|^2 dV                -> (rho_f/rho_p) J_p = rho_f Ju
+    enum VolumeField { volVu, volJu, volumesWidth };
+
+    // Integrals: every inner iteration, one record per particle, all in SI units:
     //   F  = rho_f int (I_u u*/alpha - I_lambda lambda^n) dV               (Eq. 32)
     //   T  = rho_f int (x-x_p) x (I_u u*/alpha - I_lambda lambda^n) dV     (Eq. 32)
-    enum IntegralField { iVu, iJu, iFx, iFy, iFz, iTx, iTy, iTz, integralsWidth };
+    enum IntegralField { iFx, iFy, iFz, iTx, iTy, iTz, integralsWidth };
 
     // Velocities: one record per particle: [Ux, Uy, Uz, Wx, Wy, Wz]
     enum VelocityField { vUx, vUy, vUz, vWx, vWy, vWz, velocitiesWidth };
@@ -208,15 +215,23 @@ struct Step {
     static Step fromMessage(const Message& m, long expectedCount = -1);
 };
 
-// Integrals of inner iteration `iteration` (Eqs. 32, 38): Vu, Ju and the fluid part of F^tot.
-struct ParticleIntegrals {
+// Volumes of the time step `step` (they depend only on the positions): Eq. (31)'s diagonal.
+struct ParticleVolume {
     double Vu, Ju;
-    ForceTorque fluid;
 };
+struct Volumes {
+    uint64_t step = 0;
+    std::vector<ParticleVolume> particles;
+
+    Message toMessage() const;
+    static Volumes fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// Integrals of inner iteration `iteration`: the fluid part of F^tot (Eqs. 32, 38).
 struct Integrals {
     uint64_t step = 0;
     uint32_t iteration = 0;
-    std::vector<ParticleIntegrals> particles;
+    std::vector<ForceTorque> particles;
 
     Message toMessage() const;
     static Integrals fromMessage(const Message& m, long expectedCount = -1);

@@ -31,7 +31,8 @@ Foam::fluidCoupling::fluidCoupling(const Time& runTime, const dictionary& dict)
     lastStep_(-1),
     dt_(0),
     nParticles_(0),
-    stresslets_(false)
+    stresslets_(false),
+    volumesSent_(false)
 {
     if (!Pstream::master())
     {
@@ -449,6 +450,7 @@ bool Foam::fluidCoupling::receiveStep(List<fdmParticle>& particles)
     }
 
     const cpl::Step step = cpl::Step::fromMessage(m, nParticles_);
+    volumesSent_ = false;
     step_ = label(step.step);
     dt_ = step.dt;
     lastStep_ = label(step.lastStep);
@@ -497,22 +499,36 @@ void Foam::fluidCoupling::sendIntegrals
     {
         return;
     }
-    // particleForcing::integrals: per particle [Vu, Ju, F(3), T(3)]
-    const label width = 8;
+    // particleForcing::integrals: per particle the Volumes record, then the
+    // Integrals record
+    namespace layout = cpl::layout;
+    const label nv = layout::volumesWidth;
+    const label width = nv + layout::integralsWidth;
+    const label n = integrals.size()/width;
+    if (!volumesSent_)
+    {
+        cpl::Volumes volumes;
+        volumes.step = step_;
+        volumes.particles.resize(n);
+        for (label p = 0; p < n; ++p)
+        {
+            volumes.particles[p].Vu = integrals[width*p + layout::volVu];
+            volumes.particles[p].Ju = integrals[width*p + layout::volJu];
+        }
+        send(volumes.toMessage());
+        volumesSent_ = true;
+    }
     cpl::Integrals m;
     m.step = step_;
     m.iteration = iteration;
-    m.particles.resize(integrals.size()/width);
-    for (size_t p = 0; p < m.particles.size(); ++p)
+    m.particles.resize(n);
+    for (label p = 0; p < n; ++p)
     {
-        const scalar* rec = &integrals[width*p];
-        cpl::ParticleIntegrals& q = m.particles[p];
-        q.Vu = rec[0];
-        q.Ju = rec[1];
+        const scalar* rec = &integrals[width*p + nv];
         for (direction d = 0; d < 3; ++d)
         {
-            q.fluid.F[d] = rec[2 + d];
-            q.fluid.T[d] = rec[5 + d];
+            m.particles[p].F[d] = rec[layout::iFx + d];
+            m.particles[p].T[d] = rec[layout::iTx + d];
         }
     }
     send(m.toMessage());
