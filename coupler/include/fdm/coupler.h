@@ -1,7 +1,8 @@
 // fdm/coupler.h -- the thin library that the fluid solver (fdmFoam) and the particle code
-// (fdmDEM, LIGGGHTS) both link. A versioned message format and two transports (TCP socket
-// between the two master ranks, or a shared directory of message files for debugging and
-// replay). Nothing else: no physics, no MPI. See docs/coupling.md for the protocol.
+// (fdmDEM, LIGGGHTS) both link. A versioned message format, one typed struct per message that
+// packs and unpacks its records, and two transports (TCP socket between the two master ranks, or
+// a shared directory of message files for debugging and replay). Nothing else: no physics, no
+// MPI. See docs/coupling.md for the protocol.
 //
 // Must stay C++11: OpenFOAM v1912 code includes it.
 #ifndef FDM_COUPLER_H
