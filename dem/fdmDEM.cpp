@@ -2,6 +2,7 @@
 //   fdmDEM -in input [-var name value ...] [-echo screen] [other LIGGGHTS options]   (serial or mpirun)
 // The styles are added to LIGGGHTS's style maps before the input is read, so no LIGGGHTS rebuild
 // is needed (docs/dem.md). After the input script, the fluid solver is told to finish.
+#include "coupling_session.h"
 #include "fix_contact_history_fdm.h"
 #include "fix_fdm_couple.h"
 #include "pair_fdm_subgrid.h"
@@ -54,7 +55,7 @@ int main(int argc, char **argv)
   // LIGGGHTS's contact history, made to serve pair fdm/subgrid too (Neighbor finds it by this name)
   fdm::registerFix<LAMMPS_NS::FixContactHistoryFdm>(lmp, "contacthistory");
   lmp->input->file();
-  LAMMPS_NS::FixFdmCouple::finishAll(lmp);
+  LAMMPS_NS::CouplingSession::instance().finishAll(lmp);
   delete lmp;
   MPI_Finalize();
   return 0;

@@ -2,6 +2,7 @@
 // See fix_fdm_couple.h for what it does and docs/dem.md for its use.
 #include "fix_fdm_couple.h"
 
+#include "coupling_session.h"
 #include "pair_fdm_subgrid.h"
 
 #include "atom.h"
@@ -13,10 +14,6 @@
 #include "modify.h"
 #include "update.h"
 
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -26,18 +23,6 @@
 
 using namespace LAMMPS_NS;
 namespace cpl = fdm::coupler;
-
-std::unique_ptr<cpl::Transport> FixFdmCouple::connection_;
-bool FixFdmCouple::connected_ = false;
-int FixFdmCouple::sessionParticles_ = 0;
-double FixFdmCouple::alphaLambda_ = 0.0;
-double FixFdmCouple::rhoFluid_ = 0.0;
-double FixFdmCouple::delta_ = 0.0;
-double FixFdmCouple::viscosity_ = 0.0;
-double FixFdmCouple::fluidFaces_[6][4] = {{0}};
-FixFdmCouple::Timing FixFdmCouple::total_;
-int FixFdmCouple::runs_ = 0;
-double FixFdmCouple::sessionStart_ = 0.0;
 
 namespace {
 
@@ -55,45 +40,10 @@ std::string fmt(double x)
 std::string point(const double *x) { return "(" + fmt(x[0]) + ", " + fmt(x[1]) + ", " + fmt(x[2]) + ")"; }
 std::string tagName(int index) { return std::to_string(index + 1); }
 
-// If LIGGGHTS stops on an error (error->all exits), tell the fluid solver why it lost its peer
-// rather than leave it to guess from a closed socket.
-void tellPeerWeStopped();
-
 }  // namespace
 
-void FixFdmCouple::Timing::add(const Timing &t)
-{
-  solve += t.solve;
-  exchange += t.exchange;
-  gatherScatter += t.gatherScatter;
-  steps += t.steps;
-  solves += t.solves;
-  solverIterations += t.solverIterations;
-  solverIterationsMax = std::max(solverIterationsMax, t.solverIterationsMax);
-  gapTargets += t.gapTargets;
-  gapLimited += t.gapLimited;
-  gapFallbacks += t.gapFallbacks;
-  gapSweepsMax = std::max(gapSweepsMax, t.gapSweepsMax);
-}
-
-// Eq. (31) on rank 0 for one time step.
-struct FixFdmCouple::System {
-  Eigen::SparseMatrix<double> matrix;  // (rho_f/rho_p) J/alpha_lambda + R^SG
-  std::vector<int> diagonalIndex;      // position of entry (k, k) in matrix.valuePtr()
-  std::vector<double> subgridDiagonal; // R^SG(k, k)
-  Eigen::VectorXd wallRhs;             // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
-  Eigen::VectorXd diagonal;            // (rho_f/rho_p) J/alpha_lambda of the last inner iteration
-  std::vector<double> pairs, walls;    // the gathered blocks (stress rows used after the step)
-  int pairRecord, wallRecord;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                           Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double> > ldlt;
-  bool analysed;
-  System() : pairRecord(0), wallRecord(0), analysed(false) {}
-};
-
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
-  Fix(lmp, narg, arg), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), noFluidViscosity_(0), noFluidMesh_(0), noFluidDensity_(1000.0), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
+  Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), solverIterationsMax_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0)
@@ -108,7 +58,9 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   size_peratom_cols = 12;
   peratom_freq = 1;
   gravity_[0] = gravity_[1] = gravity_[2] = 0.0;
-  options_.name = "fluid solver fdmFoam";
+  CouplingSession::Request request;
+  cpl::Options &options = request.options;
+  options.name = "fluid solver fdmFoam";
 
   for (int i = 3; i < narg; i++) {
     const std::string key = arg[i];
@@ -117,17 +69,17 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       return arg[i + n];
     };
     if (key == "transport") {
-      options_.transport = value(1);
-      if (options_.transport != "socket" && options_.transport != "file" && options_.transport != "none")
-        error->all(FLERR, ("fix fdm/couple: transport " + options_.transport + " is not socket, file or none").c_str());
+      options.transport = value(1);
+      if (options.transport != "socket" && options.transport != "file" && options.transport != "none")
+        error->all(FLERR, ("fix fdm/couple: transport " + options.transport + " is not socket, file or none").c_str());
       i++;
-    } else if (key == "host") { options_.host = value(1); i++; }
-    else if (key == "port") { options_.port = force->inumeric(FLERR, value(1)); i++; }
-    else if (key == "portfile") { options_.portFile = value(1); i++; }
-    else if (key == "directory") { options_.directory = value(1); i++; }
-    else if (key == "connect_timeout") { options_.connectTimeout = force->numeric(FLERR, value(1)); i++; }
-    else if (key == "timeout") { options_.receiveTimeout = force->numeric(FLERR, value(1)); i++; }
-    else if (key == "record") { options_.recordFile = value(1); i++; }
+    } else if (key == "host") { options.host = value(1); i++; }
+    else if (key == "port") { options.port = force->inumeric(FLERR, value(1)); i++; }
+    else if (key == "portfile") { options.portFile = value(1); i++; }
+    else if (key == "directory") { options.directory = value(1); i++; }
+    else if (key == "connect_timeout") { options.connectTimeout = force->numeric(FLERR, value(1)); i++; }
+    else if (key == "timeout") { options.receiveTimeout = force->numeric(FLERR, value(1)); i++; }
+    else if (key == "record") { options.recordFile = value(1); i++; }
     else if (key == "gravity") {
       for (int d = 0; d < 3; d++) gravity_[d] = force->numeric(FLERR, value(d + 1));
       i += 3;
@@ -137,13 +89,13 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       move_ = (v == "yes");
       i++;
     } else if (key == "viscosity") {
-      noFluidViscosity_ = force->numeric(FLERR, value(1));
+      request.viscosity = force->numeric(FLERR, value(1));
       i++;
     } else if (key == "mesh") {
-      noFluidMesh_ = force->numeric(FLERR, value(1));
+      request.meshSize = force->numeric(FLERR, value(1));
       i++;
     } else if (key == "fluid_density") {
-      noFluidDensity_ = force->numeric(FLERR, value(1));
+      request.fluidDensity = force->numeric(FLERR, value(1));
       i++;
     } else if (key == "integrator") {
       const std::string v = value(1);
@@ -176,21 +128,25 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   }
   perAtomColumns_ = stresslets_ ? 25 : 12;
   size_peratom_cols = perAtomColumns_;
-  if (options_.transport == "none" && (!(noFluidViscosity_ > 0) || !(noFluidMesh_ > 0) || !(noFluidDensity_ > 0)))
+  if (options.transport == "none" && (!(request.viscosity > 0) || !(request.meshSize > 0) || !(request.fluidDensity > 0)))
     error->all(FLERR, "fix fdm/couple transport none (DEM only, no fluid) needs viscosity eta [Pa s] and mesh Delta [m] "
                       "(the sub-grid model's mesh size), both positive; fluid_density (default 1000 kg/m3) too");
-  if (options_.transport == "none" && stresslets_)
+  if (options.transport == "none" && stresslets_)
     error->all(FLERR, "fix fdm/couple: stresslets need the fluid solver (not with transport none)");
-  if (options_.transport == "socket" && (options_.port <= 0 || options_.port > 65535) && options_.portFile.empty())
+  if (options.transport == "socket" && (options.port <= 0 || options.port > 65535) && options.portFile.empty())
     error->all(FLERR, "fix fdm/couple: give the fluid solver's port (port P) or its port file (portfile F)");
-  if (options_.transport == "file" && options_.directory.empty())
+  if (options.transport == "file" && options.directory.empty())
     error->all(FLERR, "fix fdm/couple: transport file needs directory D");
-  if (!(options_.connectTimeout > 0) || !(options_.receiveTimeout > 0))
+  if (!(options.connectTimeout > 0) || !(options.receiveTimeout > 0))
     error->all(FLERR, "fix fdm/couple: connect_timeout and timeout must be positive (seconds)");
+  request.stresslets = stresslets_;
+  hasFluid_ = options.transport != "none";
+  session_.attach(this, request);
 }
 
 FixFdmCouple::~FixFdmCouple()
 {
+  session_.detach(this);
   memory->destroy(perAtom_);
 }
 
@@ -199,24 +155,9 @@ int FixFdmCouple::setmask()
   return FixConst::INITIAL_INTEGRATE | FixConst::FINAL_INTEGRATE;
 }
 
-void FixFdmCouple::checkAtoms()
-{
-  if (!atom->sphere_flag || !atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag ||
-      !atom->density_flag)
-    error->all(FLERR, "fix fdm/couple requires atom_style sphere (radius, mass, density, omega, torque)");
-  if (atom->map_style != 1) error->all(FLERR, "fix fdm/couple requires atom_modify map array");
-  if (!atom->tag_enable) error->all(FLERR, "fix fdm/couple requires atom IDs (tags)");
-  if (atom->natoms > 100000000)
-    error->all(FLERR, "fix fdm/couple: more than 10^8 particles are not supported by the coupling messages");
-  if (atom->natoms > 0 && atom->map_tag_max != atom->natoms)
-    error->all(FLERR, ("fix fdm/couple requires atom IDs 1..N without gaps: there are " +
-                       std::to_string((long long) atom->natoms) + " atoms but the largest ID is " +
-                       std::to_string(atom->map_tag_max) + " (use reset_atom_ids or renumber the data file)").c_str());
-}
-
 void FixFdmCouple::init()
 {
-  checkAtoms();
+  session_.checkAtoms(lmp);
   atomsAtInit_ = int(atom->natoms);
   pair_ = dynamic_cast<PairFdmSubgrid *>(force->pair_match("fdm/subgrid", 1));
   if (pair_) pair_->requestContactStress(stresslets_);
@@ -243,112 +184,15 @@ void FixFdmCouple::init()
 
 void FixFdmCouple::allAgree(const std::string &problemOnRank0)
 {
-  // The problem is known on rank 0 only; every rank must call error->all.
-  int length = int(problemOnRank0.size());
-  MPI_Bcast(&length, 1, MPI_INT, 0, world);
-  if (length == 0) return;
-  std::vector<char> text(problemOnRank0.begin(), problemOnRank0.end());
-  text.resize(size_t(length) + 1, '\0');
-  MPI_Bcast(text.data(), length, MPI_CHAR, 0, world);
-  if (comm->me == 0 && connection_) {
-    connection_->sendError("fdmDEM: " + problemOnRank0);
-    connection_.reset();
-  }
-  error->all(FLERR, (std::string("fdm/couple: ") + text.data()).c_str());
+  // The problem is known on rank 0 only; every rank must stop (and the fluid is told why).
+  session_.stopIf(lmp, problemOnRank0);
 }
 
 void FixFdmCouple::fail(const std::string &message)
 {
   // rank 0, in the middle of a step (the other ranks wait in MPI_Bcast): error->one aborts them all
-  if (connection_) {
-    connection_->sendError("fdmDEM: " + message);
-    connection_.reset();
-  }
+  session_.abandon("fdmDEM: " + message);
   error->one(FLERR, ("fdm/couple: " + message).c_str());
-}
-
-std::string FixFdmCouple::checkFluidHello(const cpl::Message &hello) const
-{
-  using cpl::protocolVersion;
-  if (hello.count != 1 || hello.width < cpl::layout::helloFluidWidth)
-    return "malformed Hello from the fluid solver (" + std::to_string(hello.count) + " records of " +
-           std::to_string(hello.width) + " values)";
-  const long version = std::lround(hello.textNumber("version"));
-  if (version != protocolVersion)
-    return "coupling protocol version mismatch: fdmFoam speaks " + std::to_string(version) + ", fdmDEM speaks " +
-           std::to_string(protocolVersion);
-  const double *r = &hello.data[0];
-  const long long nExpected = std::llround(r[0]);
-  if (nExpected >= 0 && nExpected != natoms_)
-    return "the fluid case expects " + std::to_string(nExpected) + " particles (constant/fdmProperties nParticles) "
-           "but the LIGGGHTS input has " + std::to_string(natoms_);
-  if (!(r[1] > 0) || !(r[2] > 0) || !(r[3] > 0) || !(r[cpl::layout::hfViscosity] > 0))
-    return "the fluid solver sent a non-positive alpha_lambda (" + fmt(r[1]) + " s), rho_f (" + fmt(r[2]) +
-           " kg/m3), mesh size (" + fmt(r[3]) + " m) or viscosity (" + fmt(r[cpl::layout::hfViscosity]) + " Pa s)";
-  const char *axis = "xyz";
-  for (int d = 0; d < 3; d++) {
-    const double lo = r[4 + 2*d], hi = r[5 + 2*d];
-    const double tolerance = 1e-9 * std::max(std::fabs(domain->prd[d]), std::fabs(hi - lo));
-    if (!(std::fabs(lo - domain->boxlo[d]) <= tolerance) || !(std::fabs(hi - domain->boxhi[d]) <= tolerance))
-      return std::string(1, axis[d]) + " extent: LIGGGHTS box " + fmt(domain->boxlo[d]) + " .. " +
-             fmt(domain->boxhi[d]) + " but OpenFOAM mesh " + fmt(lo) + " .. " + fmt(hi);
-    const bool fluidPeriodic = r[10 + d] != 0;
-    if (fluidPeriodic != (domain->periodicity[d] != 0))
-      return std::string(1, axis[d]) + " boundary: LIGGGHTS " + (domain->periodicity[d] ? "periodic (p)" :
-             "not periodic") + " but the OpenFOAM mesh " + (fluidPeriodic ? "has cyclic patches" : "has no cyclic patches") +
-             " in " + axis[d];
-  }
-  return "";
-}
-
-void FixFdmCouple::connectAndHandshake()
-{
-  std::string problem;
-  if (comm->me == 0) {
-    try {
-      if (screen)
-        fprintf(screen, "fdm/couple: connecting to fdmFoam (%s%s)\n", options_.transport.c_str(),
-                options_.transport == "file" ? (" in " + options_.directory).c_str() :
-                (" " + options_.host + (options_.portFile.empty() ? ":" + std::to_string(options_.port) :
-                                        ", port file " + options_.portFile)).c_str());
-      connection_ = cpl::connect(options_);
-      std::atexit(tellPeerWeStopped);
-      cpl::Message hello = cpl::makeMessage(cpl::MessageType::Hello, 0, 0, 1, cpl::layout::helloDemWidth,
-          "role=dem version=" + std::to_string(cpl::protocolVersion) + " dt=" + fmt(update->dt) +
-          " lastStep=" + std::to_string((long long) update->laststep) + " stresslets=" + (stresslets_ ? "1" : "0"));
-      double *r = &hello.data[0];
-      r[0] = natoms_;
-      for (int d = 0; d < 3; d++) {
-        r[1 + 2*d] = domain->boxlo[d];
-        r[2 + 2*d] = domain->boxhi[d];
-        r[7 + d] = domain->periodicity[d];
-      }
-      connection_->send(hello);
-      const cpl::Message reply = connection_->receive(cpl::MessageType::Hello);
-      problem = checkFluidHello(reply);
-      if (problem.empty()) {
-        alphaLambda_ = reply.at(0, 1);
-        rhoFluid_ = reply.at(0, 2);
-        delta_ = reply.at(0, 3);
-        viscosity_ = reply.at(0, cpl::layout::hfViscosity);
-        for (int face = 0; face < 6; face++)
-          for (int c = 0; c < 4; c++) fluidFaces_[face][c] = reply.at(0, cpl::layout::hfFaceBase + cpl::layout::faceWidth * face + c);
-        if (screen)
-          fprintf(screen, "fdm/couple: connected (%s): %d particles, alpha_lambda %g s, rho_f %g kg/m3, "
-                  "viscosity %g Pa s, mesh size %g m\n", connection_->describe().c_str(), natoms_, alphaLambda_,
-                  rhoFluid_, viscosity_, delta_);
-      }
-    } catch (const std::exception &e) {
-      problem = e.what();
-    }
-  }
-  allAgree(problem);
-  MPI_Bcast(&alphaLambda_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&rhoFluid_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&delta_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&viscosity_, 1, MPI_DOUBLE, 0, world);
-  MPI_Bcast(&fluidFaces_[0][0], 24, MPI_DOUBLE, 0, world);
-  sessionStart_ = MPI_Wtime();
 }
 
 void FixFdmCouple::gather(std::vector<Particle> &particles)
@@ -504,59 +348,14 @@ std::string FixFdmCouple::findOverlap(const std::vector<Particle> &p) const
          (pairs > 1 ? " (" + std::to_string(pairs) + " overlapping pairs in all)" : std::string());
 }
 
-void FixFdmCouple::ensureConnected()
-{
-  if (connected_) return;
-  // Counted before this setup's re-partitioning (at init(), or earlier when the pair style asks):
-  // LIGGGHTS silently drops an atom put outside a non-periodic face, and gather() must name it.
-  if (atomsAtInit_ == 0) checkAtoms();  // asked by the pair style, before this fix's init()
-  sessionParticles_ = atomsAtInit_ > 0 ? atomsAtInit_ : int(atom->natoms);  // told to the fluid, for the session
-  natoms_ = sessionParticles_;
-  if (hasFluid()) {
-    connectAndHandshake();
-  } else {
-    // DEM only: Eq. (31) with each particle's isolated Stokes resistance in place of the fluid's
-    // (alpha_lambda = 1 s makes rho_f Vu / alpha_lambda = 6 pi eta a, see noFluidIntegrals)
-    viscosity_ = noFluidViscosity_;
-    delta_ = noFluidMesh_;
-    rhoFluid_ = noFluidDensity_;
-    alphaLambda_ = 1.0;
-    for (int face = 0; face < 6; face++) {
-      fluidFaces_[face][0] = domain->periodicity[face / 2] ? facePeriodic : faceNoFluid;
-      for (int d = 0; d < 3; d++) fluidFaces_[face][1 + d] = 0.0;
-    }
-    if (comm->me == 0 && screen)
-      fprintf(screen, "fdm/couple: transport none: DEM only, no fluid solver; each particle feels its isolated "
-              "Stokes drag (viscosity %g Pa s) plus the pair style's forces and sub-grid lubrication (mesh size %g m)\n",
-              viscosity_, delta_);
-    sessionStart_ = MPI_Wtime();
-  }
-  connected_ = true;
-}
-
-const char *FixFdmCouple::faceKindName(int kind)
-{
-  switch (kind) {
-    case facePeriodic: return "a periodic (cyclic) boundary";
-    case faceWall: return "a no-slip wall";
-    case faceSlip: return "a slip wall";
-  }
-  return "another kind of boundary";
-}
-
-void FixFdmCouple::fluidFace(int face, int &kind, double velocity[3]) const
-{
-  kind = int(std::lround(fluidFaces_[face][0]));
-  for (int d = 0; d < 3; d++) velocity[d] = fluidFaces_[face][1 + d];
-}
-
 void FixFdmCouple::setup(int)
 {
   // Called before every run (not with 'run N pre no'): connect once, then check the particles
   // wherever the input has put them since (set atom ... between runs).
-  const bool firstSetup = !connected_;
-  ensureConnected();
-  natoms_ = sessionParticles_;
+  const bool firstSetup = !session_.connected();
+  // the count of init(): LIGGGHTS may have dropped an atom since, which gather() must name
+  session_.ensureConnected(lmp, atomsAtInit_);
+  natoms_ = session_.particles();
   // fewer atoms than announced: gather() names the particle LIGGGHTS lost
   if (atom->natoms > natoms_ || atom->map_tag_max > natoms_)
     allAgree("the particles changed since the coupling started: " + std::to_string((long long) atom->natoms) +
@@ -624,25 +423,28 @@ void FixFdmCouple::initial_integrate(int)
   }
 }
 
-cpl::Message FixFdmCouple::makeStep(const std::vector<Particle> &particles) const
+cpl::Step FixFdmCouple::makeStep(const std::vector<Particle> &particles) const
 {
-  using namespace cpl::layout;
-  cpl::Message step = cpl::makeMessage(cpl::MessageType::Step, update->ntimestep, 0, natoms_, stepWidth,
-      "dt=" + fmt(update->dt) + " lastStep=" + std::to_string((long long) update->laststep));
+  cpl::Step step;
+  step.step = update->ntimestep;
+  step.dt = update->dt;
+  step.lastStep = update->laststep;
+  step.particles.resize(natoms_);
+  const bool solved = currentVelocity_.size() == size_t(6) * natoms_;
   for (int p = 0; p < natoms_; p++) {
     const Particle &q = particles[p];
-    step.at(p, sTag) = p + 1;
+    cpl::StepParticle &out = step.particles[p];
+    out.tag = p + 1;
     for (int d = 0; d < 3; d++) {
       // LIGGGHTS wraps periodic coordinates only when it re-neighbours: the fluid gets them in the box
       double x = q.x[d];
       if (domain->periodicity[d]) x -= domain->prd[d] * std::floor((x - domain->boxlo[d]) / domain->prd[d]);
-      step.at(p, sX + d) = x;
+      out.x[d] = x;
       // the last solved velocities U_n (v may hold this step's Adams-Bashforth displacement rate)
-      const bool solved = currentVelocity_.size() == size_t(6) * natoms_;
-      step.at(p, sUx + d) = solved ? currentVelocity_[size_t(6) * p + d] : q.v[d];
-      step.at(p, sWx + d) = solved ? currentVelocity_[size_t(6) * p + 3 + d] : q.omega[d];
+      out.velocity.U[d] = solved ? currentVelocity_[size_t(6) * p + d] : q.v[d];
+      out.velocity.omega[d] = solved ? currentVelocity_[size_t(6) * p + 3 + d] : q.omega[d];
     }
-    step.at(p, sRadius) = q.radius;
+    out.radius = q.radius;
   }
   return step;
 }
@@ -663,156 +465,114 @@ void gatherOnRoot(const std::vector<double> &local, std::vector<double> &all, MP
 }
 }  // namespace
 
-void FixFdmCouple::collectSubgrid()
+void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
 {
   // Every rank builds the sub-grid blocks of its own pairs and wall gaps from its neighbour list;
-  // rank 0 collects them and assembles R^SG once for the step (paper section 4.4.2).
-  std::vector<double> pairs, walls;
+  // rank 0 collects them and assembles Eq. (31) once for the step (paper section 4.4.2).
+  std::vector<double> pairs, walls, allPairs, allWalls;
   long contacts = 0;
   if (pair_) {
     pair_->collectBlocks(stresslets_, pairs, walls);
     contacts = pair_->contactsLast();
   }
-  if (!system_) system_.reset(new System);
-  System &sys = *system_;
-  gatherOnRoot(pairs, sys.pairs, world, comm->me, comm->nprocs);
-  gatherOnRoot(walls, sys.walls, world, comm->me, comm->nprocs);
+  gatherOnRoot(pairs, allPairs, world, comm->me, comm->nprocs);
+  gatherOnRoot(walls, allWalls, world, comm->me, comm->nprocs);
   MPI_Reduce(&contacts, &contacts_, 1, MPI_LONG, MPI_SUM, 0, world);
   if (comm->me != 0) return;
 
-  const int N = natoms_;
-  sys.pairRecord = PairFdmSubgrid::pairRecord + (stresslets_ ? PairFdmSubgrid::pairStressRecord : 0);
-  sys.wallRecord = PairFdmSubgrid::wallRecord + (stresslets_ ? PairFdmSubgrid::wallStressRecord : 0);
-  pairBlocks_ = long(sys.pairs.size() / sys.pairRecord);
-  wallBlocks_ = long(sys.walls.size() / sys.wallRecord);
-  std::vector<Eigen::Triplet<double> > triplets;
-  triplets.reserve(size_t(6) * N + size_t(144) * pairBlocks_ + size_t(36) * wallBlocks_);
-  for (int k = 0; k < 6 * N; k++) triplets.push_back(Eigen::Triplet<double>(k, k, 0.0));  // the diagonal, always
-  sys.wallRhs = Eigen::VectorXd::Zero(6 * N);
-  auto index = [&](double tag) {
-    const long t = std::lround(tag);
-    if (t < 1 || t > N) fail("pair fdm/subgrid sent a block for particle ID " + std::to_string(t));
-    return int(t - 1);
-  };
-  for (long b = 0; b < pairBlocks_; b++) {
-    const double *rec = &sys.pairs[size_t(b) * sys.pairRecord];
-    const int base[2] = {6 * index(rec[0]), 6 * index(rec[1])};
-    const double *R = rec + 2;
-    for (int i = 0; i < 12; i++)
-      for (int j = 0; j < 12; j++)
-        triplets.push_back(Eigen::Triplet<double>(base[i / 6] + i % 6, base[j / 6] + j % 6, R[12 * i + j]));
-  }
-  for (long b = 0; b < wallBlocks_; b++) {
-    const double *rec = &sys.walls[size_t(b) * sys.wallRecord];
-    const int base = 6 * index(rec[0]);
-    const double *R = rec + 1, *rhs = rec + 37;
-    for (int i = 0; i < 6; i++) {
-      for (int j = 0; j < 6; j++) triplets.push_back(Eigen::Triplet<double>(base + i, base + j, R[6 * i + j]));
-      sys.wallRhs(base + i) += rhs[i];  // F = -R_w (U - U_w, Omega): the wall velocity is a force
+  std::vector<fdm::ParticleVelocitySystem::Particle> loads(natoms_);
+  for (int p = 0; p < natoms_; p++) {
+    const Particle &q = particles[p];
+    fdm::ParticleVelocitySystem::Particle &l = loads[p];
+    for (int d = 0; d < 3; d++) {
+      l.x[d] = q.x[d];
+      l.force[d] = q.f[d];
+      l.torque[d] = q.torque[d];
     }
+    l.radius = q.radius;
+    l.mass = q.mass;
+    l.density = q.density;
   }
-  sys.matrix.resize(6 * N, 6 * N);
-  sys.matrix.setFromTriplets(triplets.begin(), triplets.end());
-  sys.matrix.makeCompressed();
-  sys.diagonalIndex.assign(size_t(6) * N, -1);
-  sys.subgridDiagonal.assign(size_t(6) * N, 0.0);
-  for (int k = 0; k < 6 * N; k++)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(sys.matrix, k); it; ++it)
-      if (it.row() == k) {
-        sys.diagonalIndex[k] = int(&it.valueRef() - sys.matrix.valuePtr());
-        sys.subgridDiagonal[k] = it.value();
-      }
-  sys.diagonal = Eigen::VectorXd::Zero(6 * N);
-  sys.analysed = false;
+  try {
+    if (!system_) {
+      fdm::ParticleVelocitySystem::Settings settings;
+      settings.solver = directSolver_ ? fdm::ParticleVelocitySystem::ldlt : fdm::ParticleVelocitySystem::cg;
+      settings.tolerance = tolerance_;
+      settings.alphaLambda = session_.alphaLambda();
+      settings.rhoFluid = session_.rhoFluid();
+      for (int d = 0; d < 3; d++) settings.gravity[d] = gravity_[d];
+      settings.stresslets = stresslets_;
+      system_.reset(new fdm::ParticleVelocitySystem(settings));
+    }
+    system_->assemble(std::move(loads), std::move(allPairs), std::move(allWalls));
+  } catch (const fdm::ParticleVelocitySystem::Error &e) {
+    fail(e.what());
+  }
+  pairBlocks_ = system_->pairBlocks();
+  wallBlocks_ = system_->wallBlocks();
 }
 
-void FixFdmCouple::solveVelocities(const std::vector<Particle> &particles, const cpl::Message &integrals)
+std::string FixFdmCouple::systemProblem(const fdm::ParticleVelocitySystem::Error &e, uint64_t step,
+                                        uint32_t iteration) const
 {
-  // Eq. (31): [ (rho_f/rho_p) J / alpha_lambda + R^SG ] u = F_tot, unknowns (U, Omega) per particle
-  // by tag. (rho_f/rho_p) M_p = rho_f Vu and (rho_f/rho_p) J_p = rho_f Ju come from the fluid's
-  // indicator function I_u; F_tot (Eq. 32) = the fluid integral + buoyant weight + everything
-  // LIGGGHTS put in f and torque (contacts, fix addforce, ...: F^c + F^ext) + the moving walls'
-  // term of Eq. (D.6). R^SG was assembled for this step by collectSubgrid().
-  using namespace cpl::layout;
-  System &sys = *system_;
-  const int N = natoms_;
-  Eigen::VectorXd rhs(6 * N), guess(6 * N), diagonal(6 * N);
-  for (int p = 0; p < N; p++) {
-    const Particle &q = particles[p];
-    const double Vu = integrals.at(p, iVu), Ju = integrals.at(p, iJu);
-    for (int f = 0; f < integralsWidth; f++)
-      if (!std::isfinite(integrals.at(p, f)))
-        fail("the fluid solver sent a non-finite integral for particle " + tagName(p) + " at " + point(q.x) +
-             " (field " + std::to_string(f) + " of [Vu, Ju, F, T]) at step " + std::to_string(integrals.step) +
-             ", inner iteration " + std::to_string(integrals.iteration));
-    if (!(Vu > 0) || !(Ju > 0))
-      fail("particle " + tagName(p) + " at " + point(q.x) + " with radius " + fmt(q.radius) +
-           ": the fluid's indicator function gives it no volume (Vu " + fmt(Vu) + ", Ju " + fmt(Ju) +
-           "): is it smaller than a mesh cell (" + fmt(delta_) + ")?");
-    const double buoyantFraction = 1.0 - rhoFluid_ / q.density;  // (rho_p - rho_f)/rho_p
-    for (int d = 0; d < 3; d++) {
-      diagonal(6*p + d) = rhoFluid_ * Vu / alphaLambda_;
-      diagonal(6*p + 3 + d) = rhoFluid_ * Ju / alphaLambda_;
-      rhs(6*p + d) = integrals.at(p, iFx + d) + buoyantFraction * q.mass * gravity_[d] + q.f[d];
-      rhs(6*p + 3 + d) = integrals.at(p, iTx + d) + q.torque[d];
-    }
-  }
-  rhs += sys.wallRhs;
-  const bool diagonalChanged = diagonal != sys.diagonal;
-  sys.diagonal = diagonal;
-  double *values = sys.matrix.valuePtr();
-  for (int k = 0; k < 6 * N; k++) values[sys.diagonalIndex[k]] = sys.subgridDiagonal[k] + diagonal(k);
-  for (int k = 0; k < 6 * N; k++) guess(k) = solution_[k];  // warm start: the previous inner iteration
+  // what the system cannot know: the mesh size, and when (iteration 0: the step's Volumes)
+  if (e.kind == fdm::ParticleVelocitySystem::Error::noVolume)
+    return std::string(e.what()) + ": is it smaller than a mesh cell (" + fmt(session_.meshSize()) + ")?";
+  if (e.kind == fdm::ParticleVelocitySystem::Error::fluidValue)
+    return std::string(e.what()) + " at step " + std::to_string(step) +
+           (iteration > 0 ? ", inner iteration " + std::to_string(iteration) : std::string());
+  return e.what();
+}
 
-  Eigen::VectorXd u;
-  long iterations = 1;
-  if (directSolver_) {
-    // the matrix only changes with the positions: one factorisation per step
-    if (!sys.analysed) {
-      sys.ldlt.analyzePattern(sys.matrix);
-      sys.analysed = true;
-    }
-    if (diagonalChanged) sys.ldlt.factorize(sys.matrix);
-    if (sys.ldlt.info() != Eigen::Success)
-      fail("the particle velocity system (Eq. 31) could not be factorised (LDLT): is the sub-grid matrix indefinite?");
-    u = sys.ldlt.solve(rhs);
-  } else {
-    sys.cg.setTolerance(tolerance_);
-    sys.cg.setMaxIterations(std::max(1000, 6 * N));
-    sys.cg.compute(sys.matrix);
-    u = sys.cg.solveWithGuess(rhs, guess);
-    iterations = long(sys.cg.iterations());
-    if (sys.cg.info() != Eigen::Success && !(sys.cg.error() < 1e-6))
-      fail("the particle velocity system (Eq. 31) did not converge: relative residual " + fmt(sys.cg.error()) +
-           " after " + std::to_string(sys.cg.iterations()) + " conjugate-gradient iterations (" +
-           std::to_string(pairBlocks_) + " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
+void FixFdmCouple::setVolumes(const cpl::Volumes &volumes)
+{
+  // Eq. (31)'s diagonal and its factorisation, once per time step (Vu, Ju depend only on the positions)
+  std::vector<double> Vu(natoms_), Ju(natoms_);
+  for (int p = 0; p < natoms_; p++) {
+    Vu[p] = volumes.particles[p].Vu;
+    Ju[p] = volumes.particles[p].Ju;
   }
+  try {
+    system_->setVolumes(Vu, Ju);
+  } catch (const fdm::ParticleVelocitySystem::Error &e) {
+    fail(systemProblem(e, volumes.step, 0));
+  }
+}
+
+void FixFdmCouple::solveVelocities(const cpl::Integrals &integrals)
+{
+  // Eq. (31) for the integrals of one inner iteration (particle_velocity_system.h)
+  std::vector<double> fluid(size_t(6) * natoms_);
+  for (int p = 0; p < natoms_; p++)
+    for (int d = 0; d < 3; d++) {
+      fluid[size_t(6) * p + d] = integrals.particles[p].F[d];
+      fluid[size_t(6) * p + 3 + d] = integrals.particles[p].T[d];
+    }
+  try {
+    solution_ = system_->solve(fluid);
+  } catch (const fdm::ParticleVelocitySystem::Error &e) {
+    fail(systemProblem(e, integrals.step, integrals.iteration));
+  }
+  const long iterations = system_->lastIterations();
   run_.solves++;
   run_.solverIterations += iterations;
   run_.solverIterationsMax = std::max(run_.solverIterationsMax, iterations);
   solverIterations_ = std::max(solverIterations_, iterations);
-  for (int k = 0; k < 6 * N; k++) {
-    if (!std::isfinite(u(k))) {
-      const int p = k / 6;
-      fail("the velocity of particle " + tagName(p) + " at " + point(particles[p].x) + " is not finite (Eq. 31): "
-           "its force " + point(particles[p].f) + ", torque " + point(particles[p].torque) + ", fluid integrals Vu " +
-           fmt(integrals.at(p, iVu)) + " Ju " + fmt(integrals.at(p, iJu)));
-    }
-    solution_[k] = u(k);
-  }
 }
 
-cpl::Message FixFdmCouple::noFluidIntegrals(const std::vector<Particle> &particles) const
+cpl::Volumes FixFdmCouple::noFluidVolumes(const std::vector<Particle> &particles) const
 {
-  // transport none: "integrals" of an isolated sphere in a fluid at rest, so that Eq. (31) reads
+  // transport none: "volumes" of an isolated sphere in a fluid at rest, so that Eq. (31) reads
   // [diag(6 pi eta a, 8 pi eta a^3) + R^SG] u = F^c + F^ext + buoyant weight
-  using namespace cpl::layout;
   const double pi = 3.14159265358979323846;
-  cpl::Message m = cpl::makeMessage(cpl::MessageType::Integrals, update->ntimestep, 1, natoms_, integralsWidth);
+  const double eta = session_.viscosity(), alpha = session_.alphaLambda(), rho = session_.rhoFluid();
+  cpl::Volumes m;
+  m.step = update->ntimestep;
+  m.particles.resize(natoms_);
   for (int p = 0; p < natoms_; p++) {
     const double a = particles[p].radius;
-    m.at(p, iVu) = 6 * pi * viscosity_ * a * alphaLambda_ / rhoFluid_;
-    m.at(p, iJu) = 8 * pi * viscosity_ * a * a * a * alphaLambda_ / rhoFluid_;
+    m.particles[p].Vu = 6 * pi * eta * a * alpha / rho;
+    m.particles[p].Ju = 8 * pi * eta * a * a * a * alpha / rho;
   }
   return m;
 }
@@ -821,61 +581,32 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
 {
   // rank 0, after the last inner iteration: the sub-grid force and torque (Eq. 21 and D.6) and,
   // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
-  System &sys = *system_;
-  const int N = natoms_;
-  const Eigen::Map<const Eigen::VectorXd> u(solution_.data(), 6 * N);
-  const Eigen::VectorXd forces = sys.wallRhs - sys.matrix * u + sys.diagonal.cwiseProduct(u);
-  for (int k = 0; k < 6 * N; k++) subgrid_[k] = forces(k);
+  subgrid_ = system_->subgridForces();
   if (!stresslets_) return;
-  for (int p = 0; p < N; p++) {
+  std::vector<double> hydrodynamic = fluidStress_;  // 7 per particle
+  system_->addSubgridStresslets(hydrodynamic);
+  for (int p = 0; p < natoms_; p++) {
     double *out = &stress_[size_t(13) * p];
-    for (int c = 0; c < 7; c++) out[c] = fluidStress_[size_t(7) * p + c];
+    for (int c = 0; c < 7; c++) out[c] = hydrodynamic[size_t(7) * p + c];
     for (int c = 0; c < 6; c++) out[7 + c] = particles[p].contactStress[c];
-  }
-  for (size_t b = 0; b < sys.pairs.size() / sys.pairRecord; b++) {
-    const double *rec = &sys.pairs[b * sys.pairRecord];
-    const int p[2] = {int(std::lround(rec[0])) - 1, int(std::lround(rec[1])) - 1};
-    const double *rows = rec + PairFdmSubgrid::pairRecord;  // 14 x 12: S_1 (6), S_2 (6), s_1, s_2
-    double velocity[12];
-    for (int k = 0; k < 6; k++) {
-      velocity[k] = solution_[size_t(6) * p[0] + k];
-      velocity[6 + k] = solution_[size_t(6) * p[1] + k];
-    }
-    for (int row = 0; row < 14; row++) {
-      double value = 0;
-      for (int k = 0; k < 12; k++) value -= rows[12 * row + k] * velocity[k];
-      const int who = row < 12 ? row / 6 : row - 12;
-      const int component = row < 12 ? row % 6 : 6;
-      stress_[size_t(13) * p[who] + component] += value;
-    }
-  }
-  for (size_t b = 0; b < sys.walls.size() / sys.wallRecord; b++) {
-    const double *rec = &sys.walls[b * sys.wallRecord];
-    const int p = int(std::lround(rec[0])) - 1;
-    const double *rows = rec + PairFdmSubgrid::wallRecord, *wallTerm = rows + 42;  // 7 x 6, then 7
-    for (int row = 0; row < 7; row++) {
-      double value = wallTerm[row];
-      for (int k = 0; k < 6; k++) value -= rows[6 * row + k] * solution_[size_t(6) * p + k];
-      stress_[size_t(13) * p + row] += value;
-    }
   }
 }
 
-void FixFdmCouple::storeStepDone(const cpl::Message &done)
+void FixFdmCouple::storeStepDone(const cpl::StepDone &done)
 {
-  const uint32_t width = stresslets_ ? cpl::layout::stepDoneStressWidth : cpl::layout::stepDoneWidth;
-  if (int(done.count) != natoms_ || done.width != width)
-    fail("the fluid solver ended step " + std::to_string(done.step) + " with forces for " + std::to_string(done.count) +
-         " particles (" + std::to_string(done.width) + " values each) where " + std::to_string(natoms_) +
-         " particles (" + std::to_string(width) + " values) were expected");
   for (int p = 0; p < natoms_; p++) {
-    for (int c = 0; c < 6; c++) hydro_[size_t(6) * p + c] = done.at(p, c);
-    if (stresslets_)
-      for (int c = 0; c < 7; c++) fluidStress_[size_t(7) * p + c] = done.at(p, cpl::layout::dSxx + c);
+    for (int d = 0; d < 3; d++) {
+      hydro_[size_t(6) * p + d] = done.forces[p].F[d];
+      hydro_[size_t(6) * p + 3 + d] = done.forces[p].T[d];
+    }
+    if (stresslets_) {
+      for (int c = 0; c < 6; c++) fluidStress_[size_t(7) * p + c] = done.stresslets[p].S[c];
+      fluidStress_[size_t(7) * p + 6] = done.stresslets[p].trace;
+    }
   }
-  lastIterations_ = int(std::lround(done.textNumber("iterations")));
-  lastResidual_ = done.textNumber("residual");
-  if (done.textValue("converged") != "1") notConverged_++;
+  lastIterations_ = int(done.iterations);
+  lastResidual_ = done.residual;
+  if (!done.converged) notConverged_++;
 }
 
 void FixFdmCouple::final_integrate()
@@ -888,50 +619,74 @@ void FixFdmCouple::final_integrate()
   run_.gatherScatter += MPI_Wtime() - t0;
   t0 = MPI_Wtime();
   solverIterations_ = 0;
-  collectSubgrid();
+  assembleSystem(particles);
   run_.solve += MPI_Wtime() - t0;
 
-  if (comm->me == 0 && !hasFluid()) {
+  if (comm->me == 0 && !hasFluid_) {
     t0 = MPI_Wtime();
-    const cpl::Message integrals = noFluidIntegrals(particles);
-    solveVelocities(particles, integrals);
+    setVolumes(noFluidVolumes(particles));
+    cpl::Integrals atRest;  // no fluid: no fluid force
+    atRest.step = update->ntimestep;
+    atRest.iteration = 1;
+    atRest.particles.assign(natoms_, cpl::ForceTorque());
+    solveVelocities(atRest);
     for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
       hydro_[k] = -system_->diagonal(k) * solution_[k];
     subgridResults(particles);
     lastIterations_ = 1;
     run_.solve += MPI_Wtime() - t0;
   } else if (comm->me == 0) {
-    if (!connection_) fail("the connection to the fluid solver is closed");
+    cpl::Transport *connection = session_.transport();
+    if (!connection) fail("the connection to the fluid solver is closed");
     const bigint step = update->ntimestep;
+    // the next message of this step from the fluid, of the expected type
+    auto receive = [&](bool volumes) {
+      const cpl::Message m = connection->receive();
+      const bool expected = volumes ? m.type == cpl::MessageType::Volumes :
+                            m.type == cpl::MessageType::Integrals || m.type == cpl::MessageType::StepDone;
+      if (!expected)
+        fail(std::string("coupling: expected ") + (volumes ? "Volumes" : "Integrals or StepDone") +
+             " from the fluid solver, got " + cpl::messageTypeName(m.type) + " (step " +
+             std::to_string((long long) step) + ")");
+      if (m.step != uint64_t(step))
+        fail(std::string("coupling: the fluid solver sent ") + cpl::messageTypeName(m.type) + " of step " +
+             std::to_string(m.step) + " during step " + std::to_string((long long) step));
+      return m;
+    };
     try {
       t0 = MPI_Wtime();
-      connection_->send(makeStep(particles));
+      connection->send(makeStep(particles).toMessage());
+      // Protocol 3: Vu and Ju once per step, before the first Integrals
+      const cpl::Message volumes = receive(true);
+      double t1 = MPI_Wtime();
+      run_.exchange += t1 - t0;
+      setVolumes(cpl::Volumes::fromMessage(volumes, natoms_));
+      t0 = MPI_Wtime();
+      run_.solve += t0 - t1;
       while (true) {
-        const cpl::Message m = connection_->receive();
-        double t1 = MPI_Wtime();
+        const cpl::Message m = receive(false);
+        t1 = MPI_Wtime();
         run_.exchange += t1 - t0;
-        if (m.type != cpl::MessageType::Integrals && m.type != cpl::MessageType::StepDone)
-          fail(std::string("coupling: expected Integrals or StepDone from the fluid solver, got ") +
-               cpl::messageTypeName(m.type) + " (step " + std::to_string((long long) step) + ")");
-        if (m.step != uint64_t(step))
-          fail(std::string("coupling: the fluid solver sent ") + cpl::messageTypeName(m.type) + " of step " +
-               std::to_string(m.step) + " during step " + std::to_string((long long) step));
         if (m.type == cpl::MessageType::StepDone) {
-          storeStepDone(m);
+          storeStepDone(cpl::StepDone::fromMessage(m, stresslets_, natoms_));
           subgridResults(particles);
           run_.solve += MPI_Wtime() - t1;
           break;
         }
-        if (int(m.count) != natoms_ || m.width != cpl::layout::integralsWidth)
-          fail("coupling: the fluid solver sent integrals for " + std::to_string(m.count) + " particles (" +
-               std::to_string(m.width) + " values each), LIGGGHTS has " + std::to_string(natoms_) + " (8 values)");
-        solveVelocities(particles, m);
-        cpl::Message reply = cpl::makeMessage(cpl::MessageType::Velocities, m.step, m.iteration, natoms_,
-                                              cpl::layout::velocitiesWidth);
-        reply.data = solution_;
+        const cpl::Integrals integrals = cpl::Integrals::fromMessage(m, natoms_);
+        solveVelocities(integrals);
+        cpl::Velocities reply;
+        reply.step = integrals.step;
+        reply.iteration = integrals.iteration;
+        reply.particles.resize(natoms_);
+        for (int p = 0; p < natoms_; p++)
+          for (int d = 0; d < 3; d++) {
+            reply.particles[p].U[d] = solution_[size_t(6) * p + d];
+            reply.particles[p].omega[d] = solution_[size_t(6) * p + 3 + d];
+          }
         t0 = MPI_Wtime();
         run_.solve += t0 - t1;
-        connection_->send(reply);
+        connection->send(reply.toMessage());
       }
     } catch (const std::exception &e) {
       fail(e.what());
@@ -971,13 +726,7 @@ void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
 
   std::vector<int> closePairs;
   std::vector<motion::Wall> walls;
-  if (gapUpdate_ && system_) {
-    const System &sys = *system_;
-    for (size_t b = 0; sys.pairRecord > 0 && b < sys.pairs.size() / sys.pairRecord; b++) {
-      closePairs.push_back(int(std::lround(sys.pairs[b * sys.pairRecord])) - 1);
-      closePairs.push_back(int(std::lround(sys.pairs[b * sys.pairRecord + 1])) - 1);
-    }
-  }
+  if (gapUpdate_ && system_) closePairs = system_->closePairs();
   if (gapUpdate_ && pair_)
     for (const PairFdmSubgrid::Wall &w : pair_->walls())
       walls.push_back(motion::Wall{w.axis, w.side, w.side == 0 ? domain->boxlo[w.axis] : domain->boxhi[w.axis]});
@@ -1084,8 +833,7 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
 void FixFdmCouple::post_run()
 {
   const double now = MPI_Wtime();
-  total_.add(run_);
-  runs_++;
+  session_.addRun(run_.steps, run_.solve, run_.exchange, run_.gatherScatter);
   printTiming("of this run", run_, now - runStart_, 1);
   notConverged_ = 0;
   // a following 'run N pre no' skips setup(): its timing starts here
@@ -1098,8 +846,8 @@ double FixFdmCouple::compute_vector(int n)
   switch (n) {
     case 0: return lastIterations_;
     case 1: return lastResidual_;
-    case 2: return total_.solve + run_.solve;
-    case 3: return total_.exchange + run_.exchange;
+    case 2: return session_.totalSolve() + run_.solve;
+    case 3: return session_.totalExchange() + run_.exchange;
     case 4: return solverIterations_;
     case 5: return pairBlocks_;
     case 6: return wallBlocks_;
@@ -1113,39 +861,3 @@ double FixFdmCouple::memory_usage()
   return double(nmax_) * perAtomColumns_ * sizeof(double) + double(solution_.size() + hydro_.size()) * sizeof(double);
 }
 
-void FixFdmCouple::finishAll(LAMMPS *lmp)
-{
-  if (lmp->comm->me != 0 || !connection_) return;
-  try {
-    connection_->send(cpl::makeMessage(cpl::MessageType::Finish, lmp->update->ntimestep, 0, 0, 0));
-  } catch (const std::exception &e) {
-    if (lmp->screen) fprintf(lmp->screen, "fdm/couple: WARNING: could not tell the fluid solver to finish: %s\n",
-                             e.what());
-  }
-  connection_->close();
-  connection_.reset();
-  const double wall = MPI_Wtime() - sessionStart_, percent = wall > 0 ? 100.0 / wall : 0.0;
-  char line[512];
-  std::snprintf(line, sizeof line,
-                "fdm/couple timing total (%d run%s, %ld steps, %.4g s coupled): particle solve %.4g s (%.1f %%), "
-                "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%)\n",
-                runs_, runs_ == 1 ? "" : "s", total_.steps, wall, total_.solve, total_.solve * percent,
-                total_.exchange, total_.exchange * percent, total_.gatherScatter, total_.gatherScatter * percent);
-  if (lmp->screen) fputs(line, lmp->screen);
-  if (lmp->logfile) fputs(line, lmp->logfile);
-}
-
-namespace {
-void tellPeerWeStopped()
-{
-  FixFdmCouple::abandon("fdmDEM stopped before the end of its input (a LIGGGHTS error? see the fdmDEM log)");
-}
-}  // namespace
-
-void FixFdmCouple::abandon(const std::string &why)
-{
-  if (!connection_) return;
-  connection_->sendError(why);
-  connection_->close();
-  connection_.reset();
-}

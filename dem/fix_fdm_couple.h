@@ -9,10 +9,12 @@
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
    then (final_integrate, after every pair and fix force is in f and torque) sends the particles
-   to fdmFoam and, every inner iteration, solves Eq. (31) for all particle velocities with Eigen
-   from the integrals it receives, until fdmFoam reports convergence. Replaces fix nve/sphere.
-   With pair_style fdm/subgrid, the sub-grid lubrication blocks R^SG (pairs and walls) are gathered
-   on rank 0 once per time step and enter the matrix of Eq. (31) (paper section 4.4.2).
+   to fdmFoam and, every inner iteration, solves Eq. (31) for all particle velocities from the
+   integrals it receives, until fdmFoam reports convergence. Replaces fix nve/sphere. With
+   pair_style fdm/subgrid, the sub-grid lubrication blocks R^SG (pairs and walls) are gathered on
+   rank 0 once per time step and enter the matrix of Eq. (31) (paper section 4.4.2).
+   Eq. (31) itself is particle_velocity_system.h; the connection to fdmFoam and what it said at the
+   handshake are the process's coupling session (coupling_session.h), which this fix configures.
 
    Outputs (docs/dem.md): global vector [inner iterations, lambda residual, particle-solve seconds,
    exchange seconds, linear-solver iterations, sub-grid pair blocks, wall blocks, contacts] of the
@@ -24,6 +26,7 @@
 
 #include "fix.h"
 #include "fdm/coupler.h"
+#include "particle_velocity_system.h"
 #include "position_update.h"
 
 #include <memory>
@@ -45,23 +48,6 @@ class FixFdmCouple : public Fix {
   double compute_vector(int);
   double memory_usage();
 
-  // Called by the fdmDEM driver on every rank after the input script: tells fdmFoam to finish,
-  // prints the timing over all runs, closes the connection.
-  static void finishAll(class LAMMPS *lmp);
-  // Best effort, at exit after an error: sends Error(why) to the fluid solver if still connected.
-  static void abandon(const std::string &why);
-
-  // Connects and shakes hands with the fluid solver if not yet done (every rank calls it): the
-  // pair style needs the fluid's viscosity and mesh size before LIGGGHTS builds neighbour lists.
-  void ensureConnected();
-  double viscosity() const { return viscosity_; }
-  double meshSize() const { return delta_; }
-  // Boundary of the fluid case on box face 0..5 (xlo xhi ylo yhi zlo zhi), from its Hello.
-  enum FaceKind { facePeriodic = 0, faceWall = 1, faceSlip = 2, faceOther = 3, faceNoFluid = -1 };
-  bool hasFluid() const { return options_.transport != "none"; }
-  static const char *faceKindName(int kind);
-  void fluidFace(int face, int &kind, double velocity[3]) const;
-
  private:
   // One particle as gathered on rank 0, stored by tag (index tag-1).
   struct Particle {
@@ -77,21 +63,19 @@ class FixFdmCouple : public Fix {
     int gapSweepsMax;
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
                gapTargets(0), gapLimited(0), gapFallbacks(0), gapSweepsMax(0) {}
-    void add(const Timing &t);
   };
 
-  void checkAtoms();
-  void connectAndHandshake();
-  std::string checkFluidHello(const fdm::coupler::Message &hello) const;
   void gather(std::vector<Particle> &particles);
   std::string checkConfiguration(const std::vector<Particle> &particles, bool checkOverlaps) const;
   std::string findOverlap(const std::vector<Particle> &particles) const;
-  fdm::coupler::Message makeStep(const std::vector<Particle> &particles) const;
-  void collectSubgrid();
-  void solveVelocities(const std::vector<Particle> &particles, const fdm::coupler::Message &integrals);
+  fdm::coupler::Step makeStep(const std::vector<Particle> &particles) const;
+  void assembleSystem(const std::vector<Particle> &particles);
+  void setVolumes(const fdm::coupler::Volumes &volumes);
+  void solveVelocities(const fdm::coupler::Integrals &integrals);
+  std::string systemProblem(const fdm::ParticleVelocitySystem::Error &e, uint64_t step, uint32_t iteration) const;
   void subgridResults(const std::vector<Particle> &particles);
-  fdm::coupler::Message noFluidIntegrals(const std::vector<Particle> &particles) const;
-  void storeStepDone(const fdm::coupler::Message &done);
+  fdm::coupler::Volumes noFluidVolumes(const std::vector<Particle> &particles) const;
+  void storeStepDone(const fdm::coupler::StepDone &done);
   void planNextMove(const std::vector<Particle> &particles);
   void scatter();
   void fillPerAtomArray();
@@ -99,7 +83,8 @@ class FixFdmCouple : public Fix {
   void fail(const std::string &message);
   void printTiming(const char *what, const Timing &t, double wall, int runs) const;
 
-  fdm::coupler::Options options_;
+  class CouplingSession &session_;  // the connection and what the fluid said (coupling_session.h)
+  bool hasFluid_;                   // not transport none
   double gravity_[3];
   bool move_;
   bool adamsBashforth_;      // position update: Adams-Bashforth 2 (default) or Euler
@@ -110,22 +95,10 @@ class FixFdmCouple : public Fix {
   // rates (6N by tag, x += dt rate), and the positions x_n it starts from (rank 0, 3N by tag).
   bool havePlan_;
   std::vector<double> moveRate_, planPositions_;
-  double noFluidViscosity_, noFluidMesh_, noFluidDensity_;  // transport none (DEM only)
   bool stresslets_;          // per-particle stresslets asked for (fluid, sub-grid, contact)
   bool directSolver_;        // Eq. (31) by sparse LDLT instead of conjugate gradients
   double tolerance_;         // relative residual of the conjugate-gradient solve
   class PairFdmSubgrid *pair_;  // the sub-grid / contact pair style, if that is the pair style
-
-  // The connection and what the fluid said at the handshake live as long as the process: an input
-  // may run many times (and even unfix / fix again) over one coupled session.
-  static std::unique_ptr<fdm::coupler::Transport> connection_;  // rank 0 only
-  static bool connected_;                                          // every rank: handshake done
-  static int sessionParticles_;                                    // N told to the fluid at the handshake
-  static double alphaLambda_, rhoFluid_, delta_, viscosity_;
-  static double fluidFaces_[6][4];                                 // kind, wall velocity
-  static Timing total_;
-  static int runs_;
-  static double sessionStart_;
 
   int atomsAtInit_;                // atom count when init() checked the tags 1..N
   int natoms_;                     // N, particles are tags 1..N
@@ -141,11 +114,8 @@ class FixFdmCouple : public Fix {
   double **perAtom_;
   int perAtomColumns_;
 
-  // Eq. (31) on rank 0, for the current time step: the matrix is assembled once per step (the
-  // positions do not move during the inner iterations); only its diagonal and the right-hand
-  // side change from one inner iteration to the next.
-  struct System;
-  std::unique_ptr<System> system_;
+  // Eq. (31) on rank 0 (particle_velocity_system.h): assembled once per step, solved every inner iteration.
+  std::unique_ptr<fdm::ParticleVelocitySystem> system_;
   std::vector<double> subgrid_;    // 6N: F^SG, T^SG of the last step, by tag
   std::vector<double> stress_;     // 13N: S^h (6), s^h, S^c (6) of the last step, by tag
   long solverIterations_, solverIterationsMax_, pairBlocks_, wallBlocks_, contacts_;

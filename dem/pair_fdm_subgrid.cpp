@@ -2,8 +2,9 @@
 // docs/dem.md).
 #include "pair_fdm_subgrid.h"
 
+#include "coupling_session.h"
 #include "fix_contact_history_fdm.h"
-#include "fix_fdm_couple.h"
+#include "particle_velocity_system.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -143,19 +144,17 @@ std::string PairFdmSubgrid::wallName(const Wall &w) const { return faceNames[2 *
 
 void PairFdmSubgrid::fluidParameters()
 {
-  // The viscosity and the mesh size are the fluid case's: fix fdm/couple has them from the handshake
-  // (it connects now if this is the first run). Without the fix there is no fluid: contact only.
-  FixFdmCouple *couple = nullptr;
-  for (int i = 0; i < modify->nfix; i++)
-    if (std::strcmp(modify->fix[i]->style, "fdm/couple") == 0) couple = dynamic_cast<FixFdmCouple *>(modify->fix[i]);
-  if (!couple) {
+  // The viscosity and the mesh size are the fluid case's, from the coupling session's handshake
+  // (it connects now if this is the first run). Without fix fdm/couple there is no fluid: contact only.
+  CouplingSession &session = CouplingSession::instance();
+  if (!session.attached()) {
     model_.reset();
     wallModel_.reset();
     return;
   }
-  couple->ensureConnected();
-  viscosity_ = couple->viscosity();
-  meshSize_ = couple->meshSize();
+  session.ensureConnected(lmp);
+  viscosity_ = session.viscosity();
+  meshSize_ = session.meshSize();
   // Two cut-offs: the solver resolves a wall gap less well than a pair gap of the same width
   // (measured with cases/pairSqueeze and cases/wallSqueeze, docs/validation.md)
   if (!model_) model_.reset(new res::CutoffSubgridModel(meshSize_, cutoffCells_));
@@ -163,22 +162,22 @@ void PairFdmSubgrid::fluidParameters()
 
   // The walls declared here are the fluid case's no-slip walls, with the same velocities.
   std::string problem;
-  if (!couple->hasFluid()) return;  // transport none: the walls are the ones declared here
+  if (!session.hasFluid()) return;  // transport none: the walls are the ones declared here
   for (int face = 0; face < 6 && problem.empty(); face++) {
     int kind;
     double velocity[3];
-    couple->fluidFace(face, kind, velocity);
+    session.fluidFace(face, kind, velocity);
     const Wall *declared = nullptr;
     for (const Wall &w : walls_)
       if (2 * w.axis + w.side == face) declared = &w;
     const std::string u = "(" + fmt(velocity[0]) + " " + fmt(velocity[1]) + " " + fmt(velocity[2]) + ")";
-    if (kind == FixFdmCouple::faceWall && !declared) {
+    if (kind == CouplingSession::faceWall && !declared) {
       problem = std::string("the fluid case has a no-slip wall on ") + faceNames[face] + " moving at " + u +
                 " m/s, not declared to pair_style fdm/subgrid: add 'wall " + faceNames[face] + " " + fmt(velocity[0]) +
                 " " + fmt(velocity[1]) + " " + fmt(velocity[2]) + "'";
-    } else if (declared && kind != FixFdmCouple::faceWall) {
+    } else if (declared && kind != CouplingSession::faceWall) {
       problem = std::string("pair_style fdm/subgrid declares a wall on ") + faceNames[face] +
-                " but the fluid case has " + FixFdmCouple::faceKindName(kind) + " there";
+                " but the fluid case has " + CouplingSession::faceKindName(kind) + " there";
     } else if (declared) {
       double scale = 0, diff = 0;
       for (int d = 0; d < 3; d++) {
@@ -193,7 +192,7 @@ void PairFdmSubgrid::fluidParameters()
   }
   if (!problem.empty()) {
     // tell the fluid solver why (it would otherwise only learn that fdmDEM stopped)
-    FixFdmCouple::abandon("fdmDEM: pair fdm/subgrid: " + problem);
+    session.abandon("fdmDEM: pair fdm/subgrid: " + problem);
     error->all(FLERR, ("pair fdm/subgrid: " + problem).c_str());
   }
 }
@@ -487,7 +486,7 @@ void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, 
       pairs.push_back(tag[i]);
       pairs.push_back(tag[j]);
       pairs.insert(pairs.end(), &block.R[0][0], &block.R[0][0] + 144);
-      if (withStress) pairs.insert(pairs.end(), &block.stress[0][0], &block.stress[0][0] + pairStressRecord);
+      if (withStress) pairs.insert(pairs.end(), &block.stress[0][0], &block.stress[0][0] + fdm::subgrid::pairStressRecord);
     }
   }
   res::WallBlock wallBlock;

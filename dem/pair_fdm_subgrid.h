@@ -10,8 +10,10 @@
    The contact forces go into f and torque at every force evaluation, like any LIGGGHTS pair style
    (they enter F^c of Eq. 32). The sub-grid blocks are not forces: they are the matrix R^SG of
    Eq. (31), which fix fdm/couple solves implicitly. The fix asks for them once per time step
-   (collectBlocks) with the viscosity and mesh size the fluid solver announced at the handshake;
-   the resistance functions come from the project's resistance library (dem/resistance/). */
+   (collectBlocks); the viscosity and mesh size are those the fluid solver announced at the
+   handshake, asked of the coupling session (coupling_session.h), which also says which box faces
+   are the fluid case's walls. The resistance functions come from the project's resistance library
+   (dem/resistance/). */
 
 #ifndef FDM_PAIR_FDM_SUBGRID_H
 #define FDM_PAIR_FDM_SUBGRID_H
@@ -48,12 +50,8 @@ class PairFdmSubgrid : public Pair {
     double velocity[3];
   };
 
-  // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0.
-  // Pair record: [tag1, tag2, R (12x12, row-major, unknowns U1 W1 U2 W2)] + stress rows (14x12) if
-  // withStress. Wall record: [tag, R (6x6), rhs R[:,0:3] U_w (6)] + stress rows (7x6) and their
-  // wall-velocity term (7) if withStress. R already contains the viscosity (F = -R u).
-  static const int pairRecord = 2 + 144, pairStressRecord = 14 * 12;
-  static const int wallRecord = 1 + 36 + 6, wallStressRecord = 7 * 6 + 7;
+  // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0, in
+  // the records of fdm::subgrid (particle_velocity_system.h), with their stress rows if withStress.
   void collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls);
 
   bool lubricationActive() const { return lubrication_ && model_; }
@@ -88,7 +86,7 @@ class PairFdmSubgrid : public Pair {
   double kn_, kt_, mu_, hr_;
   std::vector<Wall> walls_;
 
-  // from the fluid solver (via fix fdm/couple) at the handshake
+  // from the fluid solver at the handshake (coupling session)
   double viscosity_, meshSize_;
   std::unique_ptr<fdm::resistance::SubgridModel> model_, wallModel_;  // pairs, walls
 

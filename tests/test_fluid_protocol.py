@@ -1,6 +1,7 @@
-"""fdmFoam's side of coupling protocol 2 (viscosity, box faces, stresslets of Eq. 12), checked by
-fluid/fdmFoam/tests/checkProtocol2.py: it plays the particle code over the socket against the real
-fdmFoam, serial and on 2 ranks (see its docstring for every check)."""
+"""fdmFoam's side of the coupling protocol (version 3: Volumes once per step; version 2's viscosity,
+box faces, stresslets of Eq. 12), checked by fluid/fdmFoam/tests/checkProtocol2.py: it plays the
+particle code over the socket against the real fdmFoam, serial and on 2 ranks (see its docstring
+for every check)."""
 import os
 import subprocess
 import sys

@@ -34,6 +34,7 @@ const char* messageTypeName(MessageType t)
     switch (t) {
         case MessageType::Hello: return "Hello";
         case MessageType::Step: return "Step";
+        case MessageType::Volumes: return "Volumes";
         case MessageType::Integrals: return "Integrals";
         case MessageType::Velocities: return "Velocities";
         case MessageType::StepDone: return "StepDone";
@@ -120,7 +121,7 @@ size_t encodedSize(const unsigned char* header)
         throw CouplerError("coupling: protocol version mismatch: the peer speaks version " + std::to_string(version) +
                            ", this side speaks version " + std::to_string(protocolVersion));
     const uint16_t type = get<uint16_t>(header, 6);
-    if (type < uint16_t(MessageType::Hello) || type > uint16_t(MessageType::Error))
+    if (type < uint16_t(MessageType::Hello) || type > uint16_t(MessageType::Volumes))  // 1..8, Volumes the newest
         throw CouplerError("coupling: malformed message (unknown type " + std::to_string(type) + ")");
     const uint32_t count = get<uint32_t>(header, 20), width = get<uint32_t>(header, 24);
     const uint32_t textLength = get<uint32_t>(header, 28);
@@ -160,7 +161,9 @@ Message decode(const unsigned char* bytes, size_t size)
 void Transport::sendError(const std::string& why) noexcept
 {
     try {
-        send(makeMessage(MessageType::Error, 0, 0, 0, 0, why));
+        Error e;
+        e.text = why;
+        send(e.toMessage());
     } catch (...) {
     }
 }

@@ -145,9 +145,12 @@ TEST(Message, TextValues)
     expectCouplerError([&] { bad.textNumber("dt"); }, {"dt=abc", "not a number"});
 }
 
-TEST(Message, LayoutOfProtocol2)
+TEST(Message, LayoutOfProtocol3)
 {
-    EXPECT_EQ(protocolVersion, 2);
+    EXPECT_EQ(protocolVersion, 3);
+    EXPECT_EQ(layout::volumesWidth, 2);  // protocol 3: Vu, Ju once per step ...
+    EXPECT_EQ(layout::integralsWidth, 6);  // ... F, T every inner iteration
+    EXPECT_EQ(uint16_t(MessageType::Volumes), 8);
     EXPECT_EQ(layout::helloDemWidth, 10u);
     EXPECT_EQ(layout::helloFluidWidth, 38u);
     EXPECT_EQ(layout::hfViscosity, 13);
@@ -182,7 +185,7 @@ TEST(Message, FluidHelloOfProtocol2RoundTrips)
     EXPECT_EQ(back.type, MessageType::Hello);
     EXPECT_EQ(back.count, 1u);
     EXPECT_EQ(back.width, 38u);
-    EXPECT_EQ(back.textNumber("version"), 2);
+    EXPECT_EQ(back.textNumber("version"), protocolVersion);
     EXPECT_EQ(back.data, m.data);
     EXPECT_EQ(back.at(0, 2), 1000);                      // the first 13 fields unchanged
     EXPECT_EQ(back.at(0, 12), 1);
@@ -270,16 +273,329 @@ TEST(Message, InconsistentMessageIsNotEncoded)
     EXPECT_THROW(encode(m), CouplerError);
 }
 
+// ---- typed messages ---------------------------------------------------------------------------------
+
+namespace {
+// pack -> encode -> decode: what the peer gets
+template <class T> Message overTheWire(const T& typed)
+{
+    const std::vector<unsigned char> bytes = encode(typed.toMessage());
+    return decode(bytes.data(), bytes.size());
+}
+double value(int i) { return 1.0 / (i + 3) - 0.125 * i; }  // distinct, not round
+}  // namespace
+
+TEST(TypedMessages, DemHelloRoundTrips)
+{
+    DemHello h;
+    h.dt = 0.0125;
+    h.lastStep = 1234567;
+    h.stresslets = true;
+    h.nParticles = 8000;
+    for (int d = 0; d < 3; ++d) {
+        h.lo[d] = value(d);
+        h.hi[d] = 10 + value(d + 3);
+        h.periodic[d] = d != 1;
+    }
+    const Message m = overTheWire(h);
+    EXPECT_EQ(m.type, MessageType::Hello);
+    EXPECT_EQ(m.width, layout::helloDemWidth);
+    EXPECT_EQ(m.textValue("role"), "dem");
+    const DemHello b = DemHello::fromMessage(m);
+    EXPECT_EQ(b.version, protocolVersion);
+    EXPECT_EQ(b.dt, 0.0125);
+    EXPECT_EQ(b.lastStep, 1234567);
+    EXPECT_TRUE(b.stresslets);
+    EXPECT_EQ(b.nParticles, 8000);
+    for (int d = 0; d < 3; ++d) {
+        EXPECT_EQ(b.lo[d], h.lo[d]);
+        EXPECT_EQ(b.hi[d], h.hi[d]);
+        EXPECT_EQ(b.periodic[d], h.periodic[d]);
+    }
+    h.stresslets = false;
+    EXPECT_FALSE(DemHello::fromMessage(overTheWire(h)).stresslets);
+}
+
+TEST(TypedMessages, DemHelloReadsStressletsTolerantlyAndRequiresIt)
+{
+    Message m = DemHello().toMessage();
+    for (const char* yes : {"1", "1.0", "yes", "TRUE", "on"}) {
+        m.text = "role=dem version=" + std::to_string(protocolVersion) + " dt=1 lastStep=1 stresslets=" + yes;
+        EXPECT_TRUE(DemHello::fromMessage(m).stresslets) << yes;
+    }
+    m.text = "role=dem version=" + std::to_string(protocolVersion) + " dt=1 lastStep=1 stresslets=off";
+    EXPECT_FALSE(DemHello::fromMessage(m).stresslets);
+    m.text = "role=dem version=" + std::to_string(protocolVersion) + " dt=1 lastStep=1";
+    expectCouplerError([&] { DemHello::fromMessage(m); }, {"no stresslets= entry", "dt=1 lastStep=1"});
+    m.text += " stresslets=2";
+    expectCouplerError([&] { DemHello::fromMessage(m); }, {"stresslets=2", "not 0 or 1"});
+    m.text = "role=dem version=1 dt=1 lastStep=1 stresslets=0";
+    expectCouplerError([&] { DemHello::fromMessage(m); },
+                       {"version mismatch", "version 1", "version " + std::to_string(protocolVersion)});
+}
+
+TEST(TypedMessages, FluidHelloRoundTrips)
+{
+    FluidHello h;
+    h.nParticlesExpected = -1;
+    h.alphaLambda = 0.0625;
+    h.rhoFluid = 1000;
+    h.delta = 0.25;
+    h.viscosity = 1e-3;
+    for (int d = 0; d < 3; ++d) {
+        h.lo[d] = -value(d);
+        h.hi[d] = 6 + value(d);
+        h.periodic[d] = d != 1;
+    }
+    for (int f = 0; f < 6; ++f) {
+        h.faces[f].kind = f / 2 == 1 ? layout::bWall : layout::bPeriodic;
+        for (int d = 0; d < 3; ++d) h.faces[f].velocity[d] = f / 2 == 1 && d == 0 ? (f == 2 ? -0.5 : 0.5) : 0.0;
+    }
+    const Message m = overTheWire(h);
+    EXPECT_EQ(m.width, layout::helloFluidWidth);
+    EXPECT_EQ(m.at(0, layout::hfViscosity), 1e-3);                                          // the documented offsets
+    EXPECT_EQ(m.at(0, layout::hfFaceBase + 3 * layout::faceWidth + layout::fUx), 0.5);    // yhi Ux
+    const FluidHello b = FluidHello::fromMessage(m);
+    EXPECT_EQ(b.nParticlesExpected, -1);
+    EXPECT_EQ(b.alphaLambda, 0.0625);
+    EXPECT_EQ(b.rhoFluid, 1000);
+    EXPECT_EQ(b.delta, 0.25);
+    EXPECT_EQ(b.viscosity, 1e-3);
+    for (int d = 0; d < 3; ++d) {
+        EXPECT_EQ(b.lo[d], h.lo[d]);
+        EXPECT_EQ(b.hi[d], h.hi[d]);
+        EXPECT_EQ(b.periodic[d], h.periodic[d]);
+    }
+    for (int f = 0; f < 6; ++f) {
+        EXPECT_EQ(b.faces[f].kind, h.faces[f].kind);
+        for (int d = 0; d < 3; ++d) EXPECT_EQ(b.faces[f].velocity[d], h.faces[f].velocity[d]);
+    }
+    Message bad = m;
+    bad.at(0, layout::hfFaceBase + 4 * layout::faceWidth + layout::fKind) = 7;
+    expectCouplerError([&] { FluidHello::fromMessage(bad); }, {"face zlo", "boundary kind 7"});
+}
+
+TEST(TypedMessages, StepRoundTrips)
+{
+    Step s;
+    s.step = 42;
+    s.dt = 0.05;
+    s.lastStep = 100;
+    for (int p = 0; p < 3; ++p) {
+        StepParticle q;
+        q.tag = p + 1;
+        for (int d = 0; d < 3; ++d) {
+            q.x[d] = value(10 * p + d);
+            q.velocity.U[d] = value(10 * p + 3 + d);
+            q.velocity.omega[d] = value(10 * p + 6 + d);
+        }
+        q.radius = 0.5 + p;
+        s.particles.push_back(q);
+    }
+    const Message m = overTheWire(s);
+    EXPECT_EQ(m.width, uint32_t(layout::stepWidth));
+    EXPECT_EQ(m.at(2, layout::sRadius), 2.5);
+    const Step b = Step::fromMessage(m, 3);
+    EXPECT_EQ(b.step, 42u);
+    EXPECT_EQ(b.dt, 0.05);
+    EXPECT_EQ(b.lastStep, 100);
+    ASSERT_EQ(b.particles.size(), 3u);
+    for (int p = 0; p < 3; ++p) {
+        EXPECT_EQ(b.particles[p].tag, p + 1);
+        EXPECT_EQ(b.particles[p].radius, s.particles[p].radius);
+        for (int d = 0; d < 3; ++d) {
+            EXPECT_EQ(b.particles[p].x[d], s.particles[p].x[d]);
+            EXPECT_EQ(b.particles[p].velocity.U[d], s.particles[p].velocity.U[d]);
+            EXPECT_EQ(b.particles[p].velocity.omega[d], s.particles[p].velocity.omega[d]);
+        }
+    }
+    // dt goes with 10 significant digits (as it always did)
+    s.dt = 1.0 / 3.0;
+    EXPECT_EQ(Step::fromMessage(overTheWire(s)).dt, 0.3333333333);
+}
+
+TEST(TypedMessages, VolumesRoundTrip)
+{
+    Volumes v;
+    v.step = 7;
+    for (int p = 0; p < 3; ++p) {
+        ParticleVolume q;
+        q.Vu = value(2 * p);
+        q.Ju = value(2 * p + 1);
+        v.particles.push_back(q);
+    }
+    const Message m = overTheWire(v);
+    EXPECT_EQ(m.type, MessageType::Volumes);
+    EXPECT_EQ(m.width, uint32_t(layout::volumesWidth));
+    EXPECT_EQ(m.at(2, layout::volJu), value(5));
+    const Volumes b = Volumes::fromMessage(m, 3);
+    EXPECT_EQ(b.step, 7u);
+    for (int p = 0; p < 3; ++p) {
+        EXPECT_EQ(b.particles[p].Vu, v.particles[p].Vu);
+        EXPECT_EQ(b.particles[p].Ju, v.particles[p].Ju);
+    }
+    expectCouplerError([&] { Volumes::fromMessage(m, 4); }, {"Volumes (step 7)", "3 records of 2 values", "4 records of 2"});
+}
+
+TEST(TypedMessages, IntegralsRoundTrip)
+{
+    Integrals in;
+    in.step = 7;
+    in.iteration = 3;
+    for (int p = 0; p < 2; ++p) {
+        ForceTorque q;
+        for (int d = 0; d < 3; ++d) {
+            q.F[d] = value(10 * p + d);
+            q.T[d] = value(10 * p + 3 + d);
+        }
+        in.particles.push_back(q);
+    }
+    const Message m = overTheWire(in);
+    EXPECT_EQ(m.type, MessageType::Integrals);
+    EXPECT_EQ(m.width, uint32_t(layout::integralsWidth));
+    const Integrals b = Integrals::fromMessage(m, 2);
+    EXPECT_EQ(b.step, 7u);
+    EXPECT_EQ(b.iteration, 3u);
+    for (int p = 0; p < 2; ++p)
+        for (int d = 0; d < 3; ++d) {
+            EXPECT_EQ(b.particles[p].F[d], in.particles[p].F[d]);
+            EXPECT_EQ(b.particles[p].T[d], in.particles[p].T[d]);
+        }
+}
+
+TEST(TypedMessages, VelocitiesRoundTrip)
+{
+    Velocities v;
+    v.step = 9;
+    v.iteration = 12;
+    for (int p = 0; p < 4; ++p) {
+        RigidVelocity u;
+        for (int d = 0; d < 3; ++d) {
+            u.U[d] = value(6 * p + d);
+            u.omega[d] = value(6 * p + 3 + d);
+        }
+        v.particles.push_back(u);
+    }
+    const Message m = overTheWire(v);
+    EXPECT_EQ(m.width, uint32_t(layout::velocitiesWidth));
+    EXPECT_EQ(m.at(3, layout::vWz), value(23));
+    const Velocities b = Velocities::fromMessage(m, 4);
+    EXPECT_EQ(b.step, 9u);
+    EXPECT_EQ(b.iteration, 12u);
+    for (int p = 0; p < 4; ++p)
+        for (int d = 0; d < 3; ++d) {
+            EXPECT_EQ(b.particles[p].U[d], v.particles[p].U[d]);
+            EXPECT_EQ(b.particles[p].omega[d], v.particles[p].omega[d]);
+        }
+}
+
+TEST(TypedMessages, StepDoneRoundTripsWithAndWithoutStresslets)
+{
+    StepDone s;
+    s.step = 5;
+    s.iterations = 17;
+    s.residual = 1.0 / 3.0 * 1e-7;
+    s.converged = false;
+    for (int p = 0; p < 3; ++p) {
+        ForceTorque f;
+        Stresslet S;
+        for (int d = 0; d < 3; ++d) {
+            f.F[d] = value(13 * p + d);
+            f.T[d] = value(13 * p + 3 + d);
+        }
+        for (int c = 0; c < 6; ++c) S.S[c] = value(13 * p + 6 + c);
+        S.trace = value(13 * p + 12);
+        s.forces.push_back(f);
+        s.stresslets.push_back(S);
+    }
+    for (bool withStresslets : {true, false}) {
+        if (!withStresslets) s.stresslets.clear();
+        const Message m = overTheWire(s);
+        EXPECT_EQ(m.width, withStresslets ? 13u : 6u);
+        EXPECT_EQ(m.iteration, 17u);
+        const StepDone b = StepDone::fromMessage(m, withStresslets, 3);
+        EXPECT_EQ(b.step, 5u);
+        EXPECT_EQ(b.iterations, 17u);
+        EXPECT_EQ(b.residual, s.residual);  // all 17 digits
+        EXPECT_FALSE(b.converged);
+        ASSERT_EQ(b.forces.size(), 3u);
+        ASSERT_EQ(b.stresslets.size(), withStresslets ? 3u : 0u);
+        for (int p = 0; p < 3; ++p) {
+            for (int d = 0; d < 3; ++d) {
+                EXPECT_EQ(b.forces[p].F[d], s.forces[p].F[d]);
+                EXPECT_EQ(b.forces[p].T[d], s.forces[p].T[d]);
+            }
+            if (!withStresslets) continue;
+            for (int c = 0; c < 6; ++c) EXPECT_EQ(b.stresslets[p].S[c], s.stresslets[p].S[c]);
+            EXPECT_EQ(b.stresslets[p].trace, s.stresslets[p].trace);
+        }
+        // the other width is refused, naming both
+        expectCouplerError([&] { StepDone::fromMessage(m, !withStresslets, 3); },
+                           {"StepDone", withStresslets ? "of 13 values" : "of 6 values",
+                            withStresslets ? "of 6 were expected" : "of 13 were expected"});
+    }
+    s.stresslets.resize(1);  // stresslets for one particle of three
+    expectCouplerError([&] { s.toMessage(); }, {"1 stresslets for 3 particles"});
+}
+
+TEST(TypedMessages, FinishAndErrorRoundTrip)
+{
+    Finish f;
+    f.step = 77;
+    const Message fm = overTheWire(f);
+    EXPECT_EQ(fm.type, MessageType::Finish);
+    EXPECT_EQ(Finish::fromMessage(fm).step, 77u);
+    Error e;
+    e.text = "fdmFoam: the pressure solver diverged";
+    const Message em = overTheWire(e);
+    EXPECT_EQ(em.type, MessageType::Error);
+    EXPECT_EQ(Error::fromMessage(em).text, e.text);
+}
+
+TEST(TypedMessages, MalformedSizesAreRefusedNamingTheMessageAndTheSizes)
+{
+    // width: an Integrals record of 8 values (protocol 2's)
+    Message m = makeMessage(MessageType::Integrals, 4, 2, 3, 8);
+    expectCouplerError([&] { Integrals::fromMessage(m); },
+                       {"Integrals (step 4, iteration 2)", "3 records of 8 values",
+                        "of " + std::to_string(layout::integralsWidth) + " were expected"});
+    // count: 2 particles where 3 were announced
+    m = makeMessage(MessageType::Velocities, 4, 2, 2, layout::velocitiesWidth);
+    expectCouplerError([&] { Velocities::fromMessage(m, 3); }, {"Velocities", "2 records of 6 values", "3 records of 6"});
+    m = makeMessage(MessageType::Step, 1, 0, 2, layout::stepWidth, "dt=1 lastStep=2");
+    expectCouplerError([&] { Step::fromMessage(m, 1); }, {"Step", "2 records", "1 records of 11"});
+    // a Hello of another width, or of two records
+    m = makeMessage(MessageType::Hello, 0, 0, 1, 14, "role=fluid version=" + std::to_string(protocolVersion));
+    expectCouplerError([&] { FluidHello::fromMessage(m); }, {"Hello of the fluid solver", "1 records of 14 values", "38"});
+    m = makeMessage(MessageType::Hello, 0, 0, 2, layout::helloDemWidth, "role=dem");
+    expectCouplerError([&] { DemHello::fromMessage(m); }, {"Hello of fdmDEM", "2 records of 10 values"});
+    // data that does not hold count x width values (a message built by hand)
+    m = makeMessage(MessageType::Velocities, 1, 1, 2, layout::velocitiesWidth);
+    m.data.pop_back();
+    expectCouplerError([&] { Velocities::fromMessage(m); }, {"11 in all"});
+    // a Finish with records, an Error with records
+    expectCouplerError([&] { Finish::fromMessage(makeMessage(MessageType::Finish, 1, 0, 1, 1)); }, {"Finish"});
+    expectCouplerError([&] { Error::fromMessage(makeMessage(MessageType::Error, 0, 0, 1, 2)); }, {"Error"});
+    // another type altogether
+    expectCouplerError([&] { Integrals::fromMessage(makeMessage(MessageType::StepDone, 3, 1, 0, 0)); },
+                       {"expected Integrals, got StepDone"});
+    // StepDone text
+    m = makeMessage(MessageType::StepDone, 3, 1, 0, layout::stepDoneWidth, "iterations=1 residual=0 converged=maybe");
+    expectCouplerError([&] { StepDone::fromMessage(m, false); }, {"converged=maybe"});
+}
+
 // ---- socket -----------------------------------------------------------------------------------------
 
 TEST(Socket, PingPongOfAWholeTimeStep)
 {
     SocketPair pair;
     EXPECT_NE(pair.dem->describe().find("socket 127.0.0.1:"), std::string::npos);
-    pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=2 stresslets=1"));
-    EXPECT_EQ(pair.fluid->receive(MessageType::Hello).text, "role=dem version=2 stresslets=1");
+    pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=3 stresslets=1"));
+    EXPECT_EQ(pair.fluid->receive(MessageType::Hello).text, "role=dem version=3 stresslets=1");
     pair.dem->send(makeMessage(MessageType::Step, 1, 0, 2, layout::stepWidth));
     EXPECT_EQ(pair.fluid->receive(MessageType::Step).step, 1u);
+    pair.fluid->send(makeMessage(MessageType::Volumes, 1, 0, 2, layout::volumesWidth));
+    EXPECT_EQ(pair.dem->receive(MessageType::Volumes).width, uint32_t(layout::volumesWidth));
     for (uint32_t k = 1; k <= 5; ++k) {
         pair.fluid->send(sample(1, k));
         const Message in = pair.dem->receive(MessageType::Integrals);
@@ -672,8 +988,10 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     std::remove(record.c_str());
     {
         SocketPair pair(Options(), record);
-        pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=2 stresslets=1"));
+        pair.dem->send(makeMessage(MessageType::Hello, 0, 0, 1, layout::helloDemWidth, "role=dem version=3 stresslets=1"));
         pair.fluid->receive();
+        pair.fluid->send(makeMessage(MessageType::Volumes, 12, 0, 2, layout::volumesWidth));
+        pair.dem->receive();
         pair.fluid->send(sample(12, 3));
         pair.dem->receive();
     }
@@ -687,7 +1005,8 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     EXPECT_NE(out.find("dem -> fluid Hello"), std::string::npos) << out;
     EXPECT_NE(out.find("fluid -> dem   Integrals  step 12 iteration 3"), std::string::npos) << out;
     EXPECT_NE(out.find("0.75"), std::string::npos) << out;  // 1/1 - 0.25, first value
-    EXPECT_NE(out.find("2 messages"), std::string::npos) << out;
+    EXPECT_NE(out.find("fluid -> dem   Volumes    step 12 iteration 0  2 x 2"), std::string::npos) << out;
+    EXPECT_NE(out.find("3 messages"), std::string::npos) << out;
 
     {
         std::ofstream f(record.c_str(), std::ios::app | std::ios::binary);
@@ -697,5 +1016,5 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     out.clear();
     while (std::fgets(buf, sizeof buf, p)) out += buf;
     EXPECT_NE(0, WEXITSTATUS(pclose(p)));
-    EXPECT_NE(out.find("(message 3): truncated"), std::string::npos) << out;
+    EXPECT_NE(out.find("(message 4): truncated"), std::string::npos) << out;
 }

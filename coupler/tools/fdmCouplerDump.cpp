@@ -25,7 +25,7 @@ std::string sender(const Message& m)
 {
     switch (m.type) {
         case MessageType::Step: case MessageType::Velocities: case MessageType::Finish: return "dem";
-        case MessageType::Integrals: case MessageType::StepDone: return "fluid";
+        case MessageType::Volumes: case MessageType::Integrals: case MessageType::StepDone: return "fluid";
         case MessageType::Hello: return m.text.find("role=fluid") != std::string::npos ? "fluid" : "dem";
         default: return "?";
     }

@@ -1,6 +1,6 @@
 // The test harness of the particle side: writes a LIGGGHTS input, runs the real fdmDEM (serial or
 // mpirun) as a child process, and plays the fluid solver's part of the coupling protocol with
-// scripted integrals (a harness for the particle side, not a fluid solver).
+// scripted volumes and integrals (a harness for the particle side, not a fluid solver).
 #ifndef FDM_DEM_TEST_HARNESS_H
 #define FDM_DEM_TEST_HARNESS_H
 
@@ -114,7 +114,7 @@ DemRun runDEM(const std::string& dir, int ranks = 1)
 // ---- the scripted fluid peer ------------------------------------------------------------------------
 
 struct FakeFluid {
-    enum Mode { Normal, DieAfterStep, ErrorAfterStep, WrongTypeAfterStep, ZeroVolume, NaNIntegral };
+    enum Mode { Normal, DieAfterStep, ErrorAfterStep, WrongTypeAfterStep, ZeroVolume, NaNIntegral, ShortVolumes };
     Mode mode = Normal;
     cpl::Options options;
     long nExpected = -1;
@@ -127,8 +127,12 @@ struct FakeFluid {
     uint32_t iterations = 3;
 
     // what happened
-    cpl::Message demHello;
-    std::vector<cpl::Message> steps, integrals, velocities, stepDones;
+    cpl::DemHello demHello;
+    std::vector<cpl::Step> steps;
+    std::vector<cpl::Volumes> volumes;       // one per step
+    std::vector<cpl::Integrals> integrals;   // one per inner iteration
+    std::vector<cpl::Velocities> velocities;
+    std::vector<cpl::StepDone> stepDones;
     bool finished = false;
     std::string error;
     std::thread thread;
@@ -157,40 +161,66 @@ struct FakeFluid {
     }
     void join() { thread.join(); }
 
-    // Deterministic, particle- and iteration-dependent integrals (all SI).
+    // Deterministic, particle- and step-dependent volumes and particle- and iteration-dependent
+    // integrals (all SI).
     static double volume(double a) { return 4.0 / 3.0 * pi * a * a * a; }
-    cpl::Message makeIntegrals(const cpl::Message& step, uint32_t k) const
+    cpl::Volumes makeVolumes(const cpl::Step& step) const
     {
-        using namespace cpl::layout;
-        cpl::Message m = cpl::makeMessage(cpl::MessageType::Integrals, step.step, k, step.count, integralsWidth);
-        for (uint32_t p = 0; p < step.count; ++p) {
-            const double a = step.at(p, sRadius);
-            m.at(p, iVu) = volume(a) * (1.0 + 0.01 * k);
-            m.at(p, iJu) = 0.4 * a * a * m.at(p, iVu);
-            for (int d = 0; d < 3; ++d) {
-                m.at(p, iFx + d) = 0.1 * (p + 1) * (d + 1) * k - 0.3 + 0.01 * double(step.step);
-                m.at(p, iTx + d) = 0.02 * (p + 2) * (3 - d) - 0.05 * k;
-            }
+        cpl::Volumes m;
+        m.step = step.step;
+        m.particles.resize(step.particles.size());
+        for (size_t p = 0; p < step.particles.size(); ++p) {
+            const double a = step.particles[p].radius;
+            m.particles[p].Vu = volume(a) * (1.0 + 0.01 * double(step.step));
+            m.particles[p].Ju = 0.4 * a * a * m.particles[p].Vu;
         }
-        if (mode == ZeroVolume && k == 2) m.at(1, iVu) = 0.0;
-        if (mode == NaNIntegral && k == 2) m.at(2, iFy) = std::nan("");
+        if (mode == ZeroVolume) m.particles[1].Vu = 0.0;
+        if (mode == ShortVolumes) m.particles.pop_back();
         return m;
+    }
+    cpl::Integrals makeIntegrals(const cpl::Step& step, uint32_t k) const
+    {
+        cpl::Integrals m;
+        m.step = step.step;
+        m.iteration = k;
+        m.particles.resize(step.particles.size());
+        for (size_t p = 0; p < step.particles.size(); ++p)
+            for (int d = 0; d < 3; ++d) {
+                m.particles[p].F[d] = 0.1 * (p + 1) * (d + 1) * k - 0.3 + 0.01 * double(step.step);
+                m.particles[p].T[d] = 0.02 * (p + 2) * (3 - d) - 0.05 * k;
+            }
+        if (mode == NaNIntegral && k == 2) m.particles[2].F[1] = std::nan("");
+        return m;
+    }
+    // The Volumes of the step an Integrals or Velocities message belongs to.
+    const cpl::ParticleVolume& volumeOf(uint64_t step, size_t particle) const
+    {
+        for (const cpl::Volumes& v : volumes)
+            if (v.step == step) return v.particles.at(particle);
+        throw std::runtime_error("harness: no Volumes of step " + std::to_string(step));
     }
     static double hydro(uint32_t p, int c, uint64_t step) { return 10.0 * (p + 1) + c + 0.5 * double(step); }
 
     void run()
     {
         std::unique_ptr<cpl::Transport> t = cpl::listen(options);
-        demHello = t->receive(cpl::MessageType::Hello);
-        cpl::Message hello = cpl::makeMessage(cpl::MessageType::Hello, 0, 0, 1, cpl::layout::helloFluidWidth,
-                                              "role=fluid version=" + std::to_string(cpl::protocolVersion));
-        hello.data = {double(nExpected), alphaLambda, rhoFluid, delta, box[0], box[1], box[2], box[3], box[4], box[5],
-                      double(periodic[0]), double(periodic[1]), double(periodic[2]), viscosity};
-        for (int f = 0; f < 6; ++f) {
-            hello.data.push_back(periodic[f / 2] ? 0.0 : double(faceKind[f]));
-            for (int d = 0; d < 3; ++d) hello.data.push_back(periodic[f / 2] ? 0.0 : faceVelocity[f][d]);
+        demHello = cpl::DemHello::fromMessage(t->receive(cpl::MessageType::Hello));
+        cpl::FluidHello hello;
+        hello.nParticlesExpected = nExpected;
+        hello.alphaLambda = alphaLambda;
+        hello.rhoFluid = rhoFluid;
+        hello.delta = delta;
+        hello.viscosity = viscosity;
+        for (int d = 0; d < 3; ++d) {
+            hello.lo[d] = box[2 * d];
+            hello.hi[d] = box[2 * d + 1];
+            hello.periodic[d] = periodic[d] != 0;
         }
-        t->send(hello);
+        for (int f = 0; f < 6; ++f) {
+            hello.faces[f].kind = periodic[f / 2] ? cpl::layout::bPeriodic : faceKind[f];
+            for (int d = 0; d < 3; ++d) hello.faces[f].velocity[d] = periodic[f / 2] ? 0.0 : faceVelocity[f][d];
+        }
+        t->send(hello.toMessage());
         while (true) {
             cpl::Message m = t->receive();
             if (m.type == cpl::MessageType::Finish) {
@@ -198,33 +228,61 @@ struct FakeFluid {
                 return;
             }
             if (m.type != cpl::MessageType::Step) throw cpl::CouplerError("harness: got " + std::string(cpl::messageTypeName(m.type)));
-            steps.push_back(m);
+            steps.push_back(cpl::Step::fromMessage(m));
+            const cpl::Step& step = steps.back();
             if (mode == DieAfterStep) return;  // t goes out of scope: the socket closes as on a crash
             if (mode == ErrorAfterStep) {
-                t->sendError("fdmFoam: the pressure solver diverged at step " + std::to_string(m.step));
+                t->sendError("fdmFoam: the pressure solver diverged at step " + std::to_string(step.step));
                 return;
             }
             if (mode == WrongTypeAfterStep) {
-                t->send(cpl::makeMessage(cpl::MessageType::Velocities, m.step, 1, m.count, 6));
+                t->send(cpl::makeMessage(cpl::MessageType::Velocities, step.step, 1, m.count, 6));
+                t->receive();  // the DEM's Error
+                return;
+            }
+            volumes.push_back(makeVolumes(step));  // protocol 3: once per step, before the first Integrals
+            t->send(volumes.back().toMessage());
+            if (mode == ShortVolumes) {
                 t->receive();  // the DEM's Error
                 return;
             }
             for (uint32_t k = 1; k <= iterations; ++k) {
-                integrals.push_back(makeIntegrals(m, k));
-                t->send(integrals.back());
-                velocities.push_back(t->receive(cpl::MessageType::Velocities));
+                integrals.push_back(makeIntegrals(step, k));
+                t->send(integrals.back().toMessage());
+                velocities.push_back(cpl::Velocities::fromMessage(t->receive(cpl::MessageType::Velocities)));
             }
-            const bool stresslets = demHello.textValue("stresslets") == "1";
-            const uint32_t width = stresslets ? cpl::layout::stepDoneStressWidth : cpl::layout::stepDoneWidth;
-            cpl::Message done = cpl::makeMessage(cpl::MessageType::StepDone, m.step, iterations, m.count, width,
-                                                 "iterations=" + std::to_string(iterations) + " residual=1.25e-07 converged=1");
-            for (uint32_t p = 0; p < m.count; ++p)
-                for (uint32_t c = 0; c < width; ++c) done.at(p, c) = hydro(p, c, m.step);
+            cpl::StepDone done;
+            done.step = step.step;
+            done.iterations = iterations;
+            done.residual = 1.25e-07;
+            done.converged = true;
+            done.forces.resize(step.particles.size());
+            if (demHello.stresslets) done.stresslets.resize(step.particles.size());
+            for (uint32_t p = 0; p < step.particles.size(); ++p) {
+                for (int d = 0; d < 3; ++d) {
+                    done.forces[p].F[d] = hydro(p, d, step.step);
+                    done.forces[p].T[d] = hydro(p, 3 + d, step.step);
+                }
+                if (!demHello.stresslets) continue;
+                for (int c = 0; c < 6; ++c) done.stresslets[p].S[c] = hydro(p, 6 + c, step.step);
+                done.stresslets[p].trace = hydro(p, 12, step.step);
+            }
             stepDones.push_back(done);
-            t->send(done);
+            t->send(done.toMessage());
         }
     }
 };
+
+// The velocities of a message as one vector of 6N: (U, Omega) per particle.
+std::vector<double> flat(const cpl::Velocities& v)
+{
+    std::vector<double> u;
+    for (const cpl::RigidVelocity& p : v.particles) {
+        u.insert(u.end(), p.U, p.U + 3);
+        u.insert(u.end(), p.omega, p.omega + 3);
+    }
+    return u;
+}
 
 void expectContains(const std::string& text, const std::string& needle)
 {
@@ -282,8 +340,8 @@ void expectSameRunOnOneAndTwoRanks(const std::string& name, const Scene& scene, 
         const DemRun run = runWithFluid(dir, scene, fluid, ranks);
         ASSERT_EQ(run.status, 0) << run.output;
         if (ranks == 2) expectContains(run.output, twoRankNeedle);
-        results[ranks - 1] = fluid.velocities;
-        results[ranks - 1].insert(results[ranks - 1].end(), fluid.steps.begin(), fluid.steps.end());
+        for (const cpl::Velocities& v : fluid.velocities) results[ranks - 1].push_back(v.toMessage());
+        for (const cpl::Step& s : fluid.steps) results[ranks - 1].push_back(s.toMessage());
     }
     ASSERT_EQ(results[0].size(), results[1].size());
     for (size_t m = 0; m < results[0].size(); ++m) {

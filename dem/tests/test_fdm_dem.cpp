@@ -35,29 +35,29 @@ void garbageServer(const std::string& portFile, std::string& problem)
 // with R^SG = 0 is diagonal, particle by particle.
 void expectAnalyticVelocities(const FakeFluid& fluid, const Scene& scene, const double g[3], const double fext[3])
 {
-    using namespace cpl::layout;
     ASSERT_EQ(fluid.velocities.size(), fluid.integrals.size());
     ASSERT_FALSE(fluid.velocities.empty());
     for (size_t m = 0; m < fluid.velocities.size(); ++m) {
-        const cpl::Message& in = fluid.integrals[m];
-        const cpl::Message& out = fluid.velocities[m];
+        const cpl::Integrals& in = fluid.integrals[m];
+        const cpl::Velocities& out = fluid.velocities[m];
         EXPECT_EQ(out.step, in.step);
         EXPECT_EQ(out.iteration, in.iteration);
-        ASSERT_EQ(out.count, scene.spheres.size());
-        ASSERT_EQ(out.width, uint32_t(velocitiesWidth));
-        for (uint32_t p = 0; p < out.count; ++p) {
+        ASSERT_EQ(out.particles.size(), scene.spheres.size());
+        for (uint32_t p = 0; p < out.particles.size(); ++p) {
             const Sphere& s = scene.spheres[p];
             const double mass = s.density * FakeFluid::volume(s.radius);
             const double buoyant = (s.density - fluid.rhoFluid) / s.density * mass;
+            const cpl::ForceTorque& q = in.particles[p];
+            const cpl::ParticleVolume& v = fluid.volumeOf(in.step, p);
+            const cpl::RigidVelocity& u = out.particles[p];
             for (int d = 0; d < 3; ++d) {
-                const double U = fluid.alphaLambda * (in.at(p, iFx + d) + buoyant * g[d] + fext[d]) /
-                                 (fluid.rhoFluid * in.at(p, iVu));
-                const double W = fluid.alphaLambda * in.at(p, iTx + d) / (fluid.rhoFluid * in.at(p, iJu));
-                EXPECT_LT(relativeDifference(out.at(p, vUx + d), U), 1e-12)
+                const double U = fluid.alphaLambda * (q.F[d] + buoyant * g[d] + fext[d]) / (fluid.rhoFluid * v.Vu);
+                const double W = fluid.alphaLambda * q.T[d] / (fluid.rhoFluid * v.Ju);
+                EXPECT_LT(relativeDifference(u.U[d], U), 1e-12)
                     << "particle " << p + 1 << " U" << "xyz"[d] << " step " << out.step << " iteration " << out.iteration
-                    << ": " << out.at(p, vUx + d) << " vs " << U;
-                EXPECT_LT(relativeDifference(out.at(p, vWx + d), W), 1e-12)
-                    << "particle " << p + 1 << " Omega" << "xyz"[d] << ": " << out.at(p, vWx + d) << " vs " << W;
+                    << ": " << u.U[d] << " vs " << U;
+                EXPECT_LT(relativeDifference(u.omega[d], W), 1e-12)
+                    << "particle " << p + 1 << " Omega" << "xyz"[d] << ": " << u.omega[d] << " vs " << W;
             }
         }
     }
@@ -99,31 +99,31 @@ TEST(FdmDEM, VelocitiesAreTheAnalyticSolutionOfEq31)
     const double g[3] = {0, 0, -9.81}, fext[3] = {0.5, -0.25, 0.125};
     expectAnalyticVelocities(fluid, scene, g, fext);
     ASSERT_EQ(fluid.steps.size(), 2u);
+    EXPECT_EQ(fluid.volumes.size(), 2u);     // once per step
     EXPECT_EQ(fluid.velocities.size(), 6u);  // 2 steps x 3 inner iterations
 
     // Hello: N, box, periodicity, dt
-    EXPECT_EQ(fluid.demHello.at(0, 0), 3.0);
-    EXPECT_EQ(fluid.demHello.at(0, 2), 8.0);
-    EXPECT_EQ(fluid.demHello.at(0, 7), 1.0);
-    EXPECT_DOUBLE_EQ(fluid.demHello.textNumber("dt"), 0.01);
-    EXPECT_EQ(fluid.demHello.textNumber("lastStep"), 2.0);
+    EXPECT_EQ(fluid.demHello.nParticles, 3);
+    EXPECT_EQ(fluid.demHello.hi[0], 8.0);
+    EXPECT_TRUE(fluid.demHello.periodic[0]);
+    EXPECT_DOUBLE_EQ(fluid.demHello.dt, 0.01);
+    EXPECT_EQ(fluid.demHello.lastStep, 2);
 
     // Step 1: particles by tag, with their radius; step 2: moved by dt * (U of the last inner
     // iteration of step 1), and U, Omega in the record are those velocities.
-    using namespace cpl::layout;
-    const cpl::Message &s1 = fluid.steps[0], &s2 = fluid.steps[1];
+    const cpl::Step &s1 = fluid.steps[0], &s2 = fluid.steps[1];
     EXPECT_EQ(s1.step, 1u);
     EXPECT_EQ(s2.step, 2u);
-    const cpl::Message& last1 = fluid.velocities[2];
+    const cpl::Velocities& last1 = fluid.velocities[2];
     for (uint32_t p = 0; p < 3; ++p) {
-        EXPECT_EQ(s1.at(p, sTag), p + 1.0);
-        EXPECT_DOUBLE_EQ(s1.at(p, sRadius), scene.spheres[p].radius);
+        EXPECT_EQ(s1.particles[p].tag, p + 1);
+        EXPECT_DOUBLE_EQ(s1.particles[p].radius, scene.spheres[p].radius);
         const double x0[3] = {scene.spheres[p].x, scene.spheres[p].y, scene.spheres[p].z};
         for (int d = 0; d < 3; ++d) {
-            EXPECT_DOUBLE_EQ(s1.at(p, sX + d), x0[d]) << "moved before any velocity was solved";
-            EXPECT_NEAR(s2.at(p, sX + d), x0[d] + scene.dt * last1.at(p, vUx + d), 1e-12);
-            EXPECT_EQ(s2.at(p, sUx + d), last1.at(p, vUx + d));
-            EXPECT_EQ(s2.at(p, sWx + d), last1.at(p, vWx + d));
+            EXPECT_DOUBLE_EQ(s1.particles[p].x[d], x0[d]) << "moved before any velocity was solved";
+            EXPECT_NEAR(s2.particles[p].x[d], x0[d] + scene.dt * last1.particles[p].U[d], 1e-12);
+            EXPECT_EQ(s2.particles[p].velocity.U[d], last1.particles[p].U[d]);
+            EXPECT_EQ(s2.particles[p].velocity.omega[d], last1.particles[p].omega[d]);
         }
     }
 
@@ -165,9 +165,9 @@ TEST(FdmDEM, MoveNoHoldsTheParticlesAndTheConnectionOutlivesARun)
     ASSERT_EQ(run.status, 0) << run.output;
     ASSERT_EQ(fluid.steps.size(), 4u);  // one connection for three runs
     EXPECT_TRUE(fluid.finished);
-    EXPECT_EQ(fluid.steps[1].at(0, cpl::layout::sX), 2.0);   // not moved although U != 0
-    EXPECT_EQ(fluid.steps[2].at(0, cpl::layout::sX), 3.25);  // where the input put it
-    EXPECT_EQ(fluid.steps[3].at(0, cpl::layout::sX), 3.25);
+    EXPECT_EQ(fluid.steps[1].particles[0].x[0], 2.0);   // not moved although U != 0
+    EXPECT_EQ(fluid.steps[2].particles[0].x[0], 3.25);  // where the input put it
+    EXPECT_EQ(fluid.steps[3].particles[0].x[0], 3.25);
     EXPECT_EQ(fluid.steps[3].step, 4u);
     expectContains(run.output, "fdm/couple timing total (3 runs, 4 steps");
 }
@@ -191,12 +191,13 @@ TEST(FdmDEM, FileTransportAndRecordGiveTheSameRun)
     ASSERT_EQ(run.status, 0) << run.output;
     const double g[3] = {0, 0, -9.81}, fext[3] = {0.5, -0.25, 0.125};
     expectAnalyticVelocities(fluid, scene, g, fext);
-    // the record holds the whole conversation: 2 Hello, 2 Step, 6 Integrals, 6 Velocities, 2 StepDone, Finish
+    // the record holds the whole conversation: 2 Hello, 2 Step, 2 Volumes, 6 Integrals, 6 Velocities,
+    // 2 StepDone, Finish
     std::ifstream in((dir + "/coupling.record").c_str(), std::ios::binary);
     std::vector<unsigned char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     size_t at = 0, n = 0;
     while (at + cpl::headerSize <= b.size()) { at += cpl::encodedSize(&b[at]); ++n; }
-    EXPECT_EQ(n, 19u);
+    EXPECT_EQ(n, 21u);
 }
 
 // ---- bad input: a clear error naming the particle or value, a non-zero exit, within seconds ----------
@@ -336,7 +337,7 @@ TEST(FdmDEMErrors, FluidSendsAnUnexpectedMessage)
 {
     Scene scene;
     expectFailure("wrongType", scene, [](FakeFluid& f) { f.mode = FakeFluid::WrongTypeAfterStep; },
-                  "expected Integrals or StepDone from the fluid solver, got Velocities (step 1)");
+                  "expected Volumes from the fluid solver, got Velocities (step 1)");
 }
 
 TEST(FdmDEMErrors, FluidSendsGarbage)
@@ -359,6 +360,13 @@ TEST(FdmDEMErrors, ParticleWithNoFluidVolume)
     Scene scene;
     expectFailure("zeroVolume", scene, [](FakeFluid& f) { f.mode = FakeFluid::ZeroVolume; },
                   "particle 2 at (6, 5, 3.5) with radius 0.7: the fluid's indicator function gives it no volume (Vu 0");
+}
+
+TEST(FdmDEMErrors, VolumesOfTheWrongSize)
+{
+    Scene scene;
+    expectFailure("shortVolumes", scene, [](FakeFluid& f) { f.mode = FakeFluid::ShortVolumes; },
+                  "Volumes (step 1) has 2 records of 2 values (4 in all) where 3 records of 2 were expected");
 }
 
 TEST(FdmDEMErrors, NonFiniteIntegral)

@@ -60,24 +60,25 @@ Expected subgridMatrix(const Scene& scene, const FakeFluid& fluid)
 // The velocities of Eq. (31) with R^SG: [D + R] u = F, for every inner iteration the peer saw.
 void expectSolution(const FakeFluid& fluid, const Scene& scene, const Expected& e, double tolerance)
 {
-    using namespace cpl::layout;
     ASSERT_EQ(fluid.velocities.size(), fluid.integrals.size());
     ASSERT_FALSE(fluid.velocities.empty());
     const int n = int(scene.spheres.size());
     for (size_t m = 0; m < fluid.velocities.size(); ++m) {
-        const cpl::Message &in = fluid.integrals[m], &out = fluid.velocities[m];
+        const cpl::Integrals& in = fluid.integrals[m];
+        const cpl::Velocities& out = fluid.velocities[m];
         Eigen::MatrixXd A = e.R;
         Eigen::VectorXd F = e.wallRhs;
         for (int p = 0; p < n; ++p)
             for (int d = 0; d < 3; ++d) {
-                A(6 * p + d, 6 * p + d) += fluid.rhoFluid * in.at(p, iVu) / fluid.alphaLambda;
-                A(6 * p + 3 + d, 6 * p + 3 + d) += fluid.rhoFluid * in.at(p, iJu) / fluid.alphaLambda;
-                F(6 * p + d) += in.at(p, iFx + d);
-                F(6 * p + 3 + d) += in.at(p, iTx + d);
+                A(6 * p + d, 6 * p + d) += fluid.rhoFluid * fluid.volumeOf(in.step, p).Vu / fluid.alphaLambda;
+                A(6 * p + 3 + d, 6 * p + 3 + d) += fluid.rhoFluid * fluid.volumeOf(in.step, p).Ju / fluid.alphaLambda;
+                F(6 * p + d) += in.particles[p].F[d];
+                F(6 * p + 3 + d) += in.particles[p].T[d];
             }
         const Eigen::VectorXd u = A.ldlt().solve(F);
+        const std::vector<double> got = flat(out);
         for (int k = 0; k < 6 * n; ++k)
-            EXPECT_NEAR(out.data[k], u(k), tolerance * u.cwiseAbs().maxCoeff())
+            EXPECT_NEAR(got[k], u(k), tolerance * u.cwiseAbs().maxCoeff())
                 << "unknown " << k << " (particle " << k / 6 + 1 << ") step " << out.step << " iteration " << out.iteration;
     }
 }
@@ -142,9 +143,9 @@ TEST(PairFdmSubgrid, SubgridBlocksEnterEq31AndObeyNewtonsThirdLaw)
     // the sub-grid force of the last step, F^SG = -R^SG u: equal and opposite on the two unequal spheres
     const auto rows = readDump(dir + "/sg.dump", 13);
     ASSERT_EQ(rows.size(), 3u);
-    const cpl::Message& last = fluid.velocities.back();
+    const std::vector<double> last = flat(fluid.velocities.back());
     Eigen::VectorXd u(18);
-    for (int k = 0; k < 18; ++k) u(k) = last.data[k];
+    for (int k = 0; k < 18; ++k) u(k) = last[k];
     const Eigen::VectorXd F = -e.R * u;
     double scale = 0;
     for (int d = 0; d < 3; ++d) {
@@ -232,9 +233,9 @@ TEST(PairFdmSubgrid, MovingWallBlockEntersEq31)
     // F^SG = -R_w (U - U_w, Omega)
     const auto rows = readDump(dir + "/w.dump", 13);
     ASSERT_EQ(rows.size(), 2u);
-    const cpl::Message& last = fluid.velocities.back();
+    const std::vector<double> last = flat(fluid.velocities.back());
     double relative[6];
-    for (int k = 0; k < 6; ++k) relative[k] = last.data[k] - (k < 3 ? wallU[k] : 0.0);
+    for (int k = 0; k < 6; ++k) relative[k] = last[k] - (k < 3 ? wallU[k] : 0.0);
     for (int i = 0; i < 6; ++i) {
         double F = 0;
         for (int k = 0; k < 6; ++k) F -= b.R[i][k] * relative[k];
@@ -252,18 +253,18 @@ TEST(PairFdmSubgrid, StressletsAreFluidPlusSubgridPlusContact)
     FakeFluid fluid(dir);
     const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
-    EXPECT_EQ(fluid.demHello.textValue("stresslets"), "1");
+    EXPECT_TRUE(fluid.demHello.stresslets);
     const Expected e = subgridMatrix(scene, fluid);
     ASSERT_EQ(e.pairBlocks.size(), 1u);
     const auto rows = readDump(dir + "/s.dump", 26);
     ASSERT_EQ(rows.size(), 3u);
-    const cpl::Message& last = fluid.velocities.back();
+    const std::vector<double> last = flat(fluid.velocities.back());
     const uint64_t step = fluid.stepDones.back().step;
     // S^SG_a = -(G u + H Omega): rows 0-5 particle 1, 6-11 particle 2, 12-13 the traces
     const res::PairBlock& b = e.pairBlocks[0];
     for (int row = 0; row < 14; ++row) {
         double sg = 0;
-        for (int k = 0; k < 12; ++k) sg -= b.stress[row][k] * last.data[k];
+        for (int k = 0; k < 12; ++k) sg -= b.stress[row][k] * last[k];
         const int who = row < 12 ? row / 6 : row - 12, component = row < 12 ? row % 6 : 6;
         const double fluidPart = FakeFluid::hydro(who, 6 + component, step);
         EXPECT_NEAR(rows[who][1 + 12 + component], fluidPart + sg, 1e-7 * (std::fabs(sg) + std::fabs(fluidPart)))
@@ -299,12 +300,13 @@ TEST(PairFdmSubgrid, ContactForcesAreEqualOppositeAndEnterEq31)
         EXPECT_EQ(rows[2][1 + d], 0.0);
     }
     // Eq. (31) with R^SG = 0: U = alpha (F_fluid + F_c)/(rho_f Vu)
-    using namespace cpl::layout;
-    const cpl::Message &in = fluid.integrals.back(), &out = fluid.velocities.back();
+    const cpl::Integrals& in = fluid.integrals.back();
+    const cpl::Velocities& out = fluid.velocities.back();
     for (int p = 0; p < 2; ++p)
         for (int d = 0; d < 3; ++d) {
-            const double U = fluid.alphaLambda * (in.at(p, iFx + d) + rows[p][1 + d]) / (fluid.rhoFluid * in.at(p, iVu));
-            EXPECT_NEAR(out.at(p, d), U, 1e-10 * std::fabs(U) + 1e-14);
+            const double U = fluid.alphaLambda * (in.particles[p].F[d] + rows[p][1 + d]) /
+                             (fluid.rhoFluid * fluid.volumeOf(in.step, p).Vu);
+            EXPECT_NEAR(out.particles[p].U[d], U, 1e-10 * std::fabs(U) + 1e-14);
         }
     // contact stresslet, Eq. (52): S^c_p = 1/2 a_p/(a_1+a_2) (F ⊗ x + x ⊗ F), x = x_p' - x_p
     const double r = 1.2 * 1.01, weight[2] = {0.5 / 1.2, 0.7 / 1.2};

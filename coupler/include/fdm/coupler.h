@@ -1,7 +1,8 @@
 // fdm/coupler.h -- the thin library that the fluid solver (fdmFoam) and the particle code
-// (fdmDEM, LIGGGHTS) both link. A versioned message format and two transports (TCP socket
-// between the two master ranks, or a shared directory of message files for debugging and
-// replay). Nothing else: no physics, no MPI. See docs/coupling.md for the protocol.
+// (fdmDEM, LIGGGHTS) both link. A versioned message format, one typed struct per message that
+// packs and unpacks its records, and two transports (TCP socket between the two master ranks, or
+// a shared directory of message files for debugging and replay). Nothing else: no physics, no
+// MPI. See docs/coupling.md for the protocol.
 //
 // Must stay C++11: OpenFOAM v1912 code includes it.
 #ifndef FDM_COUPLER_H
@@ -20,11 +21,14 @@ namespace coupler {
 // version is refused at the handshake with both versions in the message.
 // 2: fluid Hello gains the viscosity and the box faces' boundaries; DEM Hello asks for
 //    stresslets; StepDone may carry them (for the sub-grid lubrication pair style).
-const uint16_t protocolVersion = 2;
+// 3: Vu and Ju (they depend only on the positions) go once per time step in the new Volumes
+//    message, before the first Integrals; Integrals keep F and T only (6 values per particle).
+const uint16_t protocolVersion = 3;
 
 enum class MessageType : uint16_t {
     Hello      = 1,  // handshake, once per connection, each side sends one
     Step       = 2,  // DEM -> fluid: particle positions/radii/velocities, once per time step
+    Volumes    = 8,  // fluid -> DEM: Vu, Ju of every particle, once per time step (protocol 3)
     Integrals  = 3,  // fluid -> DEM: per-particle integrals of Eq. (38), every inner iteration
     Velocities = 4,  // DEM -> fluid: rigid velocities (U_p, Omega_p), every inner iteration
     StepDone   = 5,  // fluid -> DEM: inner iterations converged, hydrodynamic force/torque
@@ -63,6 +67,11 @@ namespace layout {
     //   text: "role=dem version=<v> dt=<s> lastStep=<n> stresslets=<0|1>"
     //   (stresslets=1: the DEM side wants the FDM stresslets in StepDone)
     //   one record: [nParticles, xlo, xhi, ylo, yhi, zlo, zhi, periodicX, periodicY, periodicZ]
+    enum HelloDemField {
+        hdNParticles = 0,
+        hdXlo = 1,        // xlo, xhi, ylo, yhi, zlo, zhi at hdXlo + 2d, hdXlo + 2d + 1
+        hdPeriodic = 7    // periodic in direction d at hdPeriodic + d
+    };
     // Hello from the fluid side. text: "role=fluid version=<v>"
     //   one record, 38 values:
     //    0      nParticlesExpected (-1 = any)
@@ -98,12 +107,16 @@ namespace layout {
     // Step: one record per particle, ordered by tag (tags 1..N). text: "dt=<s> lastStep=<n>"
     enum StepField { sTag, sX, sY, sZ, sRadius, sUx, sUy, sUz, sWx, sWy, sWz, stepWidth };
 
-    // Integrals: one record per particle (same order as Step), all in SI units:
+    // Volumes: once per time step, after Step and before the first Integrals; one record per
+    // particle (same order as Step), from the fluid's indicator function I_u:
     //   Vu = int I_u dV                               -> (rho_f/rho_p) M_p = rho_f Vu
     //   Ju = int I_u (2/3)|x-x_p|^2 dV                -> (rho_f/rho_p) J_p = rho_f Ju
+    enum VolumeField { volVu, volJu, volumesWidth };
+
+    // Integrals: every inner iteration, one record per particle, all in SI units:
     //   F  = rho_f int (I_u u*/alpha - I_lambda lambda^n) dV               (Eq. 32)
     //   T  = rho_f int (x-x_p) x (I_u u*/alpha - I_lambda lambda^n) dV     (Eq. 32)
-    enum IntegralField { iVu, iJu, iFx, iFy, iFz, iTx, iTy, iTz, integralsWidth };
+    enum IntegralField { iFx, iFy, iFz, iTx, iTy, iTz, integralsWidth };
 
     // Velocities: one record per particle: [Ux, Uy, Uz, Wx, Wy, Wz]
     enum VelocityField { vUx, vUy, vUz, vWx, vWy, vWz, velocitiesWidth };
@@ -129,6 +142,146 @@ namespace layout {
 class CouplerError : public std::runtime_error {
 public:
     explicit CouplerError(const std::string& what) : std::runtime_error(what) {}
+};
+
+// ---- Typed messages -----------------------------------------------------------------------------
+// One struct per message: toMessage() packs it, fromMessage() checks the type, the record count and
+// width and unpacks it, throwing a CouplerError that names the message and the sizes. They are the
+// only code that indexes records (with the layout above): the two codes use these. A negative
+// expectedCount accepts any number of particles.
+
+// Hello from the particle code (fdmDEM).
+struct DemHello {
+    int version = protocolVersion;
+    double dt = 0;             // DEM time step [s] (sent with 10 significant digits)
+    long long lastStep = 0;    // last step of the current run
+    bool stresslets = false;   // StepDone must carry the FDM stresslets
+    long long nParticles = 0;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the box [m]
+    bool periodic[3] = {false, false, false};
+
+    Message toMessage() const;
+    // stresslets= is required and read tolerantly: 0|1 as any number, true/false, yes/no, on/off.
+    static DemHello fromMessage(const Message& m);
+};
+
+// One face of the box as the fluid case bounds it (fluid Hello).
+struct BoxFace {
+    int kind = layout::bOther;                 // layout::BoundaryKind
+    double velocity[3] = {0, 0, 0};            // wall velocity [m/s] (kind bWall), else 0
+};
+
+// Hello from the fluid solver (fdmFoam).
+struct FluidHello {
+    int version = protocolVersion;
+    long long nParticlesExpected = -1;         // -1: any
+    double alphaLambda = 0;                    // [s]
+    double rhoFluid = 0;                       // [kg/m3]
+    double delta = 0;                          // mesh size [m]
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    bool periodic[3] = {false, false, false};
+    double viscosity = 0;                      // eta = rho_f nu [Pa s]
+    BoxFace faces[layout::nFaces];             // xlo, xhi, ylo, yhi, zlo, zhi
+
+    Message toMessage() const;
+    static FluidHello fromMessage(const Message& m);
+};
+
+// Per particle: rigid-body velocity (Step, Velocities).
+struct RigidVelocity {
+    double U[3];
+    double omega[3];
+};
+
+// Per particle: force and torque (Integrals, StepDone).
+struct ForceTorque {
+    double F[3];
+    double T[3];
+};
+
+// Step: the particles of DEM time step `step`, by tag 1..N.
+struct StepParticle {
+    long long tag;
+    double x[3];
+    double radius;
+    RigidVelocity velocity;
+};
+struct Step {
+    uint64_t step = 0;
+    double dt = 0;                             // [s] (sent with 10 significant digits)
+    long long lastStep = 0;
+    std::vector<StepParticle> particles;
+
+    Message toMessage() const;
+    static Step fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// Volumes of the time step `step` (they depend only on the positions): Eq. (31)'s diagonal.
+struct ParticleVolume {
+    double Vu, Ju;
+};
+struct Volumes {
+    uint64_t step = 0;
+    std::vector<ParticleVolume> particles;
+
+    Message toMessage() const;
+    static Volumes fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// Integrals of inner iteration `iteration`: the fluid part of F^tot (Eqs. 32, 38).
+struct Integrals {
+    uint64_t step = 0;
+    uint32_t iteration = 0;
+    std::vector<ForceTorque> particles;
+
+    Message toMessage() const;
+    static Integrals fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// Velocities: the solution of Eq. (31) for inner iteration `iteration`.
+struct Velocities {
+    uint64_t step = 0;
+    uint32_t iteration = 0;
+    std::vector<RigidVelocity> particles;
+
+    Message toMessage() const;
+    static Velocities fromMessage(const Message& m, long expectedCount = -1);
+};
+
+// The FDM stresslet of Eq. (12) [N m]: traceless S (xx xy xz yy yz zz) and the trace s.
+struct Stresslet {
+    double S[6];
+    double trace;
+};
+
+// StepDone: the inner iterations of `step` ended; hydrodynamic force and torque (Eq. 7) and, if the
+// DEM Hello asked for them, the stresslets.
+struct StepDone {
+    uint64_t step = 0;
+    uint32_t iterations = 0;
+    double residual = 0;                       // lambda residual of the last inner iteration
+    bool converged = false;
+    std::vector<ForceTorque> forces;
+    std::vector<Stresslet> stresslets;         // empty, or one per particle
+
+    Message toMessage() const;                 // stepDoneStressWidth wide if stresslets are given
+    static StepDone fromMessage(const Message& m, bool withStresslets, long expectedCount = -1);
+};
+
+// Finish: no more steps.
+struct Finish {
+    uint64_t step = 0;
+
+    Message toMessage() const;
+    static Finish fromMessage(const Message& m);
+};
+
+// Error: the sender stops; text says why.
+struct Error {
+    std::string text;
+
+    Message toMessage() const;
+    static Error fromMessage(const Message& m);
 };
 
 struct Options {

@@ -1,7 +1,6 @@
 #include "fluidCoupling.H"
 #include "Pstream.H"
 #include "OSspecific.H"
-#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -14,40 +13,6 @@ namespace
     {
         using namespace std::chrono;
         return duration<double>(steady_clock::now().time_since_epoch()).count();
-    }
-
-    std::string number(double x)
-    {
-        char buf[32];
-        std::snprintf(buf, sizeof(buf), "%.17g", x);
-        return buf;
-    }
-
-    Foam::List<Foam::scalar> toList(const std::vector<double>& v)
-    {
-        Foam::List<Foam::scalar> l(v.size());
-        forAll(l, i) { l[i] = v[i]; }
-        return l;
-    }
-
-    // A 0|1 flag of a peer's text, read tolerantly: any number equal to 0 or
-    // 1, or true/false, yes/no, on/off in any case. False if it is none.
-    bool readFlag(std::string v, bool& flag)
-    {
-        for (char& c : v)
-        {
-            c = char(std::tolower(static_cast<unsigned char>(c)));
-        }
-        if (v == "true" || v == "yes" || v == "on") { flag = true; return true; }
-        if (v == "false" || v == "no" || v == "off") { flag = false; return true; }
-        char* end = nullptr;
-        const double x = std::strtod(v.c_str(), &end);
-        if (v.empty() || *end != '\0' || (x != 0 && x != 1))
-        {
-            return false;
-        }
-        flag = (x == 1);
-        return true;
     }
 
     const char* boxFaceName[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
@@ -66,7 +31,8 @@ Foam::fluidCoupling::fluidCoupling(const Time& runTime, const dictionary& dict)
     lastStep_(-1),
     dt_(0),
     nParticles_(0),
-    stresslets_(false)
+    stresslets_(false),
+    volumesSent_(false)
 {
     if (!Pstream::master())
     {
@@ -141,7 +107,7 @@ void Foam::fluidCoupling::fatal(const string& message)
 }
 
 
-Foam::List<Foam::scalar> Foam::fluidCoupling::boxFaces
+std::vector<fdm::coupler::BoxFace> Foam::fluidCoupling::boxFaces
 (
     const uniformCartesianMesh& grid,
     const volVectorField& U,
@@ -215,7 +181,7 @@ Foam::List<Foam::scalar> Foam::fluidCoupling::boxFaces
     // Per box face: the kind its patches share (other if they differ), and
     // the wall velocity
     const List<labelList> facePatches = grid.boxFacePatches();
-    List<scalar> result(layout::nFaces*layout::faceWidth, 0.0);
+    std::vector<cpl::BoxFace> result(layout::nFaces);
     forAll(facePatches, f)
     {
         const labelList& onFace = facePatches[f];
@@ -252,11 +218,11 @@ Foam::List<Foam::scalar> Foam::fluidCoupling::boxFaces
                 }
             }
         }
-        scalar* rec = &result[layout::faceWidth*f];
-        rec[layout::fKind] = k;
-        rec[layout::fUx] = Uw.x();
-        rec[layout::fUy] = Uw.y();
-        rec[layout::fUz] = Uw.z();
+        result[f].kind = k;
+        for (direction d = 0; d < 3; ++d)
+        {
+            result[f].velocity[d] = Uw[d];
+        }
     }
     return result;
 }
@@ -276,7 +242,7 @@ void Foam::fluidCoupling::handshake
 
     // Collective: every processor, before the master talks
     string boundaryProblem;
-    const List<scalar> faces = boxFaces(grid, U, boundaryProblem);
+    const std::vector<cpl::BoxFace> faces = boxFaces(grid, U, boundaryProblem);
 
     string problem;
     label stresslets = 0;
@@ -285,29 +251,27 @@ void Foam::fluidCoupling::handshake
         const double t0 = wallClock();
         try
         {
-            cpl::Message hello = transport_->receive(cpl::MessageType::Hello);
-            const int version = int(hello.textNumber("version"));
-            if (version != cpl::protocolVersion)
+            const cpl::Message m = transport_->receive(cpl::MessageType::Hello);
+            cpl::DemHello hello;
+            try
             {
-                problem = "coupling protocol version mismatch: fdmDEM speaks "
-                    + Foam::name(version) + ", fdmFoam speaks "
-                    + Foam::name(label(cpl::protocolVersion));
+                hello = cpl::DemHello::fromMessage(m);
             }
-            else if (hello.count != 1 || hello.width < layout::helloDemWidth)
+            catch (const cpl::CouplerError& e)
             {
-                problem = "malformed Hello from fdmDEM";
+                problem = e.what();
             }
-            else
+            if (problem.empty())
             {
-                nParticles_ = label(hello.at(0, 0));
+                nParticles_ = label(hello.nParticles);
                 const boundBox& bb = grid.bounds();
                 const char* axis = "xyz";
                 for (direction d = 0; d < 3 && problem.empty(); ++d)
                 {
-                    const scalar lo = hello.at(0, 1 + 2*d);
-                    const scalar hi = hello.at(0, 2 + 2*d);
+                    const scalar lo = hello.lo[d];
+                    const scalar hi = hello.hi[d];
                     const scalar tol = 1e-9*max(mag(bb.span()[d]), 1.0);
-                    const bool periodic = hello.at(0, 7 + d) != 0;
+                    const bool periodic = hello.periodic[d];
                     OStringStream os;
                     if (mag(lo - bb.min()[d]) > tol || mag(hi - bb.max()[d]) > tol)
                     {
@@ -341,31 +305,7 @@ void Foam::fluidCoupling::handshake
                         "but the LIGGGHTS input has "
                         + Foam::name(nParticles_);
                 }
-
-                // Protocol 2 always says whether StepDone carries stresslets
-                std::string value;
-                bool found = true, flag = false;
-                try
-                {
-                    value = hello.textValue("stresslets");
-                }
-                catch (const cpl::CouplerError&)
-                {
-                    found = false;
-                }
-                if (problem.empty() && !found)
-                {
-                    problem = "the Hello of fdmDEM has no stresslets= entry"
-                        " (text: \"" + hello.text + "\"), which coupling"
-                        " protocol " + Foam::name(label(cpl::protocolVersion))
-                      + " requires";
-                }
-                else if (problem.empty() && !readFlag(value, flag))
-                {
-                    problem = "the Hello of fdmDEM says stresslets=" + value
-                      + ", which is not 0 or 1";
-                }
-                stresslets = flag ? 1 : 0;
+                stresslets = hello.stresslets ? 1 : 0;
             }
             if (problem.empty())
             {
@@ -374,31 +314,24 @@ void Foam::fluidCoupling::handshake
 
             if (problem.empty())
             {
-                cpl::Message reply = cpl::makeMessage
-                (
-                    cpl::MessageType::Hello, 0, 0, 1,
-                    layout::helloFluidWidth,
-                    "role=fluid version="
-                  + std::to_string(cpl::protocolVersion)
-                );
+                cpl::FluidHello reply;
+                reply.nParticlesExpected = nParticlesExpected;
+                reply.alphaLambda = alphaLambda;
+                reply.rhoFluid = rhoFluid;
+                reply.delta = grid.delta();
                 const boundBox& bb = grid.bounds();
-                double* r = &reply.data[0];
-                r[layout::hfNParticles] = nParticlesExpected;
-                r[layout::hfAlphaLambda] = alphaLambda;
-                r[layout::hfRhoFluid] = rhoFluid;
-                r[layout::hfDelta] = grid.delta();
                 for (direction d = 0; d < 3; ++d)
                 {
-                    r[layout::hfXlo + 2*d] = bb.min()[d];
-                    r[layout::hfXlo + 2*d + 1] = bb.max()[d];
-                    r[layout::hfPeriodic + d] = grid.periodic()[d] ? 1 : 0;
+                    reply.lo[d] = bb.min()[d];
+                    reply.hi[d] = bb.max()[d];
+                    reply.periodic[d] = grid.periodic()[d];
                 }
-                r[layout::hfViscosity] = eta;
-                forAll(faces, i)
+                reply.viscosity = eta;
+                for (label f = 0; f < label(layout::nFaces); ++f)
                 {
-                    r[layout::hfFaceBase + i] = faces[i];
+                    reply.faces[f] = faces[f];
                 }
-                transport_->send(reply);
+                transport_->send(reply.toMessage());
             }
         }
         catch (const std::exception& e)
@@ -422,13 +355,12 @@ void Foam::fluidCoupling::handshake
         << "    box faces (for the particle code):";
     for (label f = 0; f < label(layout::nFaces); ++f)
     {
-        const scalar* rec = &faces[layout::faceWidth*f];
-        const label k = label(rec[layout::fKind]);
-        Info<< ' ' << boxFaceName[f] << ' ' << boundaryKindName[k];
-        if (k == layout::bWall)
+        const cpl::BoxFace& face = faces[f];
+        Info<< ' ' << boxFaceName[f] << ' ' << boundaryKindName[face.kind];
+        if (face.kind == layout::bWall)
         {
             Info<< ' '
-                << vector(rec[layout::fUx], rec[layout::fUy], rec[layout::fUz]);
+                << vector(face.velocity[0], face.velocity[1], face.velocity[2]);
         }
     }
     Info<< endl;
@@ -452,22 +384,42 @@ fdm::coupler::Message Foam::fluidCoupling::receive()
 }
 
 
-bool Foam::fluidCoupling::receiveStep(List<fdmParticle>& particles)
+void Foam::fluidCoupling::broadcast(cpl::Message& m)
 {
-    List<scalar> data;
-    label finished = 0;
-    label lastStep = lastStep_;
-    label step = step_;
-    scalar dt = dt_;
-
+    if (!Pstream::parRun())
+    {
+        return;
+    }
+    List<char> bytes;
     if (Pstream::master())
     {
-        cpl::Message m = receive();
-        if (m.type == cpl::MessageType::Finish)
-        {
-            finished = 1;
-        }
-        else if (m.type != cpl::MessageType::Step)
+        const std::vector<unsigned char> wire = cpl::encode(m);
+        bytes.setSize(label(wire.size()));
+        forAll(bytes, i) { bytes[i] = char(wire[i]); }
+    }
+    Pstream::scatter(bytes);
+    if (!Pstream::master())
+    {
+        m = cpl::decode
+        (
+            reinterpret_cast<const unsigned char*>(bytes.cdata()),
+            size_t(bytes.size())
+        );
+    }
+}
+
+
+bool Foam::fluidCoupling::receiveStep(List<fdmParticle>& particles)
+{
+    cpl::Message m;
+    if (Pstream::master())
+    {
+        m = receive();
+        if
+        (
+            m.type != cpl::MessageType::Finish
+         && m.type != cpl::MessageType::Step
+        )
         {
             fatal
             (
@@ -475,55 +427,65 @@ bool Foam::fluidCoupling::receiveStep(List<fdmParticle>& particles)
               + cpl::messageTypeName(m.type)
             );
         }
-        else if
-        (
-            label(m.count) != nParticles_
-         || m.width != cpl::layout::stepWidth
-        )
+        if (m.type == cpl::MessageType::Step)
         {
-            fatal
-            (
-                "coupling: fdmDEM sent " + Foam::name(label(m.count))
-              + " particles in step " + Foam::name(label(m.step))
-              + " but announced " + Foam::name(nParticles_)
-              + " at the handshake"
-            );
-        }
-        else
-        {
-            step = label(m.step);
-            dt = m.textNumber("dt");
-            lastStep = label(m.textNumber("lastStep"));
-            data = toList(m.data);
+            try
+            {
+                cpl::Step::fromMessage(m, nParticles_);
+            }
+            catch (const cpl::CouplerError& e)
+            {
+                fatal
+                (
+                    string(e.what()) + " (fdmDEM announced "
+                  + Foam::name(nParticles_) + " particles at the handshake)"
+                );
+            }
         }
     }
-
-    Pstream::scatter(finished);
-    if (finished)
+    broadcast(m);
+    if (m.type == cpl::MessageType::Finish)
     {
         return false;
     }
-    Pstream::scatter(data);
-    Pstream::scatter(step);
-    Pstream::scatter(dt);
-    Pstream::scatter(lastStep);
-    step_ = step;
-    dt_ = dt;
-    lastStep_ = lastStep;
 
-    const label w = cpl::layout::stepWidth;
-    particles.setSize(data.size()/w);
+    const cpl::Step step = cpl::Step::fromMessage(m, nParticles_);
+    volumesSent_ = false;
+    step_ = label(step.step);
+    dt_ = step.dt;
+    lastStep_ = label(step.lastStep);
+    particles.setSize(step.particles.size());
     forAll(particles, p)
     {
-        const scalar* rec = &data[w*p];
+        const cpl::StepParticle& q = step.particles[p];
         fdmParticle& part = particles[p];
-        part.tag = label(rec[cpl::layout::sTag]);
-        part.x = point(rec[cpl::layout::sX], rec[cpl::layout::sY], rec[cpl::layout::sZ]);
-        part.radius = rec[cpl::layout::sRadius];
-        part.U = vector(rec[cpl::layout::sUx], rec[cpl::layout::sUy], rec[cpl::layout::sUz]);
-        part.omega = vector(rec[cpl::layout::sWx], rec[cpl::layout::sWy], rec[cpl::layout::sWz]);
+        part.tag = label(q.tag);
+        part.x = point(q.x[0], q.x[1], q.x[2]);
+        part.radius = q.radius;
+        part.U = vector(q.velocity.U[0], q.velocity.U[1], q.velocity.U[2]);
+        part.omega =
+            vector(q.velocity.omega[0], q.velocity.omega[1], q.velocity.omega[2]);
     }
     return true;
+}
+
+
+void Foam::fluidCoupling::send(const fdm::coupler::Message& m)
+{
+    if (!Pstream::master())
+    {
+        return;
+    }
+    const double t0 = wallClock();
+    try
+    {
+        transport_->send(m);
+    }
+    catch (const std::exception& e)
+    {
+        FatalErrorInFunction << "coupling: " << e.what() << exit(FatalError);
+    }
+    exchangeTime_ += wallClock() - t0;
 }
 
 
@@ -537,32 +499,48 @@ void Foam::fluidCoupling::sendIntegrals
     {
         return;
     }
-    const double t0 = wallClock();
-    cpl::Message m = cpl::makeMessage
-    (
-        cpl::MessageType::Integrals, step_, iteration,
-        integrals.size()/cpl::layout::integralsWidth,
-        cpl::layout::integralsWidth
-    );
-    forAll(integrals, i) { m.data[i] = integrals[i]; }
-    try
+    // particleForcing::integrals: per particle the Volumes record, then the
+    // Integrals record
+    namespace layout = cpl::layout;
+    const label nv = layout::volumesWidth;
+    const label width = nv + layout::integralsWidth;
+    const label n = integrals.size()/width;
+    if (!volumesSent_)
     {
-        transport_->send(m);
+        cpl::Volumes volumes;
+        volumes.step = step_;
+        volumes.particles.resize(n);
+        for (label p = 0; p < n; ++p)
+        {
+            volumes.particles[p].Vu = integrals[width*p + layout::volVu];
+            volumes.particles[p].Ju = integrals[width*p + layout::volJu];
+        }
+        send(volumes.toMessage());
+        volumesSent_ = true;
     }
-    catch (const std::exception& e)
+    cpl::Integrals m;
+    m.step = step_;
+    m.iteration = iteration;
+    m.particles.resize(n);
+    for (label p = 0; p < n; ++p)
     {
-        FatalErrorInFunction << "coupling: " << e.what() << exit(FatalError);
+        const scalar* rec = &integrals[width*p + nv];
+        for (direction d = 0; d < 3; ++d)
+        {
+            m.particles[p].F[d] = rec[layout::iFx + d];
+            m.particles[p].T[d] = rec[layout::iTx + d];
+        }
     }
-    exchangeTime_ += wallClock() - t0;
+    send(m.toMessage());
 }
 
 
 Foam::List<Foam::scalar> Foam::fluidCoupling::receiveVelocities(label iteration)
 {
-    List<scalar> data;
+    cpl::Message m;
     if (Pstream::master())
     {
-        cpl::Message m = receive();
+        m = receive();
         if (m.type != cpl::MessageType::Velocities)
         {
             fatal
@@ -571,40 +549,53 @@ Foam::List<Foam::scalar> Foam::fluidCoupling::receiveVelocities(label iteration)
               + cpl::messageTypeName(m.type)
             );
         }
-        if
-        (
-            label(m.count) != nParticles_
-         || m.width != cpl::layout::velocitiesWidth
-         || label(m.step) != step_
-         || label(m.iteration) != iteration
-        )
+        try
         {
-            fatal
-            (
-                "coupling: fdmDEM sent velocities for " + Foam::name(label(m.count))
-              + " particles (step " + Foam::name(label(m.step)) + ", iteration "
-              + Foam::name(label(m.iteration)) + ") where "
-              + Foam::name(nParticles_) + " particles (step " + Foam::name(step_)
-              + ", iteration " + Foam::name(iteration) + ") were expected"
-            );
+            const cpl::Velocities v = cpl::Velocities::fromMessage(m, nParticles_);
+            if (label(v.step) != step_ || label(v.iteration) != iteration)
+            {
+                fatal
+                (
+                    "coupling: fdmDEM sent the velocities of step "
+                  + Foam::name(label(v.step)) + ", iteration "
+                  + Foam::name(label(v.iteration)) + " where step "
+                  + Foam::name(step_) + ", iteration " + Foam::name(iteration)
+                  + " was expected"
+                );
+            }
         }
-        data = toList(m.data);
-        forAll(data, i)
+        catch (const cpl::CouplerError& e)
         {
-            if (!std::isfinite(data[i]))
+            fatal(e.what());
+        }
+        forAll(m.data, i)
+        {
+            if (!std::isfinite(m.data[i]))
             {
                 fatal
                 (
                     "fdmDEM returned a non-finite velocity for particle "
-                  + Foam::name(i/cpl::layout::velocitiesWidth + 1)
+                  + Foam::name(label(i/m.width) + 1)
                   + " at step " + Foam::name(step_) + ", inner iteration "
                   + Foam::name(iteration)
                 );
             }
         }
     }
-    Pstream::scatter(data);
-    return data;
+    broadcast(m);
+
+    // per particle [U(3), Omega(3)] (particleForcing::correct)
+    const cpl::Velocities v = cpl::Velocities::fromMessage(m, nParticles_);
+    List<scalar> velocities(6*v.particles.size());
+    forAll(v.particles, p)
+    {
+        for (direction d = 0; d < 3; ++d)
+        {
+            velocities[6*p + d] = v.particles[p].U[d];
+            velocities[6*p + 3 + d] = v.particles[p].omega[d];
+        }
+    }
+    return velocities;
 }
 
 
@@ -621,9 +612,8 @@ void Foam::fluidCoupling::sendStepDone
     {
         return;
     }
-    namespace layout = cpl::layout;
-    const label nf = layout::stepDoneWidth;                         // F, T
-    const label ns = layout::stepDoneStressWidth - layout::stepDoneWidth; // S, s
+    const label nf = 6;     // F, T (particleForcing::hydrodynamicForces)
+    const label ns = 7;     // S, s (particleForcing::stresslets)
     const label n = forces.size()/nf;
     if (stresslets_ && stresslets.size() != ns*n)
     {
@@ -632,34 +622,32 @@ void Foam::fluidCoupling::sendStepDone
             << n << " forces" << abort(FatalError);
     }
 
-    const double t0 = wallClock();
-    const label width =
-        stresslets_ ? layout::stepDoneStressWidth : layout::stepDoneWidth;
-    cpl::Message m = cpl::makeMessage
-    (
-        cpl::MessageType::StepDone, step_, iterations, n, width,
-        "iterations=" + std::to_string(iterations)
-      + " residual=" + number(residual)
-      + " converged=" + std::string(converged ? "1" : "0")
-    );
+    cpl::StepDone m;
+    m.step = step_;
+    m.iterations = iterations;
+    m.residual = residual;
+    m.converged = converged;
+    m.forces.resize(n);
+    if (stresslets_)
+    {
+        m.stresslets.resize(n);
+    }
     for (label p = 0; p < n; ++p)
     {
-        for (label k = 0; k < nf; ++k)
+        for (direction d = 0; d < 3; ++d)
         {
-            m.at(p, layout::dFx + k) = forces[nf*p + k];
+            m.forces[p].F[d] = forces[nf*p + d];
+            m.forces[p].T[d] = forces[nf*p + 3 + d];
         }
-        for (label k = 0; stresslets_ && k < ns; ++k)
+        if (!stresslets_)
         {
-            m.at(p, layout::dSxx + k) = stresslets[ns*p + k];
+            continue;
         }
+        for (label c = 0; c < 6; ++c)
+        {
+            m.stresslets[p].S[c] = stresslets[ns*p + c];
+        }
+        m.stresslets[p].trace = stresslets[ns*p + 6];
     }
-    try
-    {
-        transport_->send(m);
-    }
-    catch (const std::exception& e)
-    {
-        FatalErrorInFunction << "coupling: " << e.what() << exit(FatalError);
-    }
-    exchangeTime_ += wallClock() - t0;
+    send(m.toMessage());
 }

@@ -1,4 +1,5 @@
 #include "particleForcing.H"
+#include "fdm/coupler.h"
 
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
@@ -172,7 +173,10 @@ Foam::List<Foam::scalar> Foam::particleForcing::integrals
     const volVectorField& lambda
 ) const
 {
-    const label width = 8;    // fdm::coupler::layout::integralsWidth
+    // Per particle the coupler's Volumes record, then its Integrals record
+    namespace layout = fdm::coupler::layout;
+    const label nv = layout::volumesWidth;
+    const label width = nv + layout::integralsWidth;
     List<scalar> result(width*particles_.size(), 0.0);
 
     const scalarField& V = grid_.mesh().V();
@@ -195,12 +199,12 @@ Foam::List<Foam::scalar> Foam::particleForcing::integrals
             T += (r ^ g)*V[celli];
         }
         scalar* rec = &result[width*p];
-        rec[0] = Vu;
-        rec[1] = Ju;
+        rec[layout::volVu] = Vu;
+        rec[layout::volJu] = Ju;
         for (direction d = 0; d < 3; ++d)
         {
-            rec[2 + d] = rhoFluid_*F[d];
-            rec[5 + d] = rhoFluid_*T[d];
+            rec[nv + layout::iFx + d] = rhoFluid_*F[d];
+            rec[nv + layout::iTx + d] = rhoFluid_*T[d];
         }
     }
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Standalone check of fdmFoam's side of coupling protocol 2 (docs/coupling.md), before fdmDEM
-speaks it: this script plays the particle code over the socket (wire format of
-coupler/include/fdm/coupler.h, re-implemented here in a few lines) and runs the real fdmFoam.
+"""Standalone check of fdmFoam's side of the coupling protocol (docs/coupling.md): written for the
+additions of version 2 (viscosity, box faces, stresslets), it speaks version 3 (Volumes once per
+step). It plays the particle code over the socket (wire format of coupler/include/fdm/coupler.h,
+re-implemented here in a few lines) and runs the real fdmFoam.
 
     . etc/bashrc && python3 fluid/fdmFoam/tests/checkProtocol2.py [--keep DIR]
 
@@ -9,6 +10,9 @@ A free sphere (radius a, a/Delta = 4) at the centre of a wall-driven shear cell 
 yhi moving along -x and +x, cyclic in x and z), the set-up of tests/test_walls.py and paper 5.2.2.
 The emulated particle code solves Eq. (31) for one free particle without sub-grid terms:
 U = alpha F/(rho_f Vu), Omega = alpha T/(rho_f Ju). Checked:
+
+* protocol 3: after each Step one Volumes [Vu, Ju] (Vu within 10 % of the sphere's volume, Ju of
+  (2/5) a^2 Vu), then Integrals of 6 values [F, T], one per inner iteration, and no other Volumes;
 
 * the fluid Hello: 38 values, the first 13 as in protocol 1, eta = rho_f nu, the six box faces
   (kind, wall velocity), identical in serial and on 2 ranks split across the cyclic direction
@@ -40,9 +44,10 @@ PROJECT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 from fdm import case  # noqa: E402
 
-VERSION = 2
-HELLO, STEP, INTEGRALS, VELOCITIES, STEPDONE, FINISH, ERROR = range(1, 8)
-TYPE_NAMES = {1: "Hello", 2: "Step", 3: "Integrals", 4: "Velocities", 5: "StepDone", 6: "Finish", 7: "Error"}
+VERSION = 3
+HELLO, STEP, INTEGRALS, VELOCITIES, STEPDONE, FINISH, ERROR, VOLUMES = range(1, 9)
+TYPE_NAMES = {1: "Hello", 2: "Step", 3: "Integrals", 4: "Velocities", 5: "StepDone", 6: "Finish", 7: "Error",
+              8: "Volumes"}
 HEADER = struct.Struct("<4sHHQIIIIQ")  # 40 bytes: magic version type step iteration count width text payload
 
 # Fluid Hello layout (fdm::coupler::layout)
@@ -196,7 +201,8 @@ def dem_hello(box, stresslets_text):
 
 
 def run_coupled(root, fluid, box, np_fluid, stresslets_text, n_steps=1):
-    """One coupled run of a free sphere; returns (fluid Hello, last StepDone)."""
+    """One coupled run of a free sphere; returns (fluid Hello, last StepDone). Checks the order of
+    protocol 3: Volumes once per step, before the first Integrals."""
     proc, peer, log = start_fluid(root, fluid, np_fluid)
     try:
         peer.send(dem_hello(box, stresslets_text))
@@ -208,16 +214,29 @@ def run_coupled(root, fluid, box, np_fluid, stresslets_text, n_steps=1):
         done = None
         for step in range(1, n_steps + 1):
             peer.send(Message(STEP, step, 0, 11, "dt=1 lastStep=%d" % n_steps, [[1, x, y, z, a] + v]))
+            m = peer.receive()
+            assert m.type == VOLUMES, "expected Volumes, got %s: %s" % (TYPE_NAMES[m.type], m.text)
+            check(m.step == step and m.width == 2 and len(m.records) == 1,
+                  "np %d step %d: Volumes [Vu, Ju] of the step first" % (np_fluid, step))
+            vu, ju = m.records[0]
+            sphere = 4.0 / 3.0 * math.pi * a ** 3
+            check(abs(vu / sphere - 1) < 0.1 and abs(ju / (0.4 * a * a * vu) - 1) < 0.15,
+                  "np %d: Vu %.6g ~ the sphere's volume %.6g, Ju %.6g ~ (2/5) a^2 Vu" % (np_fluid, vu, sphere, ju))
+            iterations = 0
             while True:
                 m = peer.receive()
                 if m.type == STEPDONE:
                     done = m
                     break
                 assert m.type == INTEGRALS, "expected Integrals, got %s: %s" % (TYPE_NAMES[m.type], m.text)
-                vu, ju, fx, fy, fz, tx, ty, tz = m.records[0]
+                assert m.width == 6, "Integrals of %d values (protocol 3: 6)" % m.width
+                iterations += 1
+                fx, fy, fz, tx, ty, tz = m.records[0]
                 # Eq. (31) for one free particle, no sub-grid terms
                 v = [alpha * f / (rho * vu) for f in (fx, fy, fz)] + [alpha * t / (rho * ju) for t in (tx, ty, tz)]
                 peer.send(Message(VELOCITIES, step, m.iteration, 6, "", [v]))
+            check(iterations == done.iteration, "np %d: %d Integrals, one per inner iteration (StepDone says %d)"
+                  % (np_fluid, iterations, done.iteration))
         peer.send(Message(FINISH, n_steps))
         rc = proc.wait(timeout=120)
         check(rc == 0, "fdmFoam (np %d) ends normally after Finish (log %s)" % (np_fluid, log))

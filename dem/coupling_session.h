@@ -1,0 +1,101 @@
+/* The coupling session of this fdmDEM process with the fluid solver fdmFoam (docs/coupling.md):
+   the connection, the handshake (Hello both ways and their checks), what the fluid said (alpha_lambda,
+   rho_f, mesh size, viscosity, the kind and wall velocity of every box face), and the end: Finish
+   after the input, or Error when fdmDEM stops early. With transport none (DEM only) there is no
+   fluid and the same values come from fix fdm/couple's keywords.
+
+   One per process: it outlives runs and even the fix (unfix / fix again). fix fdm/couple registers
+   what it asks for (attach) and uses the connection; pair_style fdm/subgrid asks it for the
+   viscosity, the mesh size and the walls before LIGGGHTS builds neighbour lists (connecting then
+   if needed), without knowing the fix. Rank 0 talks; what it learns is broadcast on the LIGGGHTS
+   communicator. */
+
+#ifndef FDM_COUPLING_SESSION_H
+#define FDM_COUPLING_SESSION_H
+
+#include "fdm/coupler.h"
+
+#include <memory>
+#include <string>
+
+namespace LAMMPS_NS {
+
+class LAMMPS;
+
+class CouplingSession {
+ public:
+  // What fix fdm/couple asks for (its keywords).
+  struct Request {
+    fdm::coupler::Options options;   // transport "none": DEM only
+    bool stresslets = false;         // StepDone must carry the FDM stresslets
+    // transport none: the values the fluid would have given
+    double viscosity = 0, meshSize = 0, fluidDensity = 1000;
+  };
+
+  // The boundary of the fluid case on a box face (coupler's layout::BoundaryKind), or none at all.
+  enum FaceKind { facePeriodic = 0, faceWall = 1, faceSlip = 2, faceOther = 3, faceNoFluid = -1 };
+
+  static CouplingSession &instance();
+
+  // fix fdm/couple's constructor registers its request, its destructor withdraws it.
+  void attach(const void *fix, const Request &request);
+  void detach(const void *fix);
+  // A fix fdm/couple exists: Eq. (31) has a fluid (or its DEM-only stand-in); without, contact only.
+  bool attached() const { return owner_ != nullptr; }
+
+  // Every rank: what the coupling needs of the atoms (atom_style sphere, map array, IDs 1..N).
+  void checkAtoms(LAMMPS *lmp) const;
+  // Every rank (collective): connects and shakes hands with the fluid, or takes the DEM-only values,
+  // unless done. nParticles: the N to announce; 0: check the atoms and announce atom->natoms.
+  void ensureConnected(LAMMPS *lmp, int nParticles = 0);
+  bool connected() const { return connected_; }
+
+  // What the fluid said (every rank, once connected).
+  int particles() const { return particles_; }   // N announced at the handshake
+  bool hasFluid() const { return request_.options.transport != "none"; }
+  double alphaLambda() const { return alphaLambda_; }
+  double rhoFluid() const { return rhoFluid_; }
+  double meshSize() const { return meshSize_; }
+  double viscosity() const { return viscosity_; }
+  // Box face 0..5 (xlo xhi ylo yhi zlo zhi): kind and wall velocity.
+  void fluidFace(int face, int &kind, double velocity[3]) const;
+  static const char *faceKindName(int kind);
+
+  // Rank 0: the connection to the fluid (null once closed, on other ranks, or without a fluid).
+  fdm::coupler::Transport *transport() { return connection_.get(); }
+  // Best effort (any rank; only rank 0 holds the connection): tells the fluid why fdmDEM stops
+  // (Error) and closes the connection.
+  void abandon(const std::string &why);
+  // Every rank (collective): if rank 0 found a problem, tells the fluid and stops every rank with
+  // error->all("fdm/couple: " + problem). Does nothing if the problem is empty.
+  void stopIf(LAMMPS *lmp, const std::string &problemOnRank0);
+
+  // The seconds of each coupled run (rank 0's), for the session's total.
+  void addRun(long steps, double solve, double exchange, double gatherScatter);
+  double totalSolve() const { return totalSolve_; }
+  double totalExchange() const { return totalExchange_; }
+  // Every rank, by the fdmDEM driver after the input script: tells the fluid to finish (Finish),
+  // closes the connection and prints the session's timing.
+  void finishAll(LAMMPS *lmp);
+
+ private:
+  CouplingSession();
+  void connectAndHandshake(LAMMPS *lmp);
+  std::string checkFluidHello(LAMMPS *lmp, const fdm::coupler::FluidHello &hello) const;
+
+  const void *owner_;
+  Request request_;
+  std::unique_ptr<fdm::coupler::Transport> connection_;  // rank 0
+  bool connected_;                                       // every rank: handshake done
+  int particles_;
+  double alphaLambda_, rhoFluid_, meshSize_, viscosity_;
+  double faces_[6][4];                                   // kind, wall velocity
+  double start_;                                         // MPI_Wtime of the handshake
+  int runs_;
+  long steps_;
+  double totalSolve_, totalExchange_, totalGatherScatter_;
+};
+
+}  // namespace LAMMPS_NS
+
+#endif

@@ -1,0 +1,285 @@
+// Eq. (31) for the particle velocities: assembly, solution and sub-grid results (see the header).
+#include "particle_velocity_system.h"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace fdm {
+
+namespace {
+std::string fmt(double x)
+{
+  std::ostringstream os;
+  os.precision(10);
+  os << x;
+  return os.str();
+}
+std::string point(const double *x) { return "(" + fmt(x[0]) + ", " + fmt(x[1]) + ", " + fmt(x[2]) + ")"; }
+std::string tagName(int index) { return std::to_string(index + 1); }
+}  // namespace
+
+struct ParticleVelocitySystem::Matrices {
+  Eigen::SparseMatrix<double> matrix;   // (rho_f/rho_p) J/alpha_lambda + R^SG
+  std::vector<int> diagonalIndex;       // position of entry (k, k) in matrix.valuePtr()
+  std::vector<double> subgridDiagonal;  // R^SG(k, k)
+  Eigen::VectorXd wallRhs;              // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
+  Eigen::VectorXd diagonal;             // (rho_f/rho_p) J/alpha_lambda of this step
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                           Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double> > ldlt;
+  bool analysed = false;                // LDLT's symbolic analysis of this step's pattern
+  bool ready = false;                   // factorised (or preconditioned) for this step's diagonal
+};
+
+ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
+  settings_(settings), n_(0), pairRecord_(subgrid::pairRecord), wallRecord_(subgrid::wallRecord), pairBlocks_(0),
+  wallBlocks_(0), iterations_(0), factorisations_(0), m_(new Matrices)
+{
+  if (!(settings_.alphaLambda > 0) || !(settings_.rhoFluid > 0) || !(settings_.tolerance > 0))
+    throw Error(Error::notSolved, -1, "Eq. (31) needs a positive alpha_lambda (" + fmt(settings_.alphaLambda) +
+                                      " s), fluid density (" + fmt(settings_.rhoFluid) + " kg/m3) and CG tolerance (" +
+                                      fmt(settings_.tolerance) + ")");
+  if (settings_.stresslets) {
+    pairRecord_ += subgrid::pairStressRecord;
+    wallRecord_ += subgrid::wallStressRecord;
+  }
+}
+
+ParticleVelocitySystem::~ParticleVelocitySystem() {}
+
+int ParticleVelocitySystem::tagIndex(double tag) const
+{
+  const long t = std::lround(tag);
+  if (!(t >= 1 && t <= n_)) throw Error(Error::badBlock, -1, "pair fdm/subgrid sent a block for particle ID " + fmt(tag));
+  return int(t - 1);
+}
+
+void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vector<double> pairs,
+                                      std::vector<double> walls)
+{
+  // R^SG once per time step (paper section 4.4.2): the positions do not move during the inner iterations
+  const int N = int(particles.size());
+  if (N != n_) u_.assign(size_t(6) * N, 0.0);
+  n_ = N;
+  particles_.swap(particles);
+  pairs_.swap(pairs);
+  walls_.swap(walls);
+  if (pairs_.size() % pairRecord_ != 0 || walls_.size() % wallRecord_ != 0)
+    throw Error(Error::badBlock, -1, "pair fdm/subgrid sent " + std::to_string(pairs_.size()) + " pair and " +
+                                     std::to_string(walls_.size()) + " wall block values, not whole records of " +
+                                     std::to_string(pairRecord_) + " and " + std::to_string(wallRecord_));
+  pairBlocks_ = long(pairs_.size() / pairRecord_);
+  wallBlocks_ = long(walls_.size() / wallRecord_);
+  Vu_.clear();
+  Ju_.clear();
+
+  Matrices &m = *m_;
+  std::vector<Eigen::Triplet<double> > triplets;
+  triplets.reserve(size_t(6) * N + size_t(144) * pairBlocks_ + size_t(36) * wallBlocks_);
+  for (int k = 0; k < 6 * N; k++) triplets.push_back(Eigen::Triplet<double>(k, k, 0.0));  // the diagonal, always
+  m.wallRhs = Eigen::VectorXd::Zero(6 * N);
+  for (long b = 0; b < pairBlocks_; b++) {
+    const double *rec = &pairs_[size_t(b) * pairRecord_];
+    const int i1 = tagIndex(rec[0]), i2 = tagIndex(rec[1]);
+    const int base[2] = {6 * i1, 6 * i2};
+    const double *R = rec + 2;
+    for (int k = 0; k < pairRecord_ - 2; k++)
+      if (!std::isfinite(R[k]))
+        throw Error(Error::badBlock, i1, "pair fdm/subgrid sent a non-finite sub-grid block for particles " +
+                                         tagName(i1) + " and " + tagName(i2) + " at " + point(particles_[i1].x) +
+                                         " and " + point(particles_[i2].x));
+    for (int i = 0; i < 12; i++)
+      for (int j = 0; j < 12; j++)
+        triplets.push_back(Eigen::Triplet<double>(base[i / 6] + i % 6, base[j / 6] + j % 6, R[12 * i + j]));
+  }
+  for (long b = 0; b < wallBlocks_; b++) {
+    const double *rec = &walls_[size_t(b) * wallRecord_];
+    const int p = tagIndex(rec[0]), base = 6 * p;
+    const double *R = rec + 1, *rhs = rec + 37;
+    for (int k = 0; k < wallRecord_ - 1; k++)
+      if (!std::isfinite(R[k]))
+        throw Error(Error::badBlock, p, "pair fdm/subgrid sent a non-finite sub-grid wall block for particle " +
+                                        tagName(p) + " at " + point(particles_[p].x));
+    for (int i = 0; i < 6; i++) {
+      for (int j = 0; j < 6; j++) triplets.push_back(Eigen::Triplet<double>(base + i, base + j, R[6 * i + j]));
+      m.wallRhs(base + i) += rhs[i];  // F = -R_w (U - U_w, Omega): the wall velocity is a force
+    }
+  }
+  m.matrix.resize(6 * N, 6 * N);
+  m.matrix.setFromTriplets(triplets.begin(), triplets.end());
+  m.matrix.makeCompressed();
+  m.diagonalIndex.assign(size_t(6) * N, -1);
+  m.subgridDiagonal.assign(size_t(6) * N, 0.0);
+  for (int k = 0; k < 6 * N; k++)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(m.matrix, k); it; ++it)
+      if (it.row() == k) {
+        m.diagonalIndex[k] = int(&it.valueRef() - m.matrix.valuePtr());
+        m.subgridDiagonal[k] = it.value();
+      }
+  m.diagonal = Eigen::VectorXd::Zero(6 * N);
+  m.analysed = false;
+  m.ready = false;
+}
+
+void ParticleVelocitySystem::setVolumes(const std::vector<double> &Vu, const std::vector<double> &Ju)
+{
+  const int N = n_;
+  if (Vu.size() != size_t(N) || Ju.size() != size_t(N))
+    throw Error(Error::fluidValue, -1, "Eq. (31) got the volumes of " + std::to_string(Vu.size()) + " and " +
+                                       std::to_string(Ju.size()) + " particles for " + std::to_string(N));
+  Matrices &m = *m_;
+  Eigen::VectorXd diagonal(6 * N);
+  for (int p = 0; p < N; p++) {
+    const Particle &q = particles_[p];
+    if (!std::isfinite(Vu[p]) || !std::isfinite(Ju[p]))
+      throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite volume for particle " + tagName(p) +
+                                        " at " + point(q.x) + " (Vu " + fmt(Vu[p]) + ", Ju " + fmt(Ju[p]) + ")");
+    if (!(Vu[p] > 0) || !(Ju[p] > 0))
+      throw Error(Error::noVolume, p, "particle " + tagName(p) + " at " + point(q.x) + " with radius " +
+                                      fmt(q.radius) + ": the fluid's indicator function gives it no volume (Vu " +
+                                      fmt(Vu[p]) + ", Ju " + fmt(Ju[p]) + ")");
+    for (int d = 0; d < 3; d++) {
+      diagonal(6 * p + d) = settings_.rhoFluid * Vu[p] / settings_.alphaLambda;
+      diagonal(6 * p + 3 + d) = settings_.rhoFluid * Ju[p] / settings_.alphaLambda;
+    }
+  }
+  Vu_ = Vu;
+  Ju_ = Ju;
+  if (m.ready && diagonal == m.diagonal) return;  // the same volumes again: keep the factorisation
+  m.diagonal = diagonal;
+  double *values = m.matrix.valuePtr();
+  for (int k = 0; k < 6 * N; k++) values[m.diagonalIndex[k]] = m.subgridDiagonal[k] + diagonal(k);
+  if (settings_.solver == ldlt) {
+    if (!m.analysed) {
+      m.ldlt.analyzePattern(m.matrix);
+      m.analysed = true;
+    }
+    m.ldlt.factorize(m.matrix);
+    factorisations_++;
+    if (m.ldlt.info() != Eigen::Success)
+      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (LDLT): is "
+                                        "the sub-grid matrix indefinite?");
+  } else {
+    m.cg.setTolerance(settings_.tolerance);
+    m.cg.setMaxIterations(std::max(1000, 6 * N));
+    m.cg.compute(m.matrix);
+  }
+  m.ready = true;
+}
+
+const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<double> &fluidForces)
+{
+  const int N = n_;
+  Matrices &m = *m_;
+  if (!m.ready) throw Error(Error::notSolved, -1, "Eq. (31) solved before the particle volumes were given");
+  if (fluidForces.size() != size_t(6) * N)
+    throw Error(Error::fluidValue, -1, "Eq. (31) got " + std::to_string(fluidForces.size()) +
+                                       " fluid force and torque values for " + std::to_string(N) + " particles");
+  static const char *component[6] = {"Fx", "Fy", "Fz", "Tx", "Ty", "Tz"};
+  Eigen::VectorXd rhs(6 * N);
+  for (int p = 0; p < N; p++) {
+    const Particle &q = particles_[p];
+    for (int c = 0; c < 6; c++)
+      if (!std::isfinite(fluidForces[size_t(6) * p + c]))
+        throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite integral for particle " + tagName(p) +
+                                          " at " + point(q.x) + " (" + component[c] + " = " +
+                                          fmt(fluidForces[size_t(6) * p + c]) + ")");
+    const double buoyantFraction = 1.0 - settings_.rhoFluid / q.density;  // (rho_p - rho_f)/rho_p
+    for (int d = 0; d < 3; d++) {
+      rhs(6 * p + d) = fluidForces[size_t(6) * p + d] + buoyantFraction * q.mass * settings_.gravity[d] + q.force[d];
+      rhs(6 * p + 3 + d) = fluidForces[size_t(6) * p + 3 + d] + q.torque[d];
+    }
+  }
+  rhs += m.wallRhs;
+
+  Eigen::VectorXd u;
+  if (settings_.solver == ldlt) {
+    u = m.ldlt.solve(rhs);  // the factorisation of this step
+    iterations_ = 1;
+  } else {
+    const Eigen::Map<const Eigen::VectorXd> guess(u_.data(), 6 * N);  // warm start: the previous solution
+    u = m.cg.solveWithGuess(rhs, guess);
+    iterations_ = long(m.cg.iterations());
+    if (m.cg.info() != Eigen::Success && !(m.cg.error() < 1e-6))
+      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) did not converge: relative residual " +
+                                        fmt(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
+                                        " conjugate-gradient iterations (" + std::to_string(pairBlocks_) +
+                                        " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
+  }
+  for (int k = 0; k < 6 * N; k++) {
+    if (!std::isfinite(u(k))) {
+      const int p = k / 6;
+      const Particle &q = particles_[p];
+      throw Error(Error::notSolved, p, "the velocity of particle " + tagName(p) + " at " + point(q.x) +
+                                       " is not finite (Eq. 31): its force " + point(q.force) + ", torque " +
+                                       point(q.torque) + ", fluid integrals Vu " + fmt(Vu_[p]) + " Ju " + fmt(Ju_[p]));
+    }
+    u_[k] = u(k);
+  }
+  return u_;
+}
+
+double ParticleVelocitySystem::diagonal(int k) const { return m_->diagonal(k); }
+
+std::vector<int> ParticleVelocitySystem::closePairs() const
+{
+  std::vector<int> pairs;
+  pairs.reserve(size_t(2) * pairBlocks_);
+  for (long b = 0; b < pairBlocks_; b++) {
+    pairs.push_back(int(std::lround(pairs_[size_t(b) * pairRecord_])) - 1);
+    pairs.push_back(int(std::lround(pairs_[size_t(b) * pairRecord_ + 1])) - 1);
+  }
+  return pairs;
+}
+
+std::vector<double> ParticleVelocitySystem::subgridForces() const
+{
+  // -(R^SG u - wall term): the whole matrix times u, less its fluid diagonal
+  const Matrices &m = *m_;
+  const Eigen::Map<const Eigen::VectorXd> u(u_.data(), 6 * n_);
+  const Eigen::VectorXd forces = m.wallRhs - m.matrix * u + m.diagonal.cwiseProduct(u);
+  return std::vector<double>(forces.data(), forces.data() + forces.size());
+}
+
+void ParticleVelocitySystem::addSubgridStresslets(std::vector<double> &stresslets) const
+{
+  if (!settings_.stresslets)
+    throw Error(Error::notSolved, -1, "sub-grid stresslets asked of a system assembled without stress rows");
+  if (stresslets.size() != size_t(7) * n_)
+    throw Error(Error::notSolved, -1, "sub-grid stresslets: " + std::to_string(stresslets.size()) + " values for " +
+                                      std::to_string(n_) + " particles (7 each)");
+  for (long b = 0; b < pairBlocks_; b++) {
+    const double *rec = &pairs_[size_t(b) * pairRecord_];
+    const int p[2] = {int(std::lround(rec[0])) - 1, int(std::lround(rec[1])) - 1};
+    const double *rows = rec + subgrid::pairRecord;  // 14 x 12: S_1 (6), S_2 (6), s_1, s_2
+    double velocity[12];
+    for (int k = 0; k < 6; k++) {
+      velocity[k] = u_[size_t(6) * p[0] + k];
+      velocity[6 + k] = u_[size_t(6) * p[1] + k];
+    }
+    for (int row = 0; row < 14; row++) {
+      double value = 0;
+      for (int k = 0; k < 12; k++) value -= rows[12 * row + k] * velocity[k];
+      const int who = row < 12 ? row / 6 : row - 12;
+      const int component = row < 12 ? row % 6 : 6;
+      stresslets[size_t(7) * p[who] + component] += value;
+    }
+  }
+  for (long b = 0; b < wallBlocks_; b++) {
+    const double *rec = &walls_[size_t(b) * wallRecord_];
+    const int p = int(std::lround(rec[0])) - 1;
+    const double *rows = rec + subgrid::wallRecord, *wallTerm = rows + 42;  // 7 x 6, then 7
+    for (int row = 0; row < 7; row++) {
+      double value = wallTerm[row];
+      for (int k = 0; k < 6; k++) value -= rows[6 * row + k] * u_[size_t(6) * p + k];
+      stresslets[size_t(7) * p + row] += value;
+    }
+  }
+}
+
+}  // namespace fdm

@@ -1,0 +1,123 @@
+/* Eq. (31) of the paper (Orsi, Lobry & Peters 2023, 4.3-4.4): the linear system for the rigid
+   velocities u = (U_p, Omega_p) of all N particles, unknowns ordered by tag,
+
+       [ (rho_f/rho_p) J / alpha_lambda + R^SG ] u = F^tot,
+
+   with (rho_f/rho_p) M_p = rho_f Vu and (rho_f/rho_p) J_p = rho_f Ju from the fluid's indicator
+   function, R^SG the frame-invariant sub-grid matrix of the close pairs and wall gaps (Eq. 21,
+   Appendices C.2, D; built by pair_style fdm/subgrid) and F^tot of Eq. (32): the fluid integral +
+   the buoyant weight (rho_p - rho_f)/rho_p m g + every other force on the particle (contacts,
+   external) + the moving walls' term R_w[:, 0:3] U_w of Eq. (D.6).
+
+   Per time step: assemble() once (R^SG; the positions do not move during the inner iterations),
+   setVolumes() once (Vu, Ju depend only on the positions: the diagonal, and the LDLT factorisation),
+   then solve() every inner iteration (a back-substitution, or conjugate gradients warm-started from
+   the previous solution); after the last one, the sub-grid force, torque and stresslets.
+
+   Plain C++ and Eigen (no LIGGGHTS): fix fdm/couple uses it on rank 0; tested on its own in
+   dem/tests/test_particle_velocity_system.cpp. */
+
+#ifndef FDM_PARTICLE_VELOCITY_SYSTEM_H
+#define FDM_PARTICLE_VELOCITY_SYSTEM_H
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fdm {
+
+// The records of the sub-grid blocks, as pair_style fdm/subgrid builds them on every rank and
+// fix fdm/couple gathers them on rank 0. R already contains the viscosity (F = -R u).
+namespace subgrid {
+// pair: [tag1, tag2, R (12 x 12, row-major, unknowns U1 Omega1 U2 Omega2)]
+const int pairRecord = 2 + 144;
+// with stresslets, after it: the rows of S_1 (6), S_2 (6), s_1, s_2 (14 x 12; S^SG = -rows u)
+const int pairStressRecord = 14 * 12;
+// wall: [tag, R_w (6 x 6), R_w[:, 0:3] U_w (6)]
+const int wallRecord = 1 + 36 + 6;
+// with stresslets, after it: the rows of S, s (7 x 6) and their wall-velocity term (7)
+const int wallStressRecord = 7 * 6 + 7;
+}  // namespace subgrid
+
+class ParticleVelocitySystem {
+ public:
+  enum Solver { ldlt, cg };
+
+  struct Settings {
+    Solver solver = ldlt;              // sparse LDLT (factorised once per step) or Jacobi-preconditioned CG
+    double tolerance = 1e-10;          // relative residual of CG
+    double alphaLambda = 0;            // direct-forcing penalty [s] (Eq. 29)
+    double rhoFluid = 0;               // [kg/m3]
+    double gravity[3] = {0, 0, 0};     // [m/s2]
+    bool stresslets = false;           // the block records carry their stress rows (subgrid::*StressRecord)
+  };
+
+  // What Eq. (32) needs of a particle besides the fluid; index = tag - 1.
+  struct Particle {
+    double x[3] = {0, 0, 0};           // for the error messages
+    double radius = 0;                 // for the error messages
+    double mass = 0, density = 0;      // buoyant weight (rho_p - rho_f)/rho_p m g
+    double force[3] = {0, 0, 0};       // everything else: contacts, external forces (F^c + F^ext)
+    double torque[3] = {0, 0, 0};
+  };
+
+  // A problem with the system: what() is for the user and names the particle (index `particle`,
+  // -1 if none). noVolume: the fluid gave a particle Vu <= 0 or Ju <= 0 (smaller than a mesh cell?);
+  // fluidValue: a non-finite volume or fluid integral; the others are the system's own.
+  class Error : public std::runtime_error {
+   public:
+    enum Kind { noVolume, fluidValue, badBlock, notSolved };
+    Error(Kind kind, int particle, const std::string &what) : std::runtime_error(what), kind(kind), particle(particle) {}
+    Kind kind;
+    int particle;
+  };
+
+  explicit ParticleVelocitySystem(const Settings &settings);
+  ~ParticleVelocitySystem();
+
+  // Once per time step: the particles and R^SG from the gathered block records (layouts above).
+  // The last solution stays the warm start unless the number of particles changed.
+  void assemble(std::vector<Particle> particles, std::vector<double> pairs, std::vector<double> walls);
+  // Once per time step, after assemble(): Vu and Ju of every particle (Eq. 31's diagonal). Factorises
+  // (ldlt) or sets up the preconditioner (cg) if the diagonal changed since the last call.
+  void setVolumes(const std::vector<double> &Vu, const std::vector<double> &Ju);
+  // Every inner iteration: the fluid part of F^tot (6 per particle: F, T; Eq. 32) -> u (6 per
+  // particle: U, Omega). Throws Error if an input or the solution is not finite or CG does not converge.
+  const std::vector<double> &solve(const std::vector<double> &fluidForces);
+
+  int particles() const { return n_; }
+  const std::vector<double> &velocities() const { return u_; }      // the last solution, 6N
+  double diagonal(int k) const;                                      // (rho_f/rho_p) {M, J}/alpha_lambda
+  long pairBlocks() const { return pairBlocks_; }
+  long wallBlocks() const { return wallBlocks_; }
+  // Index pairs (2 per pair) that have a sub-grid block this step.
+  std::vector<int> closePairs() const;
+  long lastIterations() const { return iterations_; }   // of the last solve (1 for LDLT)
+  long factorisations() const { return factorisations_; }
+
+  // After the last solve: F^SG, T^SG = -(R^SG u - wall term) (Eqs. 21, D.6), 6 per particle.
+  std::vector<double> subgridForces() const;
+  // After the last solve: adds the sub-grid stresslets S^SG = -rows u (+ wall term) (Eq. 13) to
+  // `stresslets`, 7 per particle (S xx xy xz yy yz zz, s). Needs Settings::stresslets.
+  void addSubgridStresslets(std::vector<double> &stresslets) const;
+
+ private:
+  int tagIndex(double tag) const;
+
+  struct Matrices;                     // Eigen's, in the .cpp
+  Settings settings_;
+  int n_;
+  std::vector<Particle> particles_;
+  std::vector<double> pairs_, walls_;  // the block records of this step
+  int pairRecord_, wallRecord_;
+  long pairBlocks_, wallBlocks_;
+  std::vector<double> Vu_, Ju_;        // of this step, for the messages
+  std::vector<double> u_;              // the last solution: warm start of the next solve
+  long iterations_, factorisations_;
+  std::unique_ptr<Matrices> m_;
+};
+
+}  // namespace fdm
+
+#endif
