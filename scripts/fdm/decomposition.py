@@ -164,8 +164,9 @@ def boundary_faces(cells, periodic, split):
 def choose_split(cells, periodic, n_ranks):
     """(n_x, n_y, n_z) with n_x n_y n_z = n_ranks, each n_d at most the cells in d, with the fewest
     processor-boundary faces; among equals, the splits whose n_d divide the cell counts (flat
-    interfaces; OpenFOAM's hierarchical method balances the cell counts either way), then the one
-    cut most in x. DecompositionError if the mesh cannot take n_ranks."""
+    interfaces; OpenFOAM's hierarchical method balances the cell counts either way), then the most
+    cube-like sub-domains, then the one cut most in x. DecompositionError if the mesh cannot take
+    n_ranks."""
     candidates = []
     for nx in range(1, n_ranks + 1):
         if n_ranks % nx:
@@ -176,7 +177,9 @@ def choose_split(cells, periodic, n_ranks):
             split = (nx, ny, n_ranks // (nx * ny))
             if all(split[d] <= cells[d] for d in range(3)):
                 uneven = sum(cells[d] % split[d] != 0 for d in range(3))
-                candidates.append((boundary_faces(cells, periodic, split), uneven, [-s for s in split], split))
+                extents = [cells[d] / split[d] for d in range(3)]
+                candidates.append((boundary_faces(cells, periodic, split), uneven, max(extents) / min(extents),
+                                   [-s for s in split], split))
     if not candidates:
         total = cells[0] * cells[1] * cells[2]
         why = ("more ranks than the %d cells" % total if n_ranks > total else
