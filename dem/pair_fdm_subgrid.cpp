@@ -416,7 +416,9 @@ void PairFdmSubgrid::contactForces()
         }
         if (contactStressRequested_) addContactStress(j, minus, del, 1.0 - weightI);
       }
-      contactsLast_++;
+      // a pair with a ghost is listed from both sides (across ranks or a periodic face): count it
+      // on the side of the lower tag, as collectBlocks keeps its block
+      if (j < nlocal || atom->tag[i] < atom->tag[j]) contactsLast_++;
     }
   }
 }

@@ -158,12 +158,7 @@ PISO
 }
 """ % dict(tol_p=tol_p, tol_u=tol_u, ncorr=n_correctors))
 
-    foam_file(os.path.join(case_dir, "system/decomposeParDict"), "dictionary", """
-numberOfSubdomains 2;
-method          hierarchical;   // scotch/metis are stubs in Debian's OpenFOAM
-coeffs { n (2 1 1); order xyz; }
-hierarchicalCoeffs { n (2 1 1); order xyz; }
-""")
+    # no system/decomposeParDict: fdmRun -f N writes the split for N ranks (fdm.decomposition)
 
     foam_file(os.path.join(case_dir, "constant/transportProperties"), "dictionary", """
 nu              %.17g;   // kinematic viscosity eta/rho_f [m2/s]
