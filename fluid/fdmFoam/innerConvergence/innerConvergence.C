@@ -30,10 +30,7 @@ void Foam::innerConvergence::reset(scalar tolVelocity, scalar tolLambda)
 
 void Foam::innerConvergence::startIteration(const volVectorField& U)
 {
-    if (tolVelocity_ > 0)
-    {
-        flowBefore_ = U.primitiveField();
-    }
+    flowBefore_ = U.primitiveField();
 }
 
 
@@ -46,10 +43,6 @@ void Foam::innerConvergence::endIteration
 )
 {
     lambdaResidual_ = lambdaResidual;
-    if (tolVelocity_ <= 0)
-    {
-        return;
-    }
 
     const vectorField& u = U.primitiveField();
     const scalar uMax = max(gMax(mag(u)), VSMALL);
