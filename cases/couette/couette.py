@@ -27,7 +27,6 @@ zeta_t/k_t (ab2) are printed, and a dt above half of them is warned about.
   couette.py --help                  every option
 Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png here (docs/cases.md).
 """
-from __future__ import annotations
 
 import argparse
 import json
@@ -288,7 +287,7 @@ def main(argv: list[str] | None = None) -> dict:
     wall = case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
     results, (channel, avg, fine, _) = analyse(run_dir, scene, pack, wall, args.np_fluid + args.np_dem,
                                                args.h_layer)
-    results.update(case="couette", run=name, acceleration=args.acceleration, tol_lambda=args.tol_lambda,
+    results.update(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration, tol_lambda=args.tol_lambda,
                    a_over_delta=args.a_over_delta, seed=args.seed, springs=asdict(springs),
                    table8=None if args.table8 is None else dict(zip(
                        ("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi])))

@@ -81,9 +81,13 @@ def read_dump(path):
         rows = lines[k + 9:k + 9 + n]
         if len(rows) < n:
             break
-        data = np.array([r.split() for r in rows], dtype=float).reshape(n, len(names))
-        if data.shape[1] != len(names):
-            break
+        words = [r.split() for r in rows]
+        if any(len(w) != len(names) for w in words):
+            if k + 9 + n >= len(lines):
+                break  # the last frame, cut short in a row
+            raise ValueError("%s: a row of the frame of step %d does not have the %d columns %s"
+                             % (path, step, len(names), " ".join(names)))
+        data = np.array(words, dtype=float)
         frames.append((step, {name: data[:, i] for i, name in enumerate(names)}))
         k += 9 + n
     return frames
