@@ -124,14 +124,14 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
 
 
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, strain: float,
-               dump_every: int, tol_lambda: float, acceleration: str) -> dict:
+               dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50) -> dict:
     """fluid/ and dem/ of the run; returns the scene's description."""
     delta = A1 / a_over_delta
     Lx, Ly, Lz = (float(v) for v in pack.box)
     U = SHEAR_RATE * Ly / 2
     box = case.Box((0, 0, 0), (Lx, Ly, Lz), delta, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
     steps = int(round(strain / (SHEAR_RATE * dt)))
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=50,
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
                           first_step=(tol_lambda / 10, 3000), n_particles=pack.n, tol_u=1e-5, tol_p=1e-3,
                           acceleration=acceleration)
     pair = ("fdm/subgrid contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
@@ -225,6 +225,8 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--h-layer", type=float, default=5.0, help="H_layer/a1: the core is |y| < L_y/2 - H_layer")
     p.add_argument("--kn", type=float, default=None, help="normal spring [N/m] (default: the rule above)")
     p.add_argument("--kt", type=float, default=None, help="tangential spring [N/m] (default: the rule above)")
+    p.add_argument("--n-max", type=int, default=50, help="fdmFoam's innerIterations nMax: a step that reaches it "
+                   "unconverged is counted in unconverged_steps")
     p.add_argument("--np-dem", type=int, default=1, help="MPI ranks of fdmDEM")
     p.add_argument("--table8", type=float, default=None, metavar="PHI",
                    help="the paper's Table 8 scene for phi_bulk = PHI (box, N_P, dt): written, not run")
@@ -275,7 +277,7 @@ def main(argv: list[str] | None = None) -> dict:
         shutil.rmtree(run_dir)
     every = max(1, int(round(args.dump_every / (SHEAR_RATE * dt))))
     scene = write_case(run_dir, pack, springs, args.a_over_delta, dt, args.strain, every, args.tol_lambda,
-                       args.acceleration)
+                       args.acceleration, args.n_max)
     packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
     print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
           "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
@@ -288,6 +290,7 @@ def main(argv: list[str] | None = None) -> dict:
     results, (channel, avg, fine, _) = analyse(run_dir, scene, pack, wall, args.np_fluid + args.np_dem,
                                                args.h_layer)
     results.update(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration, tol_lambda=args.tol_lambda,
+                   n_max=args.n_max,
                    a_over_delta=args.a_over_delta, seed=args.seed, springs=asdict(springs),
                    table8=None if args.table8 is None else dict(zip(
                        ("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi])))

@@ -12,6 +12,9 @@ Command line (prints a summary, writes the data file):
     python3 -m fdm.packing N PHI [--bidisperse] [--seed S] [--min-gap G] [--box-multiple D]
                                  [--shake SWEEPS] [--walls y] -o FILE
 
+    p = packing.channel_packing((10, 12, 8), phi=0.3, seed=1)        # any box, walls at y = 0 and L_y
+                                                                     # (the Couette and Poiseuille cells)
+
 Boxes are periodic, or wall-bounded along some axes (walls=(1,): planar walls at y = 0 and
 y = L, every sphere at least min_gap from them; LIGGGHTS boundary 'p f p'), for Couette cells.
 
@@ -144,7 +147,7 @@ def neighbour_pairs(x, box, cutoff, walls=()):
 
 def neighbour_pairs_cells(x, box, cutoff, walls=()):
     """neighbour_pairs by the periodic cell list (vectorised numpy; the generator's search before
-    scipy's KD-tree replaced it, kept as the reference of tests/test_packing.py)."""
+    scipy's KD-tree replaced it, kept as the reference of tests/test_couette.py)."""
     x = np.asarray(x, dtype=float)
     box = np.asarray(box, dtype=float)
     periodic = _periodic_mask(walls)
