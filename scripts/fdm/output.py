@@ -53,8 +53,11 @@ def dump_custom_command(dump_id, every, path, group="all", fix_id="couple"):
     """The LIGGGHTS commands that write SUSPENSION_DUMP_COLUMNS every `every` steps, sorted by id
     (after `fix <fix_id> all fdm/couple ... stresslets yes`)."""
     columns = " ".join(c.replace("couple", fix_id) for c in SUSPENSION_DUMP_COLUMNS)
+    # full double precision: LIGGGHTS's default %g keeps 6 digits (1e-4 a1 on a position of 10 a1,
+    # 2 % of h_r)
+    digits = '"%d %d' + " %.17g" * (len(SUSPENSION_DUMP_COLUMNS) - 2) + '"'
     return ["dump            %s %s custom %d %s %s" % (dump_id, group, every, path, columns),
-            "dump_modify     %s sort id" % dump_id]
+            "dump_modify     %s sort id format %s" % (dump_id, digits)]
 
 
 def read_dump(path):
