@@ -265,18 +265,23 @@ def run_and_read(run_dir, np_fluid=1, keep=False):
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",
                     before_run="", runs=("run 1",), name="in.dem", data_file="spheres.data", pair_style="none"):
-    """LIGGGHTS input for fdmDEM: spheres [(x, y, z, radius), ...] from a data file, fix fdm/couple
-    connected to ../fluid; pair_style e.g. "fdm/subgrid contact ..." (docs/dem.md), default none.
-    Returns the input path."""
+    """LIGGGHTS input for fdmDEM: spheres [(x, y, z, radius), ...] or [(x, y, z, radius, type), ...]
+    (type: the LIGGGHTS atom type, 1 if not given; e.g. 1 for a1 and 2 for a2 in a bidisperse
+    suspension) from a data file, fix fdm/couple connected to ../fluid; pair_style e.g.
+    "fdm/subgrid contact ..." (docs/dem.md), default none. Returns the input path."""
     os.makedirs(dem_dir, exist_ok=True)
+    types = [int(s[4]) if len(s) > 4 else 1 for s in spheres]
+    if any(t < 1 for t in types):
+        raise ValueError("write_dem_input: atom types must be 1 or more, got %s" % sorted(set(types)))
     with open(os.path.join(dem_dir, data_file), "w") as f:
-        f.write("spheres for fdmDEM\n\n%d atoms\n1 atom types\n\n" % len(spheres))
+        f.write("spheres for fdmDEM\n\n%d atoms\n%d atom types\n\n" % (len(spheres), max(types, default=1)))
         for d, axis in enumerate("xyz"):
             f.write("%.17g %.17g %slo %shi\n" % (box.lo[d], box.hi[d], axis, axis))
         f.write("\nAtoms\n\n")
-        for i, (x, y, z, a) in enumerate(spheres):
+        for i, (sphere, kind) in enumerate(zip(spheres, types)):
+            x, y, z, a = sphere[:4]
             # atom_style sphere: id type diameter density x y z
-            f.write("%d 1 %.17g %.17g %.17g %.17g %.17g\n" % (i + 1, 2 * a, density, x, y, z))
+            f.write("%d %d %.17g %.17g %.17g %.17g %.17g\n" % (i + 1, kind, 2 * a, density, x, y, z))
     boundary = " ".join("p" if p else "f" for p in box.periodic())
     path = os.path.join(dem_dir, name)
     with open(path, "w") as f:

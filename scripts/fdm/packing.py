@@ -1,4 +1,4 @@
-"""Random dense packings of spheres in a periodic box (numpy only), written as LIGGGHTS data files.
+"""Random dense packings of spheres in a periodic box (numpy, scipy's KD-tree), written as LIGGGHTS data files.
 
     from fdm import packing
     p = packing.random_packing(1000, 0.45, bidisperse=True, seed=1)   # the paper's a1 = 1, a2 = 1.4
@@ -11,6 +11,9 @@ Command line (prints a summary, writes the data file):
 
     python3 -m fdm.packing N PHI [--bidisperse] [--seed S] [--min-gap G] [--box-multiple D]
                                  [--shake SWEEPS] [--walls y] -o FILE
+
+    p = packing.channel_packing((10, 12, 8), phi=0.3, seed=1)        # any box, walls at y = 0 and L_y
+                                                                     # (the Couette and Poiseuille cells)
 
 Boxes are periodic, or wall-bounded along some axes (walls=(1,): planar walls at y = 0 and
 y = L, every sphere at least min_gap from them; LIGGGHTS boundary 'p f p'), for Couette cells.
@@ -29,8 +32,9 @@ the relaxation leaves the pairs it separated at about g_t, ~1.4 pairs per sphere
 phi = 0.45 and ~1.7 at phi = 0.5 (min_gap 1e-4). Optionally, hard-sphere Monte Carlo sweeps (moves
 rejected if any gap would drop below min_gap) then loosen them: after 100 sweeps ~0.07 pairs per
 sphere below 1e-3 a1 at phi = 0.45 (1000 spheres: 5 s). Neighbours come from a periodic cell list
-(Verlet list with a skin, rebuilt when a sphere has moved half the skin): 1000 spheres at
-phi = 0.5 take under a second without Monte Carlo.
+(Verlet list with a skin, rebuilt when a sphere has moved half the skin) found by scipy's periodic
+KD-tree (cKDTree with boxsize; 2-3 times faster than the former numpy cell list, same pairs):
+1000 spheres at phi = 0.5 take under a second without Monte Carlo.
 
 The minimum gap is measured at the end over every pair (minimum image, O(N) with the cell list)
 and returned in Packing.min_gap; generation fails (RuntimeError) if it is below min_gap.
@@ -114,7 +118,7 @@ def box_side(radii, phi, multiple=None):
 
 
 # ------------------------------------------------------------------------------------------------
-# neighbour search: periodic cell list, vectorised
+# neighbour search: scipy's periodic KD-tree (and the former cell list)
 # ------------------------------------------------------------------------------------------------
 
 def _periodic_mask(walls):
@@ -134,7 +138,16 @@ def _wrap(x, box, periodic):
 
 def neighbour_pairs(x, box, cutoff, walls=()):
     """Every pair i < j with centre distance < cutoff (minimum image in the periodic directions,
-    i.e. all but the axes listed in walls); returns (i, j, distance). Needs cutoff < box/2."""
+    i.e. all but the axes listed in walls); returns (i, j, distance). Needs cutoff < box/2.
+    scipy's periodic KD-tree (neighbour_pairs_kdtree): the same pairs as the cell list
+    (neighbour_pairs_cells) and 2-3 times faster (measured on a shared 2-core machine, bidisperse, walls in y, cut-off 3.1 a1:
+    350 spheres 0.36 against 0.98 ms, 1000 spheres 1.7 against 4.4 ms, 4000 spheres 7.6 against 16 ms)."""
+    return neighbour_pairs_kdtree(x, box, cutoff, walls)
+
+
+def neighbour_pairs_cells(x, box, cutoff, walls=()):
+    """neighbour_pairs by the periodic cell list (vectorised numpy; the generator's search before
+    scipy's KD-tree replaced it, kept as the reference of tests/test_couette.py)."""
     x = np.asarray(x, dtype=float)
     box = np.asarray(box, dtype=float)
     periodic = _periodic_mask(walls)
@@ -175,6 +188,34 @@ def neighbour_pairs(x, box, cutoff, walls=()):
     return i[keep], j[keep], d[keep]
 
 
+def neighbour_pairs_kdtree(x, box, cutoff, walls=()):
+    """The same pairs as neighbour_pairs (i < j, centre distance < cutoff, minimum image in the
+    periodic directions), from scipy.spatial.cKDTree with a toroidal `boxsize`. A wall-bounded axis
+    gets a period longer than the spread of the centres plus cutoff, so that no pair is found
+through its wrap. Needs cutoff <
+    box/2 along the periodic axes (one image per pair)."""
+    from scipy.spatial import cKDTree
+    x = np.asarray(x, dtype=float)
+    box = np.asarray(box, dtype=float)
+    periodic = _periodic_mask(walls)
+    if np.any(cutoff >= box[periodic] / 2):
+        raise ValueError("neighbour cut-off %g is not below half the box %s" % (cutoff, box))
+    xw = _wrap(x, box, periodic)
+    xw = np.where(periodic, np.minimum(xw, np.nextafter(box, 0)), xw)   # [0, L): the tree refuses L itself
+    low = np.where(periodic, 0.0, xw.min(axis=0) if len(xw) else 0.0)  # a wall axis: shifted to start at 0
+    xw = xw - low
+    span = xw.max(axis=0) if len(xw) else np.zeros(3)
+    period = np.where(periodic, box, span + cutoff + 1.0)
+    tree = cKDTree(xw, boxsize=period)
+    ij = tree.query_pairs(cutoff, output_type="ndarray")
+    if len(ij) == 0:
+        return np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0)
+    i, j = ij[:, 0], ij[:, 1]
+    d = np.linalg.norm(_minimum_image(x[i] - x[j], box, periodic), axis=1)
+    keep = d < cutoff
+    return i[keep], j[keep], d[keep]
+
+
 def wall_gaps(x, radii, box, walls=()):
     """Surface gaps to the walls (the faces 0 and L of each axis in walls), shape (N, 2 len(walls))."""
     cols = []
@@ -205,12 +246,20 @@ def minimum_gap(x, radii, box, walls=()):
 # generation
 # ------------------------------------------------------------------------------------------------
 
-def relax_overlaps(x, radii, box, min_gap, margin=0.5, max_iterations=20000, skin=None, step=0.55, walls=()):
+class PackingError(RuntimeError):
+    """The packing could not be made (volume fraction too high for the box, or sweeps exhausted)."""
+
+
+def relax_overlaps(x, radii, box, min_gap, margin=0.5, max_iterations=20000, skin=None, step=0.55, walls=(),
+                   wall_gap=None):
     """Pushes apart every pair (and pushes off the walls every sphere) with a surface gap below
-    (1 + margin) min_gap until the smallest gap is >= min_gap. x is modified in place; returns the
-    number of sweeps."""
+    (1 + margin) min_gap until the smallest gap is >= min_gap (and every wall gap >= wall_gap,
+    default min_gap). x is modified in place; returns the number of sweeps; raises PackingError
+    after max_iterations sweeps."""
     periodic = _periodic_mask(walls)
     target = (1.0 + margin) * min_gap
+    wall_gap = min_gap if wall_gap is None else float(wall_gap)
+    wall_target = (1.0 + margin) * wall_gap
     skin = 0.3 * float(np.min(radii)) if skin is None else skin
     cutoff = 2 * float(np.max(radii)) + target + skin
     reference = x.copy()
@@ -225,13 +274,13 @@ def relax_overlaps(x, radii, box, min_gap, margin=0.5, max_iterations=20000, ski
         d = np.linalg.norm(dx, axis=1)
         deficit = contact - d
         bad = deficit > 0
-        wall_gap = wall_gaps(x, radii, box, walls)
+        wall_gaps_now = wall_gaps(x, radii, box, walls)
         pair_ok = not np.any(bad) or np.min(d - radii[i] - radii[j]) >= min_gap
-        if pair_ok and (wall_gap.size == 0 or wall_gap.min() >= min_gap):
+        if pair_ok and (wall_gaps_now.size == 0 or wall_gaps_now.min() >= wall_gap):
             return sweep
         for k, axis in enumerate(walls):  # off the walls, to the target gap
-            lo = np.maximum(target - wall_gap[:, 2 * k], 0.0)
-            hi = np.maximum(target - wall_gap[:, 2 * k + 1], 0.0)
+            lo = np.maximum(wall_target - wall_gaps_now[:, 2 * k], 0.0)
+            hi = np.maximum(wall_target - wall_gaps_now[:, 2 * k + 1], 0.0)
             x[:, axis] += lo - hi
         b = np.nonzero(bad)[0]
         dd = np.where(d[b] > 0, d[b], 1e-12)
@@ -243,7 +292,7 @@ def relax_overlaps(x, radii, box, min_gap, margin=0.5, max_iterations=20000, ski
         np.add.at(move, j[b], -push)
         x += move
         x[:] = _wrap(x, box, periodic)
-    raise RuntimeError("overlap relaxation did not reach a minimum gap of %g in %d sweeps (phi too high?)"
+    raise PackingError("overlap relaxation did not reach a minimum gap of %g in %d sweeps (phi too high?)"
                        % (min_gap, max_iterations))
 
 
@@ -320,6 +369,91 @@ def random_packing(n, phi, bidisperse=False, seed=0, min_gap=1e-4, box_multiple=
     if not (p.min_gap >= min_gap):
         raise RuntimeError("packing has a minimum gap %g below the requested %g" % (p.min_gap, min_gap))
     return p
+
+
+RANDOM_CLOSE_PACKING = 0.64
+"""Above this volume fraction no random packing exists (a bidisperse mixture packs a little denser,
+but not at random from an overlap relaxation): refused at once."""
+
+
+def bidisperse_counts_for_volume(volume, phi, a1=1.0):
+    """(n1, n2) for the paper's suspension (section 6: a2 = 1.4 a1, equal volumes of both sizes)
+    filling the fraction phi of `volume`: n_k = round(phi volume / 2 / (4/3 pi a_k^3))."""
+    half = 0.5 * phi * volume
+    n1 = int(round(half / (4.0 / 3.0 * math.pi * a1 ** 3)))
+    n2 = int(round(half / (4.0 / 3.0 * math.pi * (A2_OVER_A1 * a1) ** 3)))
+    return n1, n2
+
+
+def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, wall_axis=1, a1=1.0,
+                    attempts=3, max_sweeps=3000, margin=0.5):
+    """A random bidisperse packing (a2 = 1.4 a1, equal volumes) in the box [0, L_x] x [0, L_y] x
+    [0, L_z] of any shape, periodic except along wall_axis (planar walls at 0 and L there), for
+    Couette and Poiseuille cells.
+
+    box: (L_x, L_y, L_z); phi: the target volume fraction (the counts from
+    bidisperse_counts_for_volume, the actual phi is Packing.phi) or n: the total count (split by
+    counts(n, True), e.g. the N_P of Table 8). min_gap: smallest surface gap between spheres,
+    wall_gap: between a sphere and a wall (default min_gap). Tries `attempts` seeds (seed, seed +
+    1, ...) of at most max_sweeps relaxation sweeps each.
+
+    Raises ValueError for a box side smaller than a particle (diameter 2 a2 plus the wall gaps
+    across the walls) or too small for the minimum image (a periodic side below 2 (2 a2 + gaps)),
+    and for phi >= RANDOM_CLOSE_PACKING; PackingError naming phi, the box and the attempts when
+    the relaxation fails at every seed."""
+    box = np.asarray(box, dtype=float)
+    if box.shape != (3,) or np.any(box <= 0):
+        raise ValueError("packing: the box must be three positive lengths, got %s" % (box,))
+    wall_gap = min_gap if wall_gap is None else float(wall_gap)
+    a2 = A2_OVER_A1 * a1
+    text = " x ".join("%g" % b for b in box)
+    if box[wall_axis] < 2 * a2 + 2 * wall_gap or np.any(box < 2 * a2):
+        raise ValueError("packing: the box %s a1 is smaller than a particle: the large spheres have a diameter of "
+                         "%g a1 (and need %g a1 between the walls)" % (text, 2 * a2, 2 * a2 + 2 * wall_gap))
+    periodic_sides = np.delete(box, wall_axis)
+    needed = 2 * (2 * a2 + (1 + margin) * min_gap + 0.3 * a1)
+    if np.any(periodic_sides <= needed):
+        raise ValueError("packing: the periodic sides of the box %s a1 must exceed %.3g a1 (twice the neighbour "
+                         "cut-off of the large spheres) for the minimum image to be unique" % (text, needed))
+    if (phi is None) == (n is None):
+        raise ValueError("packing: give either phi or n")
+    if n is None:
+        if not 0 < phi < RANDOM_CLOSE_PACKING:
+            raise ValueError("packing: phi = %g is not in (0, %g): no random packing of spheres reaches it"
+                             % (phi, RANDOM_CLOSE_PACKING))
+        n1, n2 = bidisperse_counts_for_volume(float(np.prod(box)), phi, a1)
+    else:
+        n1, n2 = counts(int(n), True)
+    radii = np.concatenate([np.full(n1, a1), np.full(n2, a2)])
+    types = np.concatenate([np.ones(n1, dtype=int), 2 * np.ones(n2, dtype=int)])
+    if n1 + n2 == 0:
+        raise ValueError("packing: phi = %g in the box %s a1 makes no sphere" % (phi, text))
+    phi_actual = float(np.sum(4.0 / 3.0 * math.pi * radii ** 3) / np.prod(box))
+    if phi_actual >= RANDOM_CLOSE_PACKING:
+        raise ValueError("packing: %d spheres in the box %s a1 make phi = %.4g, not below %g: no random packing "
+                         "reaches it" % (n1 + n2, text, phi_actual, RANDOM_CLOSE_PACKING))
+    failures = []
+    for attempt in range(attempts):
+        rng = np.random.default_rng(seed + attempt)
+        perm = rng.permutation(n1 + n2)  # mix the two sizes in tag order
+        r, t = radii[perm], types[perm]
+        x = rng.uniform(0.0, 1.0, (n1 + n2, 3)) * box
+        # centres where the sphere fits between the walls
+        x[:, wall_axis] = r + 2 * wall_gap + rng.uniform(0.0, 1.0, n1 + n2) * (box[wall_axis] - 2 * r - 4 * wall_gap)
+        try:
+            sweeps = relax_overlaps(x, r, box, min_gap, margin=margin, max_iterations=max_sweeps,
+                                    walls=(wall_axis,), wall_gap=wall_gap)
+        except PackingError as e:
+            failures.append("seed %d: %s" % (seed + attempt, e))
+            continue
+        p = Packing(x, r, t, box, dict(seed=seed + attempt, relaxation_sweeps=sweeps, attempts=attempt + 1),
+                    walls=(wall_axis,))
+        if p.min_gap >= min(min_gap, wall_gap) and p.min_wall_gap >= wall_gap:
+            return p
+        failures.append("seed %d: minimum gap %g, wall gap %g" % (seed + attempt, p.min_gap, p.min_wall_gap))
+    raise PackingError("packing: phi = %.4g (%d + %d spheres) could not be packed in the box %s a1 with walls on "
+                       "axis %s: %d attempts of %d relaxation sweeps failed (%s); lower phi or enlarge the box"
+                       % (phi_actual, n1, n2, text, "xyz"[wall_axis], attempts, max_sweeps, "; ".join(failures)))
 
 
 def write_data(path, p, density=1000.0, scale=1.0, title=None):

@@ -1,0 +1,318 @@
+#!/usr/bin/env python3
+"""A frictional bidisperse suspension in plane Couette flow (paper section 6.1, Table 8, Eqs. 49-57).
+
+Walls y = 0 and y = L_y move at -U and +U along x (nominal shear rate gamma_dot_0 = 2U/L_y = 1),
+x and z are periodic. The suspension: spheres of radii a1 = 1 and a2 = 1.4 a1 in equal volumes
+(phi_1 = phi_2 = phi_bulk/2), placed at random without overlap and clear of the walls
+(fdm.packing.channel_packing), frictional contact with h_r = 5e-3 a1 and mu_s = 0.5 (pairs and
+walls), sub-grid lubrication for pairs and walls, stresslets on. Units: a1 = 1 m, eta = 1 Pa s,
+gamma_dot_0 = 1 1/s (time = strain).
+
+The contact springs follow the rules of docs/contact.md ("A recipe"), computed and printed:
+  F_max = 6 pi eta a2^2 gamma_dot_0 eta_MP(phi)      the design load: the Stokes drag scale of the large
+                                                     sphere times the suspension's relative viscosity
+                                                     from the paper's Maron-Pierce fit (Eq. 55:
+                                                     alpha = 0.803, phi_m = 0.59)
+  k_n   = 2 F_max / h_r                              a contact under F_max sits at h = h_r/2 (recipe step 2)
+  k_t   = min(k_n, 0.5 zeta_t / dt)                  the tangential spring within half its ab2 limit (step 4)
+with zeta_n, zeta_t the normal and slip resistances of a free a1-a1 pair at the gap h_r/2 (Stokes drag
+plus the sub-grid block at this a1/Delta, fdmResistance); the stable time steps zeta_n/k_n and
+zeta_t/k_t (ab2) are printed, and a dt above half of them is warned about.
+
+  couette.py                         the small scene (about 40 spheres, 10 x 12 x 8 a1, a1/Delta = 3,
+                                     3 strain units at dt = 0.02): a few minutes
+  couette.py --acceleration none     the same with the plain inner iteration (issue 13, benchmark c)
+  couette.py --table8 0.27           writes the paper's Table 8 scene for phi_bulk = 0.27 (box, N_P, dt)
+                                     and stops (run it with fdmRun, or --run)
+  couette.py --help                  every option
+Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png here (docs/cases.md).
+"""
+
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+import time
+import dataclasses
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
+from fdm import case, output, packing, profiles, rheology, theory  # noqa: E402
+
+A1 = 1.0
+A2 = packing.A2_OVER_A1 * A1
+ETA = 1.0
+SHEAR_RATE = 1.0
+ROUGHNESS = 5e-3 * A1        # h_r (section 6)
+FRICTION = 0.5               # mu_s (section 6)
+MARON_PIERCE = (0.803, 0.59)  # alpha, phi_m of the paper's fit (Eq. 55, Fig. 21)
+SPRING_SAFETY = 0.5           # docs/contact.md recipe step 4
+PAIR_CUTOFF = 0.65            # pair_style fdm/subgrid default cut-off (mesh cells)
+
+# Table 8: phi_bulk -> (phi_core, gamma_core/gamma_0, (Lx, Ly, Lz)/a1, N_P, dt)
+TABLE8 = {
+    0.27: (0.303, 0.923, (20, 20, 20), 350, 1e-4),
+    0.32: (0.359, 0.885, (20, 20, 20), 416, 1e-4),
+    0.37: (0.405, 0.873, (20, 20, 20), 481, 1e-4),
+    0.42: (0.458, 0.773, (20, 20, 20), 547, 1e-4),
+    0.47: (0.493, 0.745, (25, 25, 20), 956, 1e-4),
+    0.52: (0.543, 0.563, (25, 25, 20), 1057, 1e-4),
+    0.54: (0.570, 0.391, (25, 25, 20), 1098, 2e-5),
+}
+
+
+@dataclass(frozen=True)
+class Springs:
+    """The contact parameters of pair_style fdm/subgrid and how they were chosen."""
+
+    kn: float
+    kt: float
+    mu_s: float
+    h_r: float
+    design_load: float
+    zeta_n: float
+    zeta_t: float
+    dt_limit_normal: float
+    dt_limit_tangential: float
+
+    def describe(self, dt: float) -> str:
+        return ("contact springs (docs/contact.md recipe): design load F_max = %.4g N, kn = 2 F_max/h_r = %.4g N/m, "
+                "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a1-a1 pair at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
+                "stable dt (ab2): normal %.4g, tangential %.4g; dt = %g is %.2f of the smaller"
+                % (self.design_load, self.kn, self.kt, self.mu_s, self.h_r / A1, self.zeta_n, self.zeta_t,
+                   self.dt_limit_normal, self.dt_limit_tangential, dt,
+                   dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
+
+
+def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta: float = ETA,
+                          cutoff: float = PAIR_CUTOFF) -> tuple[float, float]:
+    """(zeta_n, zeta_t) of two free spheres at surface gap `gap`: the force per unit closing speed
+    under equal and opposite loads along the line of centres, and per unit slip speed of the contact
+    points under equal and opposite tangential loads there (with their torques); the resistance is
+    the isolated Stokes drag (6 pi eta a, 8 pi eta a^3) plus the sub-grid pair block of fdmResistance
+    (Eq. 21), as in Eq. (31) without the fluid's resolved part (docs/contact.md, 3c)."""
+    out = theory.resistance("matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % (a_i + a_j + gap), 0, 0, "--a1", a_i,
+                            "--a2", a_j, "--delta", "%.17g" % delta, "--eta", eta, "--cutoff", cutoff)
+    drag = [6 * math.pi * eta * a_i] * 3 + [8 * math.pi * eta * a_i ** 3] * 3 \
+        + [6 * math.pi * eta * a_j] * 3 + [8 * math.pi * eta * a_j ** 3] * 3
+    resistance = np.diag(drag) + np.array(out["R"])
+    d = np.array([1.0, 0.0, 0.0])       # from sphere i to sphere j
+    t = np.array([0.0, 1.0, 0.0])
+    zero = np.zeros(3)
+    u = np.linalg.solve(resistance, np.concatenate([-d, zero, d, zero]))   # pulled apart
+    zeta_n = 1.0 / float((u[6:9] - u[0:3]) @ d)
+    u = np.linalg.solve(resistance, np.concatenate([t, np.cross(a_i * d, t), -t, np.cross(-a_j * d, -t)]))
+    slip = u[0:3] + np.cross(u[3:6], a_i * d) - u[6:9] - np.cross(u[9:12], -a_j * d)
+    zeta_t = 1.0 / float(slip @ t)
+    return zeta_n, zeta_t
+
+
+def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None) -> Springs:
+    """The springs by the rule of the module docstring (docs/contact.md), unless given."""
+    alpha, phi_m = MARON_PIERCE
+    relative_viscosity = alpha / (1.0 - min(phi, 0.9 * phi_m) / phi_m) ** 2
+    design_load = 6 * math.pi * ETA * A2 ** 2 * SHEAR_RATE * relative_viscosity
+    zeta_n, zeta_t = pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta)
+    kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
+    kt = min(kn, SPRING_SAFETY * zeta_t / dt) if kt is None else kt
+    return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
+
+
+def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, strain: float,
+               dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50) -> dict:
+    """fluid/ and dem/ of the run; returns the scene's description."""
+    delta = A1 / a_over_delta
+    Lx, Ly, Lz = (float(v) for v in pack.box)
+    U = SHEAR_RATE * Ly / 2
+    box = case.Box((0, 0, 0), (Lx, Ly, Lz), delta, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
+    steps = int(round(strain / (SHEAR_RATE * dt)))
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
+                          first_step=(tol_lambda / 10, 3000), n_particles=pack.n, tol_u=1e-5, tol_p=1e-3,
+                          acceleration=acceleration)
+    pair = ("fdm/subgrid contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
+            % (springs.kn, springs.kt, springs.mu_s, springs.h_r, -U, U))
+    spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]
+    runs = (output.dump_custom_command("particles", dump_every, "particles.dump")
+            + ["thermo_style    custom step f_couple[1] f_couple[2] f_couple[6] f_couple[7] f_couple[8]",
+               "thermo          %d" % dump_every,
+               "run             %d" % steps])
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
+                         fix_options="stresslets yes", runs=runs, name="in.couette")
+    return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
+                wall_velocity=U, dt=dt, dump_every=dump_every)
+
+
+def minimum_gaps(snapshots: list[profiles.Snapshot], box: np.ndarray) -> tuple[float, float]:
+    """Smallest surface gap between spheres and between a sphere and a wall over the snapshots."""
+    pair, wall = math.inf, math.inf
+    for s in snapshots:
+        pair = min(pair, _pair_gap(s, box))
+        wall = min(wall, float(np.min(np.minimum(s.positions[:, 1] - s.radii, box[1] - s.positions[:, 1] - s.radii))))
+    return pair, wall
+
+
+def _pair_gap(s: profiles.Snapshot, box: np.ndarray) -> float:
+    i, j, d = packing.neighbour_pairs(s.positions, box, 2 * float(s.radii.max()) + 0.5, walls=(1,))
+    return float(np.min(d - s.radii[i] - s.radii[j])) if len(i) else math.inf
+
+
+def analyse(run_dir: str, scene: dict, pack: packing.Packing, wall_seconds: float, ranks: int,
+            h_layer: float) -> tuple[dict, list]:
+    """results of one run: the profiles and rheology (fdm.profiles, fdm.rheology), the inner
+    iterations, the gaps."""
+    fluid = os.path.join(run_dir, "fluid")
+    steps = output.steps(fluid)
+    snapshots, _ = output.suspension_snapshots(os.path.join(run_dir, "dem", "particles.dump"), scene["dt"],
+                                               SHEAR_RATE)
+    box = np.array(scene["box"])
+    channel = profiles.Channel((0, 0, 0), tuple(box))
+    phi_integral = [profiles.bulk_volume_fraction(s, channel) for s in snapshots]
+    series = profiles.core_series(snapshots, channel, h_layer=h_layer)
+    if len(snapshots) >= 16:
+        r = rheology.shear_rheology(series, eta=ETA)    # the steady part from MSER-m (docs/profiles.md)
+    elif len(snapshots) >= 8:  # too few snapshots for the transient rule: the last 8 or more, flagged
+        r = rheology.shear_rheology(series, eta=ETA, start_time=float(series.times[min(len(snapshots) // 2,
+                                                                                          len(snapshots) - 8)]))
+        r = dataclasses.replace(r, steady=False)
+    else:
+        raise ValueError("couette: %d particle snapshots are too few for time averages (8 at least): run longer "
+                         "or lower --dump-every" % len(snapshots))
+    avg = profiles.average_profiles(snapshots, channel, start_time=r.start_time)
+    fine = profiles.average_profiles(snapshots, channel, y=channel.planes(0.02), start_time=r.start_time, errors=False)
+    pair_gap, wall_gap = minimum_gaps(snapshots, box)
+    strain = float(steps["time"][-1] * SHEAR_RATE)
+    inner = steps["innerIterations"]
+
+    def est(e: rheology.Estimate) -> float:
+        return float(e.value)
+
+    res = dict(
+        phi_bulk=pack.phi, phi_bulk_integral_max_error=float(np.max(np.abs(np.array(phi_integral) - pack.phi))),
+        phi_core=est(r.phi_core), phi_core_err=r.phi_core.error,
+        gamma_core_over_gamma0=est(r.gamma_dot_core) / SHEAR_RATE, gamma_core_err=r.gamma_dot_core.error,
+        eta_s=est(r.eta_s), eta_s_err=r.eta_s.error, eta_s_n_eff=r.eta_s.n_eff,
+        N1_hat=est(r.n1_hat), N1_hat_err=r.n1_hat.error, N2_hat=est(r.n2_hat), N2_hat_err=r.n2_hat.error,
+        Sigma_c_hat=[est(e) for e in r.sigma_c_hat], Sigma_c_hat_err=[e.error for e in r.sigma_c_hat],
+        strain_units=strain, steady_from_strain=r.start_time, steady_detected=r.steady, samples_averaged=r.n_samples,
+        h_layer=h_layer, n_particles=pack.n, n_a1=int(np.sum(pack.types == 1)), n_a2=int(np.sum(pack.types == 2)),
+        cells=scene["cells"], mesh=scene["mesh"], box=scene["box"], dt=scene["dt"], steps=int(len(inner)),
+        wall_seconds=wall_seconds, ranks=ranks,
+        core_seconds_per_strain_unit=wall_seconds * ranks / strain,
+        inner_iterations_mean=float(inner.mean()), inner_iterations_max=int(inner.max()),
+        unconverged_steps=int(np.sum(steps["converged"] == 0)),
+        min_pair_gap=pair_gap, min_wall_gap=wall_gap,
+        mean_particle_velocity=np.mean([s.velocities.mean(axis=0) for s in snapshots], axis=0).tolist(),
+        snapshots=len(snapshots))
+    return res, [channel, avg, fine, snapshots]
+
+
+def main(argv: list[str] | None = None) -> dict:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--phi", type=float, default=0.3, help="phi_bulk, the volume fraction of the spheres in the box")
+    p.add_argument("--size", type=float, nargs=3, default=[10.0, 12.0, 8.0], metavar=("LX", "LY", "LZ"),
+                   help="box in units of a1 (walls normal to y); each a whole number of cells")
+    p.add_argument("--a-over-delta", type=float, default=3.0, help="a1/Delta, mesh cells per small radius")
+    p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 (default 0.02; "
+                   "with --table8, Table 8's)")
+    p.add_argument("--strain", type=float, default=3.0, help="strain units to run")
+    p.add_argument("--seed", type=int, default=1, help="seed of the random packing")
+    p.add_argument("--dump-every", type=float, default=0.1, help="strain between two particle snapshots")
+    p.add_argument("--h-layer", type=float, default=5.0, help="H_layer/a1: the core is |y| < L_y/2 - H_layer")
+    p.add_argument("--kn", type=float, default=None, help="normal spring [N/m] (default: the rule above)")
+    p.add_argument("--kt", type=float, default=None, help="tangential spring [N/m] (default: the rule above)")
+    p.add_argument("--n-max", type=int, default=50, help="fdmFoam's innerIterations nMax: a step that reaches it "
+                   "unconverged is counted in unconverged_steps")
+    p.add_argument("--np-dem", type=int, default=1, help="MPI ranks of fdmDEM")
+    p.add_argument("--table8", type=float, default=None, metavar="PHI",
+                   help="the paper's Table 8 scene for phi_bulk = PHI (box, N_P, dt): written, not run")
+    p.add_argument("--run", action="store_true", help="with --table8: run it too")
+    p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
+    case.add_run_options(p, HERE, tol_lambda=1e-3)
+    args = p.parse_args(argv)
+
+    n_particles = None
+    phi = args.phi
+    if args.table8 is not None:
+        key = min(TABLE8, key=lambda k: abs(k - args.table8))
+        if abs(key - args.table8) > 1e-9:
+            p.error("--table8 %g: Table 8 has phi_bulk = %s" % (args.table8, ", ".join("%g" % k for k in TABLE8)))
+        _, _, size, n_particles, dt_paper = TABLE8[key]
+        args.size, phi = list(size), key
+        args.dt = dt_paper if args.dt is None else args.dt
+    dt = 0.02 if args.dt is None else args.dt
+    delta = A1 / args.a_over_delta
+    for L, name in zip(args.size, "xyz"):
+        if abs(L / delta - round(L / delta)) > 1e-9 * L / delta:
+            p.error("--size: L%s = %g a1 is not a whole number of cells of a1/%g" % (name, L, args.a_over_delta))
+    if args.strain <= 0 or dt <= 0:
+        p.error("--strain and --dt must be positive")
+
+    pack = packing.channel_packing(args.size, phi=None if n_particles else phi, n=n_particles, seed=args.seed,
+                                   min_gap=2 * ROUGHNESS, wall_gap=2 * ROUGHNESS)
+    print("packing:", pack.summary())
+    springs = choose_springs(pack.phi, dt, delta, args.kn, args.kt)
+    print(springs.describe(dt))
+    limit = min(springs.dt_limit_normal, springs.dt_limit_tangential)
+    if dt > limit:
+        print("WARNING: dt = %g is beyond the contact stability limit %.4g (ab2, docs/contact.md 3c): expect limit "
+              "cycles, overlaps and contacts that look plausible but are wrong" % (dt, limit))
+    elif dt > SPRING_SAFETY * limit:
+        print("note: dt = %g is above half the contact stability limit %.4g (the recipe's safety factor): the "
+              "gaps and loads of a suspension vary" % (dt, limit))
+
+    name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (pack.phi if n_particles is None else phi, *args.size,
+                                                  args.a_over_delta, dt, args.seed,
+                                                  "" if args.acceleration == "anderson" else "_" + args.acceleration)
+    if args.table8 is not None:
+        name = "table8_" + name
+    run_dir = os.path.join(args.workdir, name)
+    if os.path.exists(run_dir):
+        if not args.overwrite:
+            raise SystemExit("couette: %s already holds a run; --overwrite replaces it" % run_dir)
+        shutil.rmtree(run_dir)
+    every = max(1, int(round(args.dump_every / (SHEAR_RATE * dt))))
+    scene = write_case(run_dir, pack, springs, args.a_over_delta, dt, args.strain, every, args.tol_lambda,
+                       args.acceleration, args.n_max)
+    packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
+    print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
+          "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
+                              " x ".join("%g" % v for v in args.size), scene["cells"], scene["steps"], dt, every))
+    if args.table8 is not None and not args.run:
+        print("Table 8 scene written, not run: fdmRun -f N -d M %s" % run_dir)
+        return dict(run_dir=run_dir, **scene)
+
+    wall = case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
+    results, (channel, avg, fine, _) = analyse(run_dir, scene, pack, wall, args.np_fluid + args.np_dem,
+                                               args.h_layer)
+    results.update(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration, tol_lambda=args.tol_lambda,
+                   n_max=args.n_max,
+                   a_over_delta=args.a_over_delta, seed=args.seed, springs=asdict(springs),
+                   table8=None if args.table8 is None else dict(zip(
+                       ("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi])))
+    figure = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_couette.png")
+    profiles.plot_profiles(figure, channel, avg, fine)
+    results["figure"] = os.path.basename(figure)
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=1)
+    keys = ("phi_bulk phi_core gamma_core_over_gamma0 eta_s eta_s_err N1_hat N2_hat Sigma_c_hat strain_units "
+            "steady_from_strain n_particles cells dt wall_seconds core_seconds_per_strain_unit inner_iterations_mean "
+            "inner_iterations_max unconverged_steps min_pair_gap min_wall_gap").split()
+    for k in keys:
+        print("%-30s %s" % (k, results[k]))
+    print("wrote %s and %s" % (args.out, figure))
+    if not args.keep:
+        fluid = os.path.join(run_dir, "fluid")
+        shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
+        for d in os.listdir(fluid):
+            if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
+                shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+    return results
+
+
+if __name__ == "__main__":
+    main()
