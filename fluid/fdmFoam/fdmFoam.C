@@ -28,6 +28,7 @@ Usage
 #include "fvCFD.H"
 #include "pisoControl.H"
 #include "OFstream.H"
+#include "OStringStream.H"
 #include "uniformCartesianMesh.H"
 #include "particleForcing.H"
 #include "fluidCoupling.H"
