@@ -7,10 +7,11 @@ import re
 import signal
 import subprocess
 import time
+import warnings
 
 import pytest
 
-from fdm import case
+from fdm import case, output
 
 PROJECT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FDMRUN = os.path.join(PROJECT, "scripts", "fdmRun")
@@ -74,7 +75,8 @@ def test_overlapping_particles(tmp_path, env):
 
 
 def test_missing_dictionary_entry(tmp_path, env):
-    root = make_case(tmp_path, fdm_edit=lambda t: re.sub(r"\n\s*tolLambda[^\n]*", "", t, count=1))
+    # neither tolerance of the inner iterations (case.py writes both)
+    root = make_case(tmp_path, fdm_edit=lambda t: re.sub(r"\n\s*tol(Lambda|Velocity)[^\n]*", "", t, count=2))
     status, out, wall = run_fdm(root, env)
     assert status != 0
     text = logs(root)
@@ -153,3 +155,97 @@ def test_peer_dies_mid_run(tmp_path, env):
     assert status != 0
     assert stopped < 10
     assert re.search(r"closed the connection|connection", open(os.path.join(root, "log.fluid")).read())
+
+
+def fluid_alone(root, env):
+    """fdmFoam alone on the case (meshed first): for errors it finds before waiting for fdmDEM."""
+    fluid = os.path.join(root, "fluid")
+    subprocess.run(["blockMesh", "-case", fluid], env=env, check=True, stdout=subprocess.DEVNULL)
+    proc = subprocess.run(["fdmFoam", "-case", fluid], env=env, text=True, errors="replace",
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60)
+    return proc.returncode, proc.stdout
+
+
+@pytest.mark.parametrize("where,good,bad,key,valid", [
+    ("constant/fdmProperties", "gradP0  ", "gradPO  ", "gradPO", "indicator alphaLambda pseudoTimeFactor"),
+    ("indicator", "{ b ", "{ bb ", "bb", "b c"),
+    ("innerIterations", "tolLambda   ", "tolLamda   ", "tolLamda",
+     "tolLambda tolVelocity nMax nMin firstStep acceleration depth report"),
+    ("innerIterations/firstStep", "innerIterations\n{", "innerIterations\n{\n    firstStep { nmax 10; }", "nmax",
+     "tolLambda tolVelocity nMax"),
+    ("output", "coupling\n{", "output { particleEvery 2; }\ncoupling\n{", "particleEvery", "particlesEvery"),
+    ("coupling", "connectTimeout 5", "conectTimeout 5", "conectTimeout",
+     "transport host port portFile directory record"),
+])
+def test_unknown_dictionary_entry(tmp_path, env, where, good, bad, key, valid):
+    """A misspelt entry would silently take its default: it is refused, with the valid ones."""
+    def misspell(text):
+        assert good in text, good
+        return text.replace(good, bad, 1)
+    root = make_case(tmp_path, fdm_edit=misspell)
+    status, out = fluid_alone(root, env)
+    assert status != 0
+    assert "unknown entry %s in %s; valid: %s" % (key, where, valid) in out, out[-2000:]
+    assert "fdmProperties" in out
+
+
+def test_used_case_folder_needs_overwrite(tmp_path, env):
+    """A second run in the same folder would mix the old fluid state and records with fresh
+    particles: refused; --overwrite deletes the outputs only and runs afresh."""
+    root = make_case(tmp_path)
+    status, out, _ = run_fdm(root, env)
+    assert status == 0, out
+    inputs = {}
+    for rel in ("fluid/0/U", "fluid/system/controlDict", "fluid/constant/fdmProperties", "dem/in.dem",
+                "dem/spheres.data"):
+        inputs[rel] = open(os.path.join(root, rel)).read()
+    fluid = os.path.join(root, "fluid")
+    first = output.steps(fluid)["step"]
+
+    status, out, _ = run_fdm(root, env)
+    assert status == 2
+    assert "holds a previous run" in out and "--overwrite" in out and "fluid/2" in out, out
+    proc = subprocess.run([FDMRUN, "--resume", root], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, env=env)
+    assert proc.returncode == 2 and "--resume is not implemented yet" in proc.stdout, proc.stdout
+
+    proc = subprocess.run([FDMRUN, "--quiet", "--overwrite", root], stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True, env=env, timeout=60)
+    assert proc.returncode == 0, proc.stdout
+    for rel, text in inputs.items():
+        assert open(os.path.join(root, rel)).read() == text, rel
+    # the records of the second run alone, from step 1, not appended to the first run's
+    assert list(output.steps(fluid)["step"]) == list(first)
+    assert "Starting time loop" in open(os.path.join(root, "log.fluid")).read()
+
+
+def test_disk_full_stops_both_codes(tmp_path, env):
+    """The records' disk fills up mid-run (a 8 kB tmpfs on postProcessing/fdm): fdmFoam stops with
+    the file it could not write, fdmDEM is told and stops, and the records already written read
+    back whole (the reader drops only an unfinished last line)."""
+    spheres = [(x, y, z, 0.5) for x in (1.0, 3.0) for y in (1.0, 3.0) for z in (1.0, 3.0)]
+    root = make_case(tmp_path, spheres=spheres, runs=("run 1000",),
+                     fdm_edit=lambda t: re.sub(r"nMax\s+\d+;", "nMax 2;", t))
+    records = os.path.join(root, "fluid", "postProcessing", "fdm")
+    os.makedirs(records)
+    if os.geteuid() != 0 or subprocess.run(["mount", "-t", "tmpfs", "-o", "size=8k", "tmpfs", records],
+                                           stderr=subprocess.DEVNULL).returncode != 0:
+        pytest.skip("cannot mount a tmpfs here (needs root)")
+    try:
+        status, out, wall = run_fdm(root, env, timeout=120)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an unfinished last line is expected here
+            steps = output.steps(os.path.join(root, "fluid"))
+            parts = output.particles(os.path.join(root, "fluid"))
+    finally:
+        subprocess.run(["umount", records])
+    assert status != 0
+    text = logs(root)
+    assert re.search(r"could not write .*(steps|particles)\.dat \(disk full", text), text[-3000:]
+    assert "fdmFoam: could not write" in open(os.path.join(root, "log.dem"), errors="replace").read()
+    assert wall < 60
+    # every step recorded before the failure is there, once, in order
+    n = len(steps["step"])
+    assert n >= 2 and list(steps["step"]) == list(range(1, n + 1))
+    complete = [s for s in range(1, n + 1) if (parts["step"] == s).sum() == len(spheres)]
+    assert complete == list(range(1, len(complete) + 1)) and len(complete) >= n - 1
