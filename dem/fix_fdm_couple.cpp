@@ -166,6 +166,8 @@ void FixFdmCouple::init()
     error->all(FLERR, (std::string("fix fdm/couple requires units si (the fluid solver works in SI), not units ") +
                        update->unit_style).c_str());
   if (!(update->dt > 0)) error->all(FLERR, "fix fdm/couple requires a positive timestep");
+  // the contact springs' stability limit depends on the time step and on this fix's integrator
+  if (pair_) pair_->checkTimeStep(update->dt, adamsBashforth_);
   for (int i = 0; i < modify->nfix; i++) {
     Fix *other = modify->fix[i];
     if (other == this) continue;
