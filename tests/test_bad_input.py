@@ -18,7 +18,7 @@ FDMRUN = os.path.join(PROJECT, "scripts", "fdmRun")
 
 
 def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None, n_particles=-1,
-              fdm_edit=None, fix_options="move no", runs=("run 2",)):
+              fdm_edit=None, fix_options="move no", runs=("run 2",), pair_style="none", dt=1.0):
     box = box or case.Box((0, 0, 0), (4, 4, 4), 0.5)
     root = str(tmp_path / "case")
     fluid = os.path.join(root, "fluid")
@@ -30,7 +30,7 @@ def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None,
         text = fdm_edit(text)
     open(props, "w").write(text)
     case.write_dem_input(os.path.join(root, "dem"), dem_box or box, list(spheres),
-                         fix_options="connect_timeout 5 " + fix_options, runs=runs)
+                         fix_options="connect_timeout 5 " + fix_options, runs=runs, pair_style=pair_style, dt=dt)
     return root
 
 
@@ -249,3 +249,51 @@ def test_disk_full_stops_both_codes(tmp_path, env):
     assert n >= 2 and list(steps["step"]) == list(range(1, n + 1))
     complete = [s for s in range(1, n + 1) if (parts["step"] == s).sum() == len(spheres)]
     assert complete == list(range(1, len(complete) + 1)) and len(complete) >= n - 1
+
+
+# Two spheres of radius 1 at a gap of 0.05 in a periodic 6 x 4 x 4 box, Delta = 0.5 (a/Delta = 2),
+# viscosity 1 Pa s, contact at h_r = 0.01 m, kt = 0: the normal spring of the pair limits the step,
+# zeta = 3 pi eta a + the sub-grid squeeze resistance, from ~480 N s/m at h_r to ~5e5 at zero gap.
+PAIR = [(1.5, 2.0, 2.0, 1.0), (3.55, 2.0, 2.0, 1.0)]
+PAIR_BOX = case.Box((0, 0, 0), (6, 4, 4), 0.5)
+
+
+def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
+    """kn = 1e6 N/m, dt = 1 s: beyond dt k/zeta < 1 (ab2) even with the largest resistance a contact
+    can have: an error at the start, with the limit and how it was computed; both codes stop."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 0 0.5 0.01")
+    status, out, wall = run_fdm(root, env)
+    assert status != 0
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    m = re.search(r"ERROR: pair_style fdm/subgrid: time step 1 s is beyond the stability limit of the contact "
+                  r"springs at every gap: the normal spring of two spheres \(k 1e\+06 N/m\) needs dt < (\S+) s even at "
+                  r"zero gap .* and dt < (\S+) s at the contact gap h_r = 0.01 m .*dt k/zeta < 1 with integrator ab2",
+                  dem)
+    assert m, dem[-3000:]
+    assert 0.1 < float(m.group(1)) < 1 and 1e-4 < float(m.group(2)) < 1e-3
+    assert "pair_style fdm/subgrid: time step 1 s" in open(os.path.join(root, "log.fluid")).read()
+    assert wall < 30
+
+
+def test_time_step_beyond_contact_stability_at_the_contact_gap(tmp_path, env):
+    """kn = 1e4 N/m, dt = 1 s: beyond the limit at h_r (~0.05 s), within it for contacts pressed
+    deeper (~50 s at zero gap): a warning, and the run goes on."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e4 0 0.5 0.01",
+                     runs=("run 1",))
+    status, out, wall = run_fdm(root, env)
+    assert status == 0, out
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    m = re.search(r"WARNING: pair_style fdm/subgrid: time step 1 s is beyond the stability limit (\S+) s of the normal "
+                  r"spring of two spheres .* at the contact gap h_r = 0.01 m", dem)
+    assert m and 0.01 < float(m.group(1)) < 0.1, dem[-3000:]
+
+
+def test_particles_too_small_for_the_mesh(tmp_path, env):
+    """a/Delta = 1: below the range of the cut-off sub-grid model (a/Delta >= 2), reported."""
+    root = make_case(tmp_path, pair_style="fdm/subgrid", runs=("run 1",))
+    status, out, wall = run_fdm(root, env)
+    assert status == 0, out
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    assert re.search(r"WARNING: pair_style fdm/subgrid: particle radius over mesh size a/Delta from 1 to 1 \(radii "
+                     r"0.5 .. 0.5 m, Delta 0.5 m\) is outside the range the cut-off sub-grid model covers, a/Delta "
+                     r"2 .. 20", dem), dem[-3000:]
