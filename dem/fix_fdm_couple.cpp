@@ -45,7 +45,7 @@ std::string tagName(int index) { return std::to_string(index + 1); }
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
-  nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), solverIterationsMax_(0), pairBlocks_(0),
+  nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0)
 {
   if (igroup != 0) error->all(FLERR, "fix fdm/couple must be applied to group all (every particle is in the fluid)");
