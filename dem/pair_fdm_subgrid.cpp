@@ -399,19 +399,21 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
   };
   std::vector<Mode> modes;
   const double a = rmin_;
+  // with mu_s = 0 the tangential force is capped at 0: the spring never acts
+  const bool tangentialSpring = kt_ > 0 && mu_ > 0;
   if (atom->natoms > 1) {
     double n0, s0, n1, s1;
     pairResistance(a, hr_, n0, s0);
     pairResistance(a, 0.0, n1, s1);
     modes.push_back({"normal spring of two spheres", kn_, n0, n1});
-    if (kt_ > 0) modes.push_back({"tangential spring of two spheres", kt_, s0, s1});
+    if (tangentialSpring) modes.push_back({"tangential spring of two spheres", kt_, s0, s1});
   }
   if (!walls_.empty()) {
     double n0, s0, n1, s1;
     wallResistance(a, hr_, n0, s0);
     wallResistance(a, 0.0, n1, s1);
     modes.push_back({"normal spring of a sphere on a wall", kn_, n0, n1});
-    if (kt_ > 0) modes.push_back({"tangential spring of a sphere on a wall", kt_, s0, s1});
+    if (tangentialSpring) modes.push_back({"tangential spring of a sphere on a wall", kt_, s0, s1});
   }
   if (modes.empty()) return;
   const Mode *worst = &modes[0];
