@@ -45,7 +45,7 @@ std::string tagName(int index) { return std::to_string(index + 1); }
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
-  nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), solverIterationsMax_(0), pairBlocks_(0),
+  nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0)
 {
   if (igroup != 0) error->all(FLERR, "fix fdm/couple must be applied to group all (every particle is in the fluid)");
@@ -166,6 +166,8 @@ void FixFdmCouple::init()
     error->all(FLERR, (std::string("fix fdm/couple requires units si (the fluid solver works in SI), not units ") +
                        update->unit_style).c_str());
   if (!(update->dt > 0)) error->all(FLERR, "fix fdm/couple requires a positive timestep");
+  // the contact springs' stability limit depends on the time step and on this fix's integrator
+  if (pair_) pair_->checkTimeStep(update->dt, adamsBashforth_);
   for (int i = 0; i < modify->nfix; i++) {
     Fix *other = modify->fix[i];
     if (other == this) continue;

@@ -118,7 +118,7 @@ class FixFdmCouple : public Fix {
   std::unique_ptr<fdm::ParticleVelocitySystem> system_;
   std::vector<double> subgrid_;    // 6N: F^SG, T^SG of the last step, by tag
   std::vector<double> stress_;     // 13N: S^h (6), s^h, S^c (6) of the last step, by tag
-  long solverIterations_, solverIterationsMax_, pairBlocks_, wallBlocks_, contacts_;
+  long solverIterations_, pairBlocks_, wallBlocks_, contacts_;
 };
 
 }  // namespace LAMMPS_NS

@@ -21,6 +21,8 @@
 
 #include "fdm/resistance/blocks.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -42,9 +44,11 @@ std::string fmt(double x)
 }  // namespace
 
 PairFdmSubgrid::PairFdmSubgrid(LAMMPS *lmp) :
-  Pair(lmp), computeflag(0), lubrication_(true), cutoffCells_(0.65), wallCutoffCells_(0.75), kn_(0), kt_(0), mu_(0), hr_(0), viscosity_(0),
+  Pair(lmp), computeflag(0), lubrication_(true), cutoffCells_(0.65), wallCutoffCells_(0.75), kn_(0), kt_(0), mu_(0), hr_(0),
+  unstableStepIsError_(true), viscosity_(0),
   meshSize_(0), rangeGap_(0), rmin_(0), rmax_(0), distanceFactor_(1.0), history_(nullptr), wallHistory_(nullptr),
-  contactStressRequested_(false), nmaxStress_(0), contactStress_(nullptr), contactsLast_(0), reported_(false)
+  contactStressRequested_(false), nmaxStress_(0), contactStress_(nullptr), contactsLast_(0), reported_(false),
+  checkedTimeStep_(0)
 {
   single_enable = 0;
   no_virial_fdotr_compute = 1;
@@ -77,6 +81,7 @@ void PairFdmSubgrid::settings(int narg, char **arg)
     if (i + n >= narg) error->all(FLERR, (std::string("pair_style fdm/subgrid: ") + what).c_str());
   };
   walls_.clear();
+  unstableStepIsError_ = true;
   for (int i = 0; i < narg; i++) {
     const std::string key = arg[i];
     if (key == "lubrication") {
@@ -123,6 +128,11 @@ void PairFdmSubgrid::settings(int narg, char **arg)
           error->all(FLERR, ("pair_style fdm/subgrid: wall " + face + " is declared twice").c_str());
       walls_.push_back(w);
       i += 4;
+    } else if (key == "unstable_step") {
+      need(i, 1, "unstable_step error|warn");
+      const std::string v = arg[++i];
+      if (v != "error" && v != "warn") error->all(FLERR, "pair_style fdm/subgrid: unstable_step error|warn");
+      unstableStepIsError_ = (v == "error");
     } else {
       error->all(FLERR, ("pair_style fdm/subgrid: unknown keyword " + key + " (see docs/dem.md)").c_str());
     }
@@ -223,6 +233,7 @@ void PairFdmSubgrid::init_style()
   MPI_Allreduce(&rmin, &rmin_, 1, MPI_DOUBLE, MPI_MIN, world);
   MPI_Allreduce(&rmax, &rmax_, 1, MPI_DOUBLE, MPI_MAX, world);
   if (!(rmax_ > 0)) error->all(FLERR, "pair_style fdm/subgrid: no particles (or no positive radius) to interact");
+  checkResolution();
 
   // Pairs up to this surface gap must be in the neighbour list, and keep their contact history:
   // LIGGGHTS's granular list includes r < (r_i + r_j) * contact_distance_factor (+ skin).
@@ -281,6 +292,167 @@ void PairFdmSubgrid::init_style()
     if (logfile) fputs(line.c_str(), logfile);
     reported_ = true;
   }
+}
+
+void PairFdmSubgrid::checkResolution()
+{
+  // The cut-off model subtracts the theory at xi_c = k Delta/a: below a/Delta = k/0.37 (1.76 for pairs
+  // at k = 0.65, 2.03 for walls at 0.75) xi_c passes 0.37, where the twist resistance of the theory
+  // stops growing towards contact and the block is clipped (docs/resistance.md, "Dissipation
+  // safeguard"); the model was measured for a/Delta 2 ... 20 and validated at 4 and 5.
+  if (!lubricationActive() || comm->me != 0 || reported_) return;
+  const double smallest = rmin_ / meshSize_, largest = rmax_ / meshSize_;
+  const double lowest = 2.0, highest = 20.0;
+  if (smallest < lowest * (1 - 1e-9) || largest > highest * (1 + 1e-9))
+    error->warning(FLERR, ("pair_style fdm/subgrid: particle radius over mesh size a/Delta from " + fmt(smallest) +
+                           " to " + fmt(largest) + " (radii " + fmt(rmin_) + " .. " + fmt(rmax_) + " m, Delta " +
+                           fmt(meshSize_) + " m) is outside the range the cut-off sub-grid model covers, a/Delta " +
+                           fmt(lowest) + " .. " + fmt(highest) + " (docs/dem.md): " +
+                           (smallest < lowest * (1 - 1e-9) ? "the flow between the particles is not resolved down to the "
+                                                "cut-off gap, the corrections are not meaningful"
+                                              : "measured up to 20 only")).c_str());
+}
+
+void PairFdmSubgrid::pairResistance(double a, double h, double &normal, double &slip) const
+{
+  // Two equal free spheres along x: translation and rotation resistances (Stokes drag of each sphere
+  // plus the sub-grid pair block). Normal: equal and opposite forces along the line of centres over
+  // the closing speed. Slip: equal and opposite tangential forces at the contact points (with their
+  // moments) over the slip speed of the contact points (Resistance.zeta_pair_slip in
+  // cases/contactTuning, docs/contact.md 3c).
+  typedef Eigen::Matrix<double, 12, 12> Matrix12;
+  typedef Eigen::Matrix<double, 12, 1> Vector12;
+  const double pi = 3.14159265358979323846, eta = viscosity_;
+  Matrix12 M = Matrix12::Zero();
+  for (int k = 0; k < 3; k++) {
+    M(k, k) = M(6 + k, 6 + k) = 6 * pi * eta * a;
+    M(3 + k, 3 + k) = M(9 + k, 9 + k) = 8 * pi * eta * a * a * a;
+  }
+  res::PairBlock block;
+  const double x1[3] = {0, 0, 0}, x2[3] = {2 * a + h, 0, 0};
+  if (lubricationActive() && res::subgridPairBlock(*model_, x1, x2, a, a, eta, block))
+    for (int r = 0; r < 12; r++)
+      for (int c = 0; c < 12; c++) M(r, c) += block.R[r][c];
+  const Eigen::FullPivLU<Matrix12> lu(M);
+  Vector12 load = Vector12::Zero();
+  load(0) = 1;    // sphere 1 pushed towards sphere 2 (+x), sphere 2 towards 1
+  load(6) = -1;
+  Vector12 u = lu.solve(load);
+  normal = 1.0 / (u(0) - u(6));
+  // unit force along +y at the contact points (a, 0, 0) of sphere 1 and (-a, 0, 0) relative to sphere
+  // 2's centre, opposite: torques a e_z on both
+  load.setZero();
+  load(1) = 1;
+  load(5) = a;
+  load(7) = -1;
+  load(11) = a;
+  u = lu.solve(load);
+  // slip of the contact points along y: (u1 + w1 x a e_x) - (u2 + w2 x (-a e_x))
+  slip = 1.0 / ((u(1) + a * u(5)) - (u(7) - a * u(11)));
+}
+
+void PairFdmSubgrid::wallResistance(double a, double h, double &normal, double &slip) const
+{
+  // A sphere at gap h from a wall below it (normal -y into the wall): pushed onto it, and pulled along
+  // x at its contact point (0, -a, 0).
+  typedef Eigen::Matrix<double, 6, 6> Matrix6;
+  typedef Eigen::Matrix<double, 6, 1> Vector6;
+  const double pi = 3.14159265358979323846, eta = viscosity_;
+  Matrix6 M = Matrix6::Zero();
+  for (int k = 0; k < 3; k++) {
+    M(k, k) = 6 * pi * eta * a;
+    M(3 + k, 3 + k) = 8 * pi * eta * a * a * a;
+  }
+  res::WallBlock block;
+  const double x[3] = {0, 0, 0}, wallPoint[3] = {0, -(a + h), 0}, intoWall[3] = {0, -1, 0};
+  if (lubricationActive() && res::subgridWallBlock(*wallModel_, x, a, wallPoint, intoWall, eta, block))
+    for (int r = 0; r < 6; r++)
+      for (int c = 0; c < 6; c++) M(r, c) += block.R[r][c];
+  const Eigen::FullPivLU<Matrix6> lu(M);
+  Vector6 load = Vector6::Zero();
+  load(1) = -1;
+  Vector6 u = lu.solve(load);
+  normal = -1.0 / u(1);
+  // force +x at (0, -a, 0): torque (-a e_y) x e_x = a e_z; contact point velocity u + w x (-a e_y)
+  load.setZero();
+  load(0) = 1;
+  load(5) = a;
+  u = lu.solve(load);
+  slip = 1.0 / (u(0) + a * u(5));
+}
+
+void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
+{
+  // docs/contact.md 3c: an explicit spring k against the implicit resistance zeta of its mode is
+  // stable for r = dt k/zeta < 1 (ab2) or 2 (euler). zeta grows as the gap closes, so it is smallest
+  // at the contact gap h_r (where a contact starts) and largest at h = 0 (the lubrication is frozen at
+  // 1e-5 a): a step beyond the limit at h_r is stable only for contacts pressed deeper (a warning),
+  // beyond the limit at h = 0 for no contact at all (an error, unless unstable_step warn).
+  // The smallest particles have the smallest resistances; with lubrication the run does not blow
+  // up but its contacts are wrong (limit cycles, overlaps pinned by the frozen lubrication).
+  if (!contactActive() || !(viscosity_ > 0) || dt == checkedTimeStep_) return;
+  checkedTimeStep_ = dt;
+  const double factor = adamsBashforth ? 1.0 : 2.0;
+  struct Mode {
+    std::string name;
+    double k, zetaContact, zetaTouching;
+  };
+  std::vector<Mode> modes;
+  const double a = rmin_;
+  // with mu_s = 0 the tangential force is capped at 0: the spring never acts
+  const bool tangentialSpring = kt_ > 0 && mu_ > 0;
+  if (atom->natoms > 1) {
+    double n0, s0, n1, s1;
+    pairResistance(a, hr_, n0, s0);
+    pairResistance(a, 0.0, n1, s1);
+    modes.push_back({"normal spring of two spheres", kn_, n0, n1});
+    if (tangentialSpring) modes.push_back({"tangential spring of two spheres", kt_, s0, s1});
+  }
+  if (!walls_.empty()) {
+    double n0, s0, n1, s1;
+    wallResistance(a, hr_, n0, s0);
+    wallResistance(a, 0.0, n1, s1);
+    modes.push_back({"normal spring of a sphere on a wall", kn_, n0, n1});
+    if (tangentialSpring) modes.push_back({"tangential spring of a sphere on a wall", kt_, s0, s1});
+  }
+  if (modes.empty()) return;
+  const Mode *worst = &modes[0];
+  for (const Mode &m : modes)
+    if (m.zetaContact / m.k < worst->zetaContact / worst->k) worst = &m;
+  const double limit = factor * worst->zetaContact / worst->k;
+  if (dt <= limit) return;
+  double limitTouching = 1e300;
+  const Mode *never = nullptr;
+  for (const Mode &m : modes)
+    if (factor * m.zetaTouching / m.k < limitTouching) {
+      limitTouching = factor * m.zetaTouching / m.k;
+      never = &m;
+    }
+  const std::string how = "(docs/contact.md 3c: dt k/zeta < " + fmt(factor) + " with " +
+                          (adamsBashforth ? "integrator ab2" : "integrator euler") + "; zeta the resistance of the "
+                          "mode, Stokes drag" + (lubricationActive() ? " + sub-grid lubrication" : "") +
+                          ", for the smallest spheres, a = " + fmt(a) + " m, viscosity " + fmt(viscosity_) + " Pa s)";
+  if (dt > limitTouching) {
+    const std::string message = "pair_style fdm/subgrid: time step " + fmt(dt) + " s is beyond the stability limit of "
+                                "the contact springs at every gap: the " + never->name + " (k " + fmt(never->k) +
+                                " N/m) needs dt < " + fmt(limitTouching) + " s even at zero gap (zeta " +
+                                fmt(never->zetaTouching) + " N s/m), and dt < " + fmt(limit) + " s at the contact gap "
+                                "h_r = " + fmt(hr_) + " m (the " + worst->name + ", zeta " + fmt(worst->zetaContact) +
+                                " N s/m) " + how;
+    if (unstableStepIsError_) {
+      CouplingSession &session = CouplingSession::instance();
+      if (session.connected()) session.abandon("fdmDEM: " + message);
+      error->all(FLERR, (message + "; 'unstable_step warn' to run anyway").c_str());
+    }
+    if (comm->me == 0) error->warning(FLERR, message.c_str());
+    return;
+  }
+  if (comm->me == 0)
+    error->warning(FLERR, ("pair_style fdm/subgrid: time step " + fmt(dt) + " s is beyond the stability limit " +
+                           fmt(limit) + " s of the " + worst->name + " (k " + fmt(worst->k) + " N/m, zeta " +
+                           fmt(worst->zetaContact) + " N s/m at the contact gap h_r = " + fmt(hr_) + " m) " + how +
+                           ": stable only for contacts pressed deeper into the roughness layer (zeta grows as the "
+                           "gap closes); an unstable contact shows no NaN, only wrong gaps and forces").c_str());
 }
 
 void PairFdmSubgrid::init_list(int id, NeighList *ptr)

@@ -4,7 +4,7 @@
 
    Syntax (docs/dem.md):
      pair_style fdm/subgrid [lubrication yes|no] [cutoff k] [wall_cutoff k] [contact kn kt mu_s h_r]
-                            [wall FACE ux uy uz] ...
+                            [wall FACE ux uy uz] ... [unstable_step error|warn]
      pair_coeff * *
 
    The contact forces go into f and torque at every force evaluation, like any LIGGGHTS pair style
@@ -67,6 +67,9 @@ class PairFdmSubgrid : public Pair {
   }
   // Contacts (pair and wall) found by this rank in the last compute.
   long contactsLast() const { return contactsLast_; }
+  // The time-step limits of the contact springs, dt k/zeta below 1 (ab2) or 2 (euler), docs/contact.md
+  // section 3c; called by fix fdm/couple, which knows the time step and its integrator.
+  void checkTimeStep(double dt, bool adamsBashforth);
 
   int computeflag;   // read and reset by fix contacthistory (pre_exchange)
 
@@ -79,11 +82,17 @@ class PairFdmSubgrid : public Pair {
                   double force[3], double nxft[3]) const;
   void addContactStress(int i, const double force[3], const double branch[3], double weight);
   std::string wallName(const Wall &w) const;
+  void checkResolution();
+  // Resistances of the contact modes at surface gap h (Stokes drag + sub-grid lubrication): two free
+  // spheres of radius a (normal, and slip of the contact points), a sphere and a wall.
+  void pairResistance(double a, double h, double &normal, double &slip) const;
+  void wallResistance(double a, double h, double &normal, double &slip) const;
 
   // settings
   bool lubrication_;
   double cutoffCells_, wallCutoffCells_;
   double kn_, kt_, mu_, hr_;
+  bool unstableStepIsError_;   // unstable_step error (default) | warn
   std::vector<Wall> walls_;
 
   // from the fluid solver at the handshake (coupling session)
@@ -99,6 +108,7 @@ class PairFdmSubgrid : public Pair {
   double **contactStress_;
   long contactsLast_;
   bool reported_;
+  double checkedTimeStep_;     // the time step last checked (checked again if it changes)
 };
 
 }  // namespace LAMMPS_NS

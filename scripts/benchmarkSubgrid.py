@@ -269,7 +269,8 @@ def coupled_shear(workdir, steps, solvers=SOLVERS):
         try:
             case.run(root)
         except RuntimeError as e:
-            failure = str(e).strip().splitlines()[-1]
+            # LIGGGHTS names its source file by absolute path: keep the data free of this machine's
+            failure = str(e).strip().splitlines()[-1].replace(PROJECT + os.sep, "")
         with open(os.path.join(root, "log.dem")) as f:
             r = demonly.analyse(scene, os.path.join(root, "dem"), f.read())
         st = output.steps(os.path.join(root, "fluid"))

@@ -7,17 +7,18 @@ import re
 import signal
 import subprocess
 import time
+import warnings
 
 import pytest
 
-from fdm import case
+from fdm import case, output
 
 PROJECT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FDMRUN = os.path.join(PROJECT, "scripts", "fdmRun")
 
 
 def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None, n_particles=-1,
-              fdm_edit=None, fix_options="move no", runs=("run 2",)):
+              fdm_edit=None, fix_options="move no", runs=("run 2",), pair_style="none", dt=1.0):
     box = box or case.Box((0, 0, 0), (4, 4, 4), 0.5)
     root = str(tmp_path / "case")
     fluid = os.path.join(root, "fluid")
@@ -29,7 +30,7 @@ def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None,
         text = fdm_edit(text)
     open(props, "w").write(text)
     case.write_dem_input(os.path.join(root, "dem"), dem_box or box, list(spheres),
-                         fix_options="connect_timeout 5 " + fix_options, runs=runs)
+                         fix_options="connect_timeout 5 " + fix_options, runs=runs, pair_style=pair_style, dt=dt)
     return root
 
 
@@ -74,7 +75,8 @@ def test_overlapping_particles(tmp_path, env):
 
 
 def test_missing_dictionary_entry(tmp_path, env):
-    root = make_case(tmp_path, fdm_edit=lambda t: re.sub(r"\n\s*tolLambda[^\n]*", "", t, count=1))
+    # neither tolerance of the inner iterations (case.py writes both)
+    root = make_case(tmp_path, fdm_edit=lambda t: re.sub(r"\n\s*tol(Lambda|Velocity)[^\n]*", "", t, count=2))
     status, out, wall = run_fdm(root, env)
     assert status != 0
     text = logs(root)
@@ -153,3 +155,145 @@ def test_peer_dies_mid_run(tmp_path, env):
     assert status != 0
     assert stopped < 10
     assert re.search(r"closed the connection|connection", open(os.path.join(root, "log.fluid")).read())
+
+
+def fluid_alone(root, env):
+    """fdmFoam alone on the case (meshed first): for errors it finds before waiting for fdmDEM."""
+    fluid = os.path.join(root, "fluid")
+    subprocess.run(["blockMesh", "-case", fluid], env=env, check=True, stdout=subprocess.DEVNULL)
+    proc = subprocess.run(["fdmFoam", "-case", fluid], env=env, text=True, errors="replace",
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60)
+    return proc.returncode, proc.stdout
+
+
+@pytest.mark.parametrize("where,good,bad,key,valid", [
+    ("constant/fdmProperties", "gradP0  ", "gradPO  ", "gradPO", "indicator alphaLambda pseudoTimeFactor"),
+    ("indicator", "{ b ", "{ bb ", "bb", "b c"),
+    ("innerIterations", "tolLambda   ", "tolLamda   ", "tolLamda",
+     "tolLambda tolVelocity nMax nMin firstStep acceleration depth report"),
+    ("innerIterations/firstStep", "innerIterations\n{", "innerIterations\n{\n    firstStep { nmax 10; }", "nmax",
+     "tolLambda tolVelocity nMax"),
+    ("output", "coupling\n{", "output { particleEvery 2; }\ncoupling\n{", "particleEvery", "particlesEvery"),
+    ("coupling", "connectTimeout 5", "conectTimeout 5", "conectTimeout",
+     "transport host port portFile directory record"),
+])
+def test_unknown_dictionary_entry(tmp_path, env, where, good, bad, key, valid):
+    """A misspelt entry would silently take its default: it is refused, with the valid ones."""
+    def misspell(text):
+        assert good in text, good
+        return text.replace(good, bad, 1)
+    root = make_case(tmp_path, fdm_edit=misspell)
+    status, out = fluid_alone(root, env)
+    assert status != 0
+    assert "unknown entry %s in %s; valid: %s" % (key, where, valid) in out, out[-2000:]
+    assert "fdmProperties" in out
+
+
+def test_used_case_folder_needs_overwrite(tmp_path, env):
+    """A second run in the same folder would mix the old fluid state and records with fresh
+    particles: refused; --overwrite deletes the outputs only and runs afresh."""
+    root = make_case(tmp_path)
+    status, out, _ = run_fdm(root, env)
+    assert status == 0, out
+    inputs = {}
+    for rel in ("fluid/0/U", "fluid/system/controlDict", "fluid/constant/fdmProperties", "dem/in.dem",
+                "dem/spheres.data"):
+        inputs[rel] = open(os.path.join(root, rel)).read()
+    fluid = os.path.join(root, "fluid")
+    first = output.steps(fluid)["step"]
+
+    status, out, _ = run_fdm(root, env)
+    assert status == 2
+    assert "holds a previous run" in out and "--overwrite" in out and "fluid/2" in out, out
+    proc = subprocess.run([FDMRUN, "--resume", root], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, env=env)
+    assert proc.returncode == 2 and "--resume is not implemented yet" in proc.stdout, proc.stdout
+
+    proc = subprocess.run([FDMRUN, "--quiet", "--overwrite", root], stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True, env=env, timeout=60)
+    assert proc.returncode == 0, proc.stdout
+    for rel, text in inputs.items():
+        assert open(os.path.join(root, rel)).read() == text, rel
+    # the records of the second run alone, from step 1, not appended to the first run's
+    assert list(output.steps(fluid)["step"]) == list(first)
+    assert "Starting time loop" in open(os.path.join(root, "log.fluid")).read()
+
+
+def test_disk_full_stops_both_codes(tmp_path, env):
+    """The records' disk fills up mid-run (a 8 kB tmpfs on postProcessing/fdm): fdmFoam stops with
+    the file it could not write, fdmDEM is told and stops, and the records already written read
+    back whole (the reader drops only an unfinished last line)."""
+    spheres = [(x, y, z, 0.5) for x in (1.0, 3.0) for y in (1.0, 3.0) for z in (1.0, 3.0)]
+    root = make_case(tmp_path, spheres=spheres, runs=("run 1000",),
+                     fdm_edit=lambda t: re.sub(r"nMax\s+\d+;", "nMax 2;", t))
+    records = os.path.join(root, "fluid", "postProcessing", "fdm")
+    os.makedirs(records)
+    if os.geteuid() != 0 or subprocess.run(["mount", "-t", "tmpfs", "-o", "size=8k", "tmpfs", records],
+                                           stderr=subprocess.DEVNULL).returncode != 0:
+        pytest.skip("cannot mount a tmpfs here (needs root)")
+    try:
+        status, out, wall = run_fdm(root, env, timeout=120)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an unfinished last line is expected here
+            steps = output.steps(os.path.join(root, "fluid"))
+            parts = output.particles(os.path.join(root, "fluid"))
+    finally:
+        subprocess.run(["umount", records])
+    assert status != 0
+    text = logs(root)
+    assert re.search(r"could not write .*(steps|particles)\.dat \(disk full", text), text[-3000:]
+    assert "fdmFoam: could not write" in open(os.path.join(root, "log.dem"), errors="replace").read()
+    assert wall < 60
+    # every step recorded before the failure is there, once, in order
+    n = len(steps["step"])
+    assert n >= 2 and list(steps["step"]) == list(range(1, n + 1))
+    complete = [s for s in range(1, n + 1) if (parts["step"] == s).sum() == len(spheres)]
+    assert complete == list(range(1, len(complete) + 1)) and len(complete) >= n - 1
+
+
+# Two spheres of radius 1 at a gap of 0.05 in a periodic 6 x 4 x 4 box, Delta = 0.5 (a/Delta = 2),
+# viscosity 1 Pa s, contact at h_r = 0.01 m, kt = 0: the normal spring of the pair limits the step,
+# zeta = 3 pi eta a + the sub-grid squeeze resistance, from ~480 N s/m at h_r to ~5e5 at zero gap.
+PAIR = [(1.5, 2.0, 2.0, 1.0), (3.55, 2.0, 2.0, 1.0)]
+PAIR_BOX = case.Box((0, 0, 0), (6, 4, 4), 0.5)
+
+
+def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
+    """kn = 1e6 N/m, dt = 1 s: beyond dt k/zeta < 1 (ab2) even with the largest resistance a contact
+    can have: an error at the start, with the limit and how it was computed; both codes stop."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 0 0.5 0.01")
+    status, out, wall = run_fdm(root, env)
+    assert status != 0
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    m = re.search(r"ERROR: pair_style fdm/subgrid: time step 1 s is beyond the stability limit of the contact "
+                  r"springs at every gap: the normal spring of two spheres \(k 1e\+06 N/m\) needs dt < (\S+) s even at "
+                  r"zero gap .* and dt < (\S+) s at the contact gap h_r = 0.01 m .*dt k/zeta < 1 with integrator ab2",
+                  dem)
+    assert m, dem[-3000:]
+    assert 0.1 < float(m.group(1)) < 1 and 1e-4 < float(m.group(2)) < 1e-3
+    assert "pair_style fdm/subgrid: time step 1 s" in open(os.path.join(root, "log.fluid")).read()
+    assert wall < 30
+
+
+def test_time_step_beyond_contact_stability_at_the_contact_gap(tmp_path, env):
+    """kn = 1e4 N/m, dt = 1 s: beyond the limit at h_r (~0.05 s), within it for contacts pressed
+    deeper (~50 s at zero gap): a warning, and the run goes on."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e4 0 0.5 0.01",
+                     runs=("run 1",))
+    status, out, wall = run_fdm(root, env)
+    assert status == 0, out
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    m = re.search(r"WARNING: pair_style fdm/subgrid: time step 1 s is beyond the stability limit (\S+) s of the normal "
+                  r"spring of two spheres .* at the contact gap h_r = 0.01 m", dem)
+    assert m and 0.01 < float(m.group(1)) < 0.1, dem[-3000:]
+
+
+def test_particles_too_small_for_the_mesh(tmp_path, env):
+    """a/Delta = 1: below the range of the cut-off sub-grid model (a/Delta >= 2), reported."""
+    root = make_case(tmp_path, pair_style="fdm/subgrid", runs=("run 1",))
+    status, out, wall = run_fdm(root, env)
+    assert status == 0, out
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    assert re.search(r"WARNING: pair_style fdm/subgrid: particle radius over mesh size a/Delta from 1 to 1 \(radii "
+                     r"0.5 .. 0.5 m, Delta 0.5 m\) is outside the range the cut-off sub-grid model covers, a/Delta "
+                     r"2 .. 20", dem), dem[-3000:]

@@ -20,12 +20,15 @@ Description
 
 Usage
     fdmFoam [-parallel] [-case dir]   (start it before fdmDEM; see scripts/fdmRun)
+    fdmFoam -postProcess [-func name] [-latestTime]   (function objects on a
+        finished case; those of system/controlDict also run during a run)
 
 \*---------------------------------------------------------------------------*/
 
 #include "fvCFD.H"
 #include "pisoControl.H"
 #include "OFstream.H"
+#include "OStringStream.H"
 #include "uniformCartesianMesh.H"
 #include "particleForcing.H"
 #include "fluidCoupling.H"
@@ -51,6 +54,11 @@ int main(int argc, char *argv[])
         "Fictitious-domain Stokes solver for particle suspensions, coupled to"
         " the particle code fdmDEM (LIGGGHTS) through the fdm coupler."
     );
+
+    // fdmFoam -postProcess -func ...: the function objects on a finished case
+    // (createFields.H needs the PISO controls, not fdmProperties)
+    #define CREATE_CONTROL createPisoControl.H
+    #include "postProcess.H"
 
     #include "setRootCaseLists.H"
     #include "createTime.H"
@@ -89,6 +97,11 @@ int main(int argc, char *argv[])
     // waiting for the particle code to connect is not part of the run
     const scalar exchangeBeforeRun = coupling.exchangeTime();
     List<fdmParticle> stepParticles;
+
+    // The function objects of system/controlDict. fdmDEM drives time, so
+    // instead of runTime.run() the loop calls what it would: start() before
+    // the first step, execute() after each step, end() after the last.
+    runTime.functionObjects().start();
 
     Info<< nl << "Starting time loop (driven by fdmDEM)" << nl << endl;
 
@@ -232,6 +245,7 @@ int main(int argc, char *argv[])
 
         const double tOut = wallClock();
         #include "writeStepOutput.H"
+        runTime.functionObjects().execute();
         outputTime += wallClock() - tOut;
 
         ++nStepsDone;
@@ -264,6 +278,7 @@ int main(int argc, char *argv[])
     // Final state, so that a run can be restarted from it
     forcing.indicator(particleIndicator);
     runTime.writeNow();
+    runTime.functionObjects().end();
 
     const scalar total = wallClock() - runStart;
     const scalar exchange = coupling.exchangeTime() - exchangeBeforeRun;

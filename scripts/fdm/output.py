@@ -1,5 +1,7 @@
 """Reading fdmFoam's per-step and per-particle records (postProcessing/fdm/*.dat)."""
+import io
 import os
+import warnings
 
 import numpy as np
 
@@ -12,7 +14,14 @@ PARTICLE_COLUMNS = "step tag x y z radius Ux Uy Uz Wx Wy Wz Fx Fy Fz Tx Ty Tz Vu
 def _read(path, columns):
     if not os.path.isfile(path):
         raise FileNotFoundError("%s not found: did fdmFoam run?" % path)
-    data = np.loadtxt(path, comments="#", ndmin=2)
+    with open(path) as f:
+        text = f.read()
+    if text and not text.endswith("\n"):
+        # a record cut by a full disk or a killed run: fdmFoam ends every step's records with a
+        # new line, so only the last, unfinished line is dropped
+        warnings.warn("%s: the last line is incomplete (the run stopped while writing it): ignored" % path)
+        text = text[:text.rfind("\n") + 1]
+    data = np.loadtxt(io.StringIO(text), comments="#", ndmin=2)
     if data.size == 0:
         raise ValueError("%s has no records" % path)
     if columns is STEP_COLUMNS and data.shape[1] == len(columns) - 1:

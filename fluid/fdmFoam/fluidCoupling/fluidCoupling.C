@@ -24,7 +24,6 @@ namespace
 
 Foam::fluidCoupling::fluidCoupling(const Time& runTime, const dictionary& dict)
 :
-    runTime_(runTime),
     transport_(),
     exchangeTime_(0),
     step_(-1),
