@@ -188,6 +188,34 @@ def timing(workdir, steps, repeats, packings):
     return results
 
 
+def particle_work_shares(root):
+    """The particle work as a percentage of the coupled run (all its steps), from the time breakdowns
+    at the end of log.fluid and log.dem: fdmFoam's particle forcing (stencil integrals and
+    corrections), fdmDEM's particle solve (sub-grid blocks and assembly, Eq. (31) solves, position
+    update), its LIGGGHTS force computation (Pair: contact; Neigh), its gather/scatter, and the
+    messages (fdmFoam's "exchange + DEM" less fdmDEM's work while fdmFoam waits); "particle work" is
+    their sum, i.e. fdmFoam's particle forcing + exchange + DEM. None if a log has no breakdown."""
+    try:
+        with open(os.path.join(root, "log.fluid")) as f:
+            fl = output.fluid_time_breakdown(f.read())
+        with open(os.path.join(root, "log.dem")) as f:
+            dm = output.dem_time_breakdown(f.read())
+    except OSError:
+        return None
+    if not fl or not dm:
+        return None
+    pair = dm["sections"].get("Pair", 0.0) + dm["sections"].get("Neigh", 0.0)
+    dem_work = dm["particle_solve"] + pair + dm["gather_scatter"]
+    pct = 100.0 / fl["wall"]
+    return {"fluid solve": fl["fluid_solve"] * pct, "particle forcing (fdmFoam)": fl["particle_forcing"] * pct,
+            "assembly + Eq. 31 + position update": dm["particle_solve"] * pct,
+            "contact + neighbour lists (Pair, Neigh)": pair * pct,
+            "gather/scatter": dm["gather_scatter"] * pct,
+            "messages": max(fl["exchange_dem"] - dem_work, 0.0) * pct,
+            "particle work": (fl["particle_forcing"] + fl["exchange_dem"]) * pct,
+            "run wall s": fl["wall"]}
+
+
 def coupled(workdir, steps, p, np_fluid=1, solvers=SOLVERS, keep=False):
     results = []
     box = case.Box((0, 0, 0), tuple(p.box), DELTA)
@@ -229,7 +257,11 @@ def coupled(workdir, steps, p, np_fluid=1, solvers=SOLVERS, keep=False):
                  solver_iterations_per_step=r["iterations"].tolist(), timing=r["timing"],
                  pair_blocks=int(r["pair_blocks"][-1]), contacts=int(r["contacts"][-1]))
         s["ratio"] = s["particle_seconds_per_iteration"] / s["fluid_seconds_per_iteration"]
+        s["step_shares"] = particle_work_shares(root)
         results.append(s)
+        if s["step_shares"]:
+            print("coupled %-10s share of the run (%%): %s" % (s["solver"], ", ".join(
+                "%s %.3g" % (k, v) for k, v in s["step_shares"].items())), flush=True)
         print("coupled %-10s fluid %.3g s/iteration (%d cells, %d rank), particle side %.3g s/iteration (%.2f %%); "
               "solver iterations per step %s; run-end line: %s" % (
                   s["solver"], s["fluid_seconds_per_iteration"], s["cells"], np_fluid, particle_per_iteration,
@@ -402,6 +434,8 @@ def main(argv=None):
     ap.add_argument("--timing-steps", type=int, default=30)
     ap.add_argument("--repeats", type=int, default=3, help="runs per timing configuration")
     ap.add_argument("--coupled-steps", type=int, default=4)
+    ap.add_argument("--coupled-solvers", nargs="+", choices=["cg1e-10", "cg1e-6", "ldlt"], default=None,
+                    help="the solvers of the coupled runs (default: all three)")
     ap.add_argument("--np-fluid", type=int, default=1)
     ap.add_argument("--shear-steps", type=int, default=30, help="steps of the coupled-shear runs")
     ap.add_argument("--scaling-repeats", type=int, default=2)
@@ -425,12 +459,18 @@ def main(argv=None):
     t0 = time.time()
     if "stability" in parts:
         results["stability"] = stability(args.workdir, args.steps)
-    packings = timing_packings() if ("timing" in parts or "coupled" in parts) else None
+    packings = None
+    if "timing" in parts:
+        packings = timing_packings()
+    elif "coupled" in parts:  # the coupled runs need the relaxed packing only
+        packings = {"relaxed": packing.random_packing(1000, 0.45, bidisperse=True, seed=1, box_multiple=DELTA)}
     if "timing" in parts:
         results["timing"] = timing(args.workdir, args.timing_steps, args.repeats, packings)
     if "coupled" in parts:
+        solvers = [st for st in SOLVERS if args.coupled_solvers is None
+                   or label(*st).replace(" ", "") in args.coupled_solvers]
         results["coupled"] = coupled(args.workdir, args.coupled_steps, packings["relaxed"], args.np_fluid,
-                                     keep=args.keep)
+                                     solvers=solvers, keep=args.keep)
     if "coupled-shear" in parts:
         results["coupled_shear"] = coupled_shear(args.workdir, args.shear_steps)
     if "scaling" in parts:

@@ -138,3 +138,45 @@ def suspension_snapshots(path, dt, strain_rate=1.0, skip_first=True):
             time=step * dt * strain_rate))
         forces.append(couple[:, _F_FDM] + couple[:, _F_SG])
     return snapshots, forces
+
+
+# ------------------------------------------------------------------------------------------------
+# Time breakdowns at the end of a coupled run's logs (log.fluid, log.dem)
+# ------------------------------------------------------------------------------------------------
+
+def fluid_time_breakdown(text):
+    """fdmFoam's "time breakdown" at the end of log.fluid as a dict: steps, inner_iterations, wall,
+    and the seconds of fluid_solve, particle_forcing, exchange_dem (exchange + DEM: the messages and
+    the whole particle side while fdmFoam waits), output. None if absent."""
+    import re
+    m = re.search(r"fdmFoam time breakdown \((\d+) steps, (\d+) inner iterations, ([0-9.eE+-]+) s wall\):\s*"
+                  r"fluid solve\s+([0-9.eE+-]+) s.*?particle forcing\s+([0-9.eE+-]+) s.*?"
+                  r"exchange \+ DEM\s+([0-9.eE+-]+) s.*?output\s+([0-9.eE+-]+) s", text, re.S)
+    if not m:
+        return None
+    g = m.groups()
+    return dict(steps=int(g[0]), inner_iterations=int(g[1]), wall=float(g[2]), fluid_solve=float(g[3]),
+                particle_forcing=float(g[4]), exchange_dem=float(g[5]), output=float(g[6]))
+
+
+def dem_time_breakdown(text):
+    """fdmDEM's side of a coupled run from log.dem: the last "fdm/couple timing of this run" line
+    (particle_solve: the Eq. (31) assembly, solves and position update; exchange_fluid: waiting for
+    and talking to the fluid; gather_scatter) and LIGGGHTS's loop-time lines (Pair -- contact forces --, Neigh, Comm, Outpt, Other: seconds; the
+    sub-grid blocks are collected inside the particle solve).
+    None if absent."""
+    import re
+    m = None
+    for m in re.finditer(r"fdm/couple timing of this run \(\d+ runs?, (\d+) steps, ([0-9.eE+-]+) s\): particle "
+                         r"solve ([0-9.eE+-]+) s .*?exchange incl\. fluid ([0-9.eE+-]+) s .*?gather/scatter "
+                         r"([0-9.eE+-]+) s", text):
+        pass
+    if not m:
+        return None
+    g = m.groups()
+    out = dict(steps=int(g[0]), wall=float(g[1]), particle_solve=float(g[2]), exchange_fluid=float(g[3]),
+               gather_scatter=float(g[4]), sections={})
+    # LIGGGHTS 3.8 writes "Pair  time (%) = 0.00028 (0.0002)" (seconds, percent of the loop)
+    for name, seconds in re.findall(r"^(Pair|Neigh|Comm|Outpt|Modify|Other)\s+time \(%\) = ([0-9.eE+-]+)", text, re.M):
+        out["sections"][name] = float(seconds)
+    return out
