@@ -1,5 +1,6 @@
 // The coupling session of fdmDEM with the fluid solver (see coupling_session.h, docs/coupling.md).
 #include "coupling_session.h"
+#include "message_text.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -22,13 +23,7 @@ namespace cpl = fdm::coupler;
 
 namespace {
 
-std::string fmt(double x)
-{
-  std::ostringstream os;
-  os.precision(10);
-  os << x;
-  return os.str();
-}
+using fdm::text::number;
 
 // If LIGGGHTS stops on an error (error->all exits), tell the fluid solver why it lost its peer
 // rather than leave it to guess from a closed socket.
@@ -177,16 +172,16 @@ std::string CouplingSession::checkFluidHello(LAMMPS *lmp, const cpl::FluidHello 
     return "the fluid case expects " + std::to_string(hello.nParticlesExpected) + " particles (constant/fdmProperties "
            "nParticles) but the LIGGGHTS input has " + std::to_string(particles_);
   if (!(hello.alphaLambda > 0) || !(hello.rhoFluid > 0) || !(hello.delta > 0) || !(hello.viscosity > 0))
-    return "the fluid solver sent a non-positive alpha_lambda (" + fmt(hello.alphaLambda) + " s), rho_f (" +
-           fmt(hello.rhoFluid) + " kg/m3), mesh size (" + fmt(hello.delta) + " m) or viscosity (" +
-           fmt(hello.viscosity) + " Pa s)";
+    return "the fluid solver sent a non-positive alpha_lambda (" + number(hello.alphaLambda) + " s), rho_f (" +
+           number(hello.rhoFluid) + " kg/m3), mesh size (" + number(hello.delta) + " m) or viscosity (" +
+           number(hello.viscosity) + " Pa s)";
   const char *axis = "xyz";
   for (int d = 0; d < 3; d++) {
     const double lo = hello.lo[d], hi = hello.hi[d];
     const double tolerance = 1e-9 * std::max(std::fabs(domain->prd[d]), std::fabs(hi - lo));
     if (!(std::fabs(lo - domain->boxlo[d]) <= tolerance) || !(std::fabs(hi - domain->boxhi[d]) <= tolerance))
-      return std::string(1, axis[d]) + " extent: LIGGGHTS box " + fmt(domain->boxlo[d]) + " .. " +
-             fmt(domain->boxhi[d]) + " but OpenFOAM mesh " + fmt(lo) + " .. " + fmt(hi);
+      return std::string(1, axis[d]) + " extent: LIGGGHTS box " + number(domain->boxlo[d]) + " .. " +
+             number(domain->boxhi[d]) + " but OpenFOAM mesh " + number(lo) + " .. " + number(hi);
     if (hello.periodic[d] != (domain->periodicity[d] != 0))
       return std::string(1, axis[d]) + " boundary: LIGGGHTS " + (domain->periodicity[d] ? "periodic (p)" :
              "not periodic") + " but the OpenFOAM mesh " + (hello.periodic[d] ? "has cyclic patches" :

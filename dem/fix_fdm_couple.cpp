@@ -3,6 +3,7 @@
 #include "fix_fdm_couple.h"
 
 #include "coupling_session.h"
+#include "message_text.h"
 #include "pair_fdm_subgrid.h"
 
 #include "atom.h"
@@ -30,15 +31,9 @@ namespace {
 // only when stresslets are asked for).
 const int gatherWidth = 19, gatherStressWidth = 6;
 
-std::string fmt(double x)
-{
-  std::ostringstream os;
-  os.precision(10);
-  os << x;
-  return os.str();
-}
-std::string point(const double *x) { return "(" + fmt(x[0]) + ", " + fmt(x[1]) + ", " + fmt(x[2]) + ")"; }
-std::string tagName(int index) { return std::to_string(index + 1); }
+using fdm::text::number;
+using fdm::text::particleId;
+using fdm::text::point;
 
 }  // namespace
 
@@ -249,7 +244,7 @@ void FixFdmCouple::gather(std::vector<Particle> &particles)
   }
   for (int t = 0; t < natoms_; t++)
     if (!seen[t])
-      fail("particle " + tagName(t) + " is missing: LIGGGHTS lost it (was it put or moved outside a non-periodic "
+      fail("particle " + particleId(t) + " is missing: LIGGGHTS lost it (was it put or moved outside a non-periodic "
            "face of the box? " + std::to_string((long long) atom->natoms) + " atoms left of " + std::to_string(natoms_) +
            ")");
 }
@@ -260,22 +255,22 @@ std::string FixFdmCouple::checkConfiguration(const std::vector<Particle> &partic
   const char *axis = "xyz";
   for (size_t i = 0; i < particles.size(); i++) {
     const Particle &p = particles[i];
-    const std::string who = "particle " + tagName(int(i)) + " at " + point(p.x) + " with radius " + fmt(p.radius);
+    const std::string who = "particle " + particleId(int(i)) + " at " + point(p.x) + " with radius " + number(p.radius);
     if (!(p.radius > 0) || !(p.density > 0) || !(p.mass > 0))
-      return who + " has a non-positive radius, density (" + fmt(p.density) + ") or mass (" + fmt(p.mass) + ")";
+      return who + " has a non-positive radius, density (" + number(p.density) + ") or mass (" + number(p.mass) + ")";
     for (int d = 0; d < 3; d++) {
       const double lo = domain->boxlo[d], hi = domain->boxhi[d];
       if (!std::isfinite(p.x[d]) || p.x[d] < lo || p.x[d] > hi)
-        return who + ": its centre lies outside the box in " + axis[d] + " (" + fmt(lo) + " .. " + fmt(hi) + ")";
+        return who + ": its centre lies outside the box in " + axis[d] + " (" + number(lo) + " .. " + number(hi) + ")";
       if (domain->periodicity[d]) {
         if (2 * p.radius > domain->prd[d])
-          return who + " is larger than the periodic box in " + axis[d] + " (extent " + fmt(domain->prd[d]) +
+          return who + " is larger than the periodic box in " + axis[d] + " (extent " + number(domain->prd[d]) +
                  "): it would overlap its own image";
       } else if (p.x[d] - p.radius < lo || p.x[d] + p.radius > hi) {
         const bool low = p.x[d] - p.radius < lo;
         const double gap = low ? p.x[d] - p.radius - lo : hi - p.x[d] - p.radius;
-        return who + " crosses the wall " + axis[d] + " = " + fmt(low ? lo : hi) + " (non-periodic boundary; box " +
-               fmt(lo) + " .. " + fmt(hi) + "): gap " + fmt(gap);
+        return who + " crosses the wall " + axis[d] + " = " + number(low ? lo : hi) + " (non-periodic boundary; box " +
+               number(lo) + " .. " + number(hi) + "): gap " + number(gap);
       }
     }
   }
@@ -344,9 +339,9 @@ std::string FixFdmCouple::findOverlap(const std::vector<Particle> &p) const
     }
   }
   if (pairs == 0) return "";
-  return "particles " + tagName(int(firstI)) + " and " + tagName(int(firstJ)) + " overlap: centres " +
-         point(p[firstI].x) + " and " + point(p[firstJ].x) + ", radii " + fmt(p[firstI].radius) + " and " +
-         fmt(p[firstJ].radius) + ", surface gap " + fmt(firstGap) +
+  return "particles " + particleId(int(firstI)) + " and " + particleId(int(firstJ)) + " overlap: centres " +
+         point(p[firstI].x) + " and " + point(p[firstJ].x) + ", radii " + number(p[firstI].radius) + " and " +
+         number(p[firstJ].radius) + ", surface gap " + number(firstGap) +
          (pairs > 1 ? " (" + std::to_string(pairs) + " overlapping pairs in all)" : std::string());
 }
 
@@ -519,7 +514,7 @@ std::string FixFdmCouple::systemProblem(const fdm::ParticleVelocitySystem::Error
 {
   // what the system cannot know: the mesh size, and when (iteration 0: the step's Volumes)
   if (e.kind == fdm::ParticleVelocitySystem::Error::noVolume)
-    return std::string(e.what()) + ": is it smaller than a mesh cell (" + fmt(session_.meshSize()) + ")?";
+    return std::string(e.what()) + ": is it smaller than a mesh cell (" + number(session_.meshSize()) + ")?";
   if (e.kind == fdm::ParticleVelocitySystem::Error::fluidValue)
     return std::string(e.what()) + " at step " + std::to_string(step) +
            (iteration > 0 ? ", inner iteration " + std::to_string(iteration) : std::string());

@@ -1,4 +1,5 @@
 // Eq. (31) for the particle velocities: assembly, solution and sub-grid results (see the header).
+#include "message_text.h"
 #include "particle_velocity_system.h"
 
 #include <Eigen/IterativeLinearSolvers>
@@ -12,15 +13,9 @@
 namespace fdm {
 
 namespace {
-std::string fmt(double x)
-{
-  std::ostringstream os;
-  os.precision(10);
-  os << x;
-  return os.str();
-}
-std::string point(const double *x) { return "(" + fmt(x[0]) + ", " + fmt(x[1]) + ", " + fmt(x[2]) + ")"; }
-std::string tagName(int index) { return std::to_string(index + 1); }
+using fdm::text::number;
+using fdm::text::particleId;
+using fdm::text::point;
 }  // namespace
 
 struct ParticleVelocitySystem::Matrices {
@@ -41,9 +36,9 @@ ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
   wallBlocks_(0), iterations_(0), factorisations_(0), m_(new Matrices)
 {
   if (!(settings_.alphaLambda > 0) || !(settings_.rhoFluid > 0) || !(settings_.tolerance > 0))
-    throw Error(Error::notSolved, -1, "Eq. (31) needs a positive alpha_lambda (" + fmt(settings_.alphaLambda) +
-                                      " s), fluid density (" + fmt(settings_.rhoFluid) + " kg/m3) and CG tolerance (" +
-                                      fmt(settings_.tolerance) + ")");
+    throw Error(Error::notSolved, -1, "Eq. (31) needs a positive alpha_lambda (" + number(settings_.alphaLambda) +
+                                      " s), fluid density (" + number(settings_.rhoFluid) + " kg/m3) and CG tolerance (" +
+                                      number(settings_.tolerance) + ")");
   if (settings_.stresslets) {
     pairRecord_ += subgrid::pairStressRecord;
     wallRecord_ += subgrid::wallStressRecord;
@@ -55,7 +50,7 @@ ParticleVelocitySystem::~ParticleVelocitySystem() {}
 int ParticleVelocitySystem::tagIndex(double tag) const
 {
   const long t = std::lround(tag);
-  if (!(t >= 1 && t <= n_)) throw Error(Error::badBlock, -1, "pair fdm/subgrid sent a block for particle ID " + fmt(tag));
+  if (!(t >= 1 && t <= n_)) throw Error(Error::badBlock, -1, "pair fdm/subgrid sent a block for particle ID " + number(tag));
   return int(t - 1);
 }
 
@@ -91,7 +86,7 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
     for (int k = 0; k < pairRecord_ - 2; k++)
       if (!std::isfinite(R[k]))
         throw Error(Error::badBlock, i1, "pair fdm/subgrid sent a non-finite sub-grid block for particles " +
-                                         tagName(i1) + " and " + tagName(i2) + " at " + point(particles_[i1].x) +
+                                         particleId(i1) + " and " + particleId(i2) + " at " + point(particles_[i1].x) +
                                          " and " + point(particles_[i2].x));
     for (int i = 0; i < 12; i++)
       for (int j = 0; j < 12; j++)
@@ -104,7 +99,7 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
     for (int k = 0; k < wallRecord_ - 1; k++)
       if (!std::isfinite(R[k]))
         throw Error(Error::badBlock, p, "pair fdm/subgrid sent a non-finite sub-grid wall block for particle " +
-                                        tagName(p) + " at " + point(particles_[p].x));
+                                        particleId(p) + " at " + point(particles_[p].x));
     for (int i = 0; i < 6; i++) {
       for (int j = 0; j < 6; j++) triplets.push_back(Eigen::Triplet<double>(base + i, base + j, R[6 * i + j]));
       m.wallRhs(base + i) += rhs[i];  // F = -R_w (U - U_w, Omega): the wall velocity is a force
@@ -137,12 +132,12 @@ void ParticleVelocitySystem::setVolumes(const std::vector<double> &Vu, const std
   for (int p = 0; p < N; p++) {
     const Particle &q = particles_[p];
     if (!std::isfinite(Vu[p]) || !std::isfinite(Ju[p]))
-      throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite volume for particle " + tagName(p) +
-                                        " at " + point(q.x) + " (Vu " + fmt(Vu[p]) + ", Ju " + fmt(Ju[p]) + ")");
+      throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite volume for particle " + particleId(p) +
+                                        " at " + point(q.x) + " (Vu " + number(Vu[p]) + ", Ju " + number(Ju[p]) + ")");
     if (!(Vu[p] > 0) || !(Ju[p] > 0))
-      throw Error(Error::noVolume, p, "particle " + tagName(p) + " at " + point(q.x) + " with radius " +
-                                      fmt(q.radius) + ": the fluid's indicator function gives it no volume (Vu " +
-                                      fmt(Vu[p]) + ", Ju " + fmt(Ju[p]) + ")");
+      throw Error(Error::noVolume, p, "particle " + particleId(p) + " at " + point(q.x) + " with radius " +
+                                      number(q.radius) + ": the fluid's indicator function gives it no volume (Vu " +
+                                      number(Vu[p]) + ", Ju " + number(Ju[p]) + ")");
     for (int d = 0; d < 3; d++) {
       diagonal(6 * p + d) = settings_.rhoFluid * Vu[p] / settings_.alphaLambda;
       diagonal(6 * p + 3 + d) = settings_.rhoFluid * Ju[p] / settings_.alphaLambda;
@@ -186,9 +181,9 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
     const Particle &q = particles_[p];
     for (int c = 0; c < 6; c++)
       if (!std::isfinite(fluidForces[size_t(6) * p + c]))
-        throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite integral for particle " + tagName(p) +
+        throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite integral for particle " + particleId(p) +
                                           " at " + point(q.x) + " (" + component[c] + " = " +
-                                          fmt(fluidForces[size_t(6) * p + c]) + ")");
+                                          number(fluidForces[size_t(6) * p + c]) + ")");
     const double buoyantFraction = 1.0 - settings_.rhoFluid / q.density;  // (rho_p - rho_f)/rho_p
     for (int d = 0; d < 3; d++) {
       rhs(6 * p + d) = fluidForces[size_t(6) * p + d] + buoyantFraction * q.mass * settings_.gravity[d] + q.force[d];
@@ -207,7 +202,7 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
     iterations_ = long(m.cg.iterations());
     if (m.cg.info() != Eigen::Success && !(m.cg.error() < 1e-6))
       throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) did not converge: relative residual " +
-                                        fmt(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
+                                        number(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
                                         " conjugate-gradient iterations (" + std::to_string(pairBlocks_) +
                                         " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
   }
@@ -215,9 +210,9 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
     if (!std::isfinite(u(k))) {
       const int p = k / 6;
       const Particle &q = particles_[p];
-      throw Error(Error::notSolved, p, "the velocity of particle " + tagName(p) + " at " + point(q.x) +
+      throw Error(Error::notSolved, p, "the velocity of particle " + particleId(p) + " at " + point(q.x) +
                                        " is not finite (Eq. 31): its force " + point(q.force) + ", torque " +
-                                       point(q.torque) + ", fluid integrals Vu " + fmt(Vu_[p]) + " Ju " + fmt(Ju_[p]));
+                                       point(q.torque) + ", fluid integrals Vu " + number(Vu_[p]) + " Ju " + number(Ju_[p]));
     }
     u_[k] = u(k);
   }
