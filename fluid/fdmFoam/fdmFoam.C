@@ -217,12 +217,12 @@ int main(int argc, char *argv[])
             }
 
             // Step 7 with Anderson acceleration: the next iterate mixes the
-            // last ones (andersonAcceleration.H)
+            // last ones (andersonAcceleration.H). Every mixed state has
+            // lambda = 0 outside the particles, so the mixture has too.
             if (accelerate)
             {
                 t0 = wallClock();
                 anderson.accelerate(state, U, lambda, p);
-                forcing.truncateLambda(lambda);
                 stepFluidTime += wallClock() - t0;
             }
         }
