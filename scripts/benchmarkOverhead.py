@@ -189,23 +189,8 @@ def write_ico_run(run_dir, fdm_fluid, scene, steps):
         raise RuntimeError("fdmFoam's fvSchemes changed: cannot add icoFoam's ddt and div schemes")
     with open(os.path.join(run_dir, "system", "fvSchemes"), "w") as f:
         f.write(schemes)
-    case.foam_file(os.path.join(run_dir, "system", "controlDict"), "dictionary", """
-application     icoFoam;
-startFrom       startTime;
-startTime       0;
-stopAt          endTime;
-endTime         %.17g;
-deltaT          %.17g;
-writeControl    timeStep;
-writeInterval   1000000;
-purgeWrite      0;
-writeFormat     binary;
-writePrecision  12;
-writeCompression off;
-timeFormat      general;
-timePrecision   8;
-runTimeModifiable false;
-""" % ((steps + 0.5) * scene.alpha, scene.alpha))
+    case.write_control_dict(run_dir, application="icoFoam", write_interval=1000000,
+                            end_time=(steps + 0.5) * scene.alpha, delta_t=scene.alpha)
     case.foam_file(os.path.join(run_dir, "constant", "transportProperties"), "dictionary",
                    "\nnu              [0 2 -1 0 0 0 0] %.17g;\n" % NU)
     link_mesh(run_dir, os.path.realpath(os.path.join(fdm_fluid, "constant", "polyMesh")))

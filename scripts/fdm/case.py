@@ -49,6 +49,34 @@ class Box:
         return [f == "cyclic" for f in self.faces]
 
 
+def write_control_dict(case_dir, application="fdmFoam", write_interval=100000, end_time=None, delta_t=None):
+    """system/controlDict. For fdmFoam (the default) time is driven by fdmDEM: the run starts from
+    the latest time and endTime and deltaT are placeholders. For another solver (e.g. icoFoam in a
+    benchmark) give end_time and delta_t: it starts from time 0."""
+    driven = application == "fdmFoam"
+    if not driven and (end_time is None or delta_t is None):
+        raise ValueError("write_control_dict: %s needs end_time and delta_t" % application)
+    foam_file(os.path.join(case_dir, "system/controlDict"), "dictionary", """
+application     %(app)s;
+startFrom       %(start)s;
+startTime       0;
+stopAt          endTime;
+endTime         %(end)s
+deltaT          %(dt)s
+writeControl    timeStep;
+writeInterval   %(interval)d;
+purgeWrite      0;
+writeFormat     binary;
+writePrecision  12;
+writeCompression off;
+timeFormat      general;
+timePrecision   8;
+runTimeModifiable false;
+""" % dict(app=application, start="latestTime" if driven else "startTime", interval=write_interval,
+           end="1e30;       // time is driven by fdmDEM" if driven else "%.17g;" % end_time,
+           dt="1;          // overridden by fdmDEM's time step" if driven else "%.17g;" % delta_t))
+
+
 def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicator=(5.0, 0.3),
                      tol_lambda=1e-4, n_max=500, n_min=1, first_step=None, tol_u=1e-6, tol_p=5e-6,
                      pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
@@ -99,23 +127,7 @@ boundary
 """ % dict(x0=x0, y0=y0, z0=z0, x1=x1, y1=y1, z1=z1, nx=box.n[0], ny=box.n[1], nz=box.n[2],
            patches="\n".join(patches)))
 
-    foam_file(os.path.join(case_dir, "system/controlDict"), "dictionary", """
-application     fdmFoam;
-startFrom       latestTime;
-startTime       0;
-stopAt          endTime;
-endTime         1e30;       // time is driven by fdmDEM
-deltaT          1;          // overridden by fdmDEM's time step
-writeControl    timeStep;
-writeInterval   %d;
-purgeWrite      0;
-writeFormat     binary;
-writePrecision  12;
-writeCompression off;
-timeFormat      general;
-timePrecision   8;
-runTimeModifiable false;
-""" % write_interval)
+    write_control_dict(case_dir, write_interval=write_interval)
 
     foam_file(os.path.join(case_dir, "system/fvSchemes"), "dictionary", """
 ddtSchemes { default none; }
