@@ -1,6 +1,8 @@
 // fix fdm/output: per-particle records and ParaView files of a coupled run (fix_fdm_output.h, docs/dem.md).
 #include "fix_fdm_output.h"
 
+#include "coupling_session.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
@@ -146,10 +148,18 @@ void FixFdmOutput::open()
         if (append_) series_->load(update->get_cur_time() * (1 + 1e-12));
       }
     } catch (const rec::Error &e) {
-      error->one(FLERR, (std::string("fix fdm/output: ") + e.what()).c_str());
+      fail(e.what());
     }
   }
   opened_ = true;
+}
+
+void FixFdmOutput::fail(const std::string &message)
+{
+  // rank 0 (the others wait in the next collective call): the fluid solver is told why, then
+  // error->one aborts every rank
+  CouplingSession::instance().abandon("fdmDEM: fix fdm/output: " + message);
+  error->one(FLERR, ("fix fdm/output: " + message).c_str());
 }
 
 void FixFdmOutput::setup(int)
@@ -180,7 +190,7 @@ void FixFdmOutput::write(bool record, bool vtk)
       if (record) writeRecords(byTag);
       if (vtk) writeVtk(byTag);
     } catch (const rec::Error &e) {
-      error->one(FLERR, (std::string("fix fdm/output: ") + e.what()).c_str());
+      fail(e.what());
     }
   }
   if (vtk) lastVtkStep_ = update->ntimestep;
@@ -223,15 +233,14 @@ bool FixFdmOutput::gather(std::vector<double> &byTag)
   MPI_Gatherv(buf.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
   if (comm->me != 0) return false;
   if (long(all.size()) != natoms_ * width_)
-    error->one(FLERR, ("fix fdm/output: " + std::to_string(all.size() / width_) + " particles where the run has " +
-                       std::to_string(natoms_) + " (particles cannot be inserted or deleted)").c_str());
+    fail(std::to_string(all.size() / width_) + " particles where the run has " + std::to_string(natoms_) +
+         " (particles cannot be inserted or deleted)");
   byTag.assign(all.size(), 0.0);
   std::vector<char> seen(natoms_, 0);
   for (size_t k = 0; k < all.size(); k += width_) {
     const long tag = std::lround(all[k + gTag]);
     if (tag < 1 || tag > natoms_ || seen[tag - 1])
-      error->one(FLERR, ("fix fdm/output: particle ID " + std::to_string(tag) + " is out of 1.." +
-                         std::to_string(natoms_) + " or twice").c_str());
+      fail("particle ID " + std::to_string(tag) + " is out of 1.." + std::to_string(natoms_) + " or twice");
     seen[tag - 1] = 1;
     std::copy(all.begin() + k, all.begin() + k + width_, byTag.begin() + (tag - 1) * width_);
   }

@@ -44,6 +44,7 @@ class FixFdmOutput : public Fix {
   void writeRecords(const std::vector<double> &byTag);
   void writeVtk(const std::vector<double> &byTag);
   void write(bool record, bool vtk);
+  void fail(const std::string &message);
 
   long recordEvery_, vtkEvery_;
   std::string recordPath_, vtkDir_;
