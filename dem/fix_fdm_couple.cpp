@@ -121,7 +121,7 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       error->all(FLERR, ("fix fdm/couple: unknown keyword " + key + " (see docs/dem.md)").c_str());
     }
   }
-  perAtomColumns_ = stresslets_ ? 25 : 12;
+  perAtomColumns_ = stresslets_ ? 32 : 12;
   size_peratom_cols = perAtomColumns_;
   if (options.transport == "none" && (!(request.viscosity > 0) || !(request.meshSize > 0) || !(request.fluidDensity > 0)))
     error->all(FLERR, "fix fdm/couple transport none (DEM only, no fluid) needs viscosity eta [Pa s] and mesh Delta [m] "
@@ -363,7 +363,7 @@ void FixFdmCouple::setup(int)
     hydro_.assign(size_t(6) * natoms_, 0.0);
     fluidStress_.assign(size_t(7) * natoms_, 0.0);
     subgrid_.assign(size_t(6) * natoms_, 0.0);
-    stress_.assign(size_t(13) * natoms_, 0.0);
+    stress_.assign(size_t(20) * natoms_, 0.0);
   }
   std::vector<Particle> particles;
   gather(particles);
@@ -580,12 +580,13 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
   subgrid_ = system_->subgridForces();
   if (!stresslets_) return;
-  std::vector<double> hydrodynamic = fluidStress_;  // 7 per particle
-  system_->addSubgridStresslets(hydrodynamic);
+  std::vector<double> subgrid(size_t(7) * natoms_, 0.0);  // S^SG, s^SG: 7 per particle
+  system_->addSubgridStresslets(subgrid);
   for (int p = 0; p < natoms_; p++) {
-    double *out = &stress_[size_t(13) * p];
-    for (int c = 0; c < 7; c++) out[c] = hydrodynamic[size_t(7) * p + c];
+    double *out = &stress_[size_t(20) * p];
+    for (int c = 0; c < 7; c++) out[c] = fluidStress_[size_t(7) * p + c] + subgrid[size_t(7) * p + c];
     for (int c = 0; c < 6; c++) out[7 + c] = particles[p].contactStress[c];
+    for (int c = 0; c < 7; c++) out[13 + c] = subgrid[size_t(7) * p + c];
   }
 }
 
@@ -759,7 +760,7 @@ void FixFdmCouple::scatter()
   haveVelocities_ = true;
   MPI_Bcast(hydro_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
   MPI_Bcast(subgrid_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
-  if (stresslets_) MPI_Bcast(stress_.data(), 13 * natoms_, MPI_DOUBLE, 0, world);
+  if (stresslets_) MPI_Bcast(stress_.data(), 20 * natoms_, MPI_DOUBLE, 0, world);
   long counters[4] = {solverIterations_, pairBlocks_, wallBlocks_, contacts_};
   MPI_Bcast(counters, 4, MPI_LONG, 0, world);
   solverIterations_ = counters[0];
@@ -795,7 +796,7 @@ void FixFdmCouple::fillPerAtomArray()
       perAtom_[i][6 + c] = known ? subgrid_[size_t(6) * t + c] : 0.0;
     }
     if (stresslets_)
-      for (int c = 0; c < 13; c++) perAtom_[i][12 + c] = known ? stress_[size_t(13) * t + c] : 0.0;
+      for (int c = 0; c < 20; c++) perAtom_[i][12 + c] = known ? stress_[size_t(20) * t + c] : 0.0;
   }
 }
 

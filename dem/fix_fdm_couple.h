@@ -19,7 +19,8 @@
    Outputs (docs/dem.md): global vector [inner iterations, lambda residual, particle-solve seconds,
    exchange seconds, linear-solver iterations, sub-grid pair blocks, wall blocks, contacts] of the
    last step; per-atom array [F^FDM, T^FDM, F^SG, T^SG] (12 columns), and with stresslets yes
-   [S^h (6), s^h, S^c (6)] after them (25 columns). */
+   [S^h (6), s^h, S^c (6), S^SG (6), s^SG] after them (32 columns; S^SG, s^SG: the sub-grid part of
+   S^h, s^h). fix fdm/output (fix_fdm_output.h) writes them to binary records and ParaView files. */
 
 #ifndef FDM_FIX_FDM_COUPLE_H
 #define FDM_FIX_FDM_COUPLE_H
@@ -117,7 +118,7 @@ class FixFdmCouple : public Fix {
   // Eq. (31) on rank 0 (particle_velocity_system.h): assembled once per step, solved every inner iteration.
   std::unique_ptr<fdm::ParticleVelocitySystem> system_;
   std::vector<double> subgrid_;    // 6N: F^SG, T^SG of the last step, by tag
-  std::vector<double> stress_;     // 13N: S^h (6), s^h, S^c (6) of the last step, by tag
+  std::vector<double> stress_;     // 20N: S^h (6), s^h, S^c (6), S^SG (6), s^SG of the last step, by tag
   long solverIterations_, pairBlocks_, wallBlocks_, contacts_;
 };
 

@@ -10,6 +10,9 @@ from fdm import case, output, packing, profiles
 
 TINY = ["--phi", "0.25", "--size", "7", "11", "7", "--a-over-delta", "3", "--dt", "0.02", "--strain", "0.4",
         "--dump-every", "0.02", "--seed", "3"]
+# the binary records are what the analysis reads; the text dump of the same steps is written too,
+# to check the records against it; the fluid fields (and the particles' VTK files) every 0.2 strain
+OUTPUTS = ["--text-dump", "--write-every", "0.2", "--keep"]
 
 
 @pytest.fixture(scope="module")
@@ -20,8 +23,16 @@ def couette():
 @pytest.fixture(scope="module")
 def tiny_run(couette, tmp_path_factory, env):
     work = tmp_path_factory.mktemp("couette")
-    results = couette.main(TINY + ["--workdir", str(work), "--out", str(work / "results.json")])
+    results = couette.main(TINY + OUTPUTS + ["--workdir", str(work), "--out", str(work / "results.json")])
     return results
+
+
+@pytest.fixture(scope="module")
+def tiny_run_two_dem_ranks(couette, tmp_path_factory, env):
+    """The tiny scene for 8 steps (the fewest the analysis takes) with the particles on 2 MPI ranks."""
+    work = tmp_path_factory.mktemp("couette2")
+    args = TINY[:TINY.index("--strain")] + ["--strain", "0.16"] + TINY[TINY.index("--strain") + 2:]
+    return couette.main(args + OUTPUTS + ["--np-dem", "2", "--workdir", str(work), "--out", str(work / "r.json")])
 
 
 def test_tiny_scene_runs_converged_and_integrates_phi_exactly(couette, tiny_run):
@@ -29,7 +40,7 @@ def test_tiny_scene_runs_converged_and_integrates_phi_exactly(couette, tiny_run)
     assert r["n_particles"] >= 15 and r["n_a1"] > 0 and r["n_a2"] > 0
     assert r["unconverged_steps"] == 0
     assert r["steps"] == 20
-    snapshots, _ = output.suspension_snapshots(os.path.join(r["run_dir"], "dem", "particles.dump"), r["dt"])
+    snapshots, _ = output.record_snapshots(os.path.join(r["run_dir"], "dem", "particles.records"))
     assert len(snapshots) == 20
     channel = profiles.Channel((0, 0, 0), tuple(r["box"]))
     for s in snapshots:
@@ -144,3 +155,124 @@ def test_dump_reader_stresslet_and_truncation(tmp_path):
     assert np.allclose(s.stresslet_h[0], expected) and np.allclose(s.stresslet_h[1], 2 * expected)
     assert np.allclose(s.stresslet_c[0], couple[19:25])
     assert np.allclose(forces[0][0], couple[0:3] + couple[6:9])
+
+
+# ---- the particle records and the ParaView files (fix fdm/output, docs/dem.md) --------------------
+
+def _records_match_the_dump(r):
+    """Every record step holds every particle, by tag, with the values of the LIGGGHTS text dump of
+    the same step (full precision): positions (wrapped into the box; image counts the periods),
+    radius, type, U, Omega, the fluid + sub-grid forces and the stresslets S^H, S^c."""
+    dem = os.path.join(r["run_dir"], "dem")
+    rec = output.read_particle_records(os.path.join(dem, "particles.records"))
+    frames = [(step, c) for step, c in output.read_dump(os.path.join(dem, "particles.dump")) if step > 0]
+    snapshots, forces = output.suspension_snapshots(os.path.join(dem, "particles.dump"), r["dt"])
+    n = r["n_particles"]
+    assert rec.n_particles == n and rec.dropped_bytes == 0
+    assert list(rec.steps) == [step for step, _ in frames] == list(range(1, r["steps"] + 1))
+    assert np.allclose(rec.times, rec.steps * r["dt"], rtol=1e-14, atol=0)
+    assert np.all(rec["tag"] == np.arange(1, n + 1))                 # every particle, in tag order
+    box = np.array(r["box"])
+    lo, hi = np.array(rec.header["box_lo"]), np.array(rec.header["box_hi"])
+    assert np.allclose(lo, 0) and np.allclose(hi, box) and rec.header["periodic"] == [1, 0, 1]
+    x = rec["x"]
+    assert np.all(x >= lo) and np.all(x < hi)                      # wrapped into the box
+    for k, (step, c) in enumerate(frames):
+        s = snapshots[k]
+        # the dump holds x as LIGGGHTS does (wrapped only when it re-neighbours): the same point
+        # modulo the periods; the unwrapped trajectory x + image L
+        d = x[k] - s.positions
+        assert np.max(np.abs(d - box * np.round(d / box))) < 1e-12 * box.max()
+        assert np.all(rec["image"][k][:, 1] == 0)
+        assert np.array_equal(rec["radius"][k], s.radii) and np.array_equal(rec["type"][k], s.types)
+        assert np.array_equal(rec["U"][k], s.velocities) and np.array_equal(rec["omega"][k], s.omegas)
+        assert np.array_equal(rec["F_fluid"][k] + rec["F_subgrid"][k], forces[k])
+        scale = np.abs(s.stresslet_h).max()
+        assert np.max(np.abs(rec["S_fluid"][k] + rec["S_subgrid"][k] - s.stresslet_h)) < 1e-13 * scale
+        assert np.array_equal(rec["S_contact"][k], s.stresslet_c)
+    # the sub-grid part is there: in a suspension at phi = 0.25 some pairs have lubrication blocks
+    assert np.abs(rec["S_subgrid"]).max() > 1e-3 * np.abs(rec["S_fluid"]).max()
+    return rec
+
+
+def test_records_hold_every_particle_and_match_the_dump(tiny_run):
+    rec = _records_match_the_dump(tiny_run)
+    # the size: a header, then one block per record step of 16 + N record_bytes + 8 bytes
+    path = rec.path
+    assert os.path.getsize(path) == rec.header["header_bytes"] + len(rec) * rec.header["block_bytes"]
+    assert rec.header["block_bytes"] == 16 + tiny_run["n_particles"] * rec.header["record_bytes"] + 8
+
+
+def test_records_of_two_dem_ranks_match_their_dump(tiny_run_two_dem_ranks):
+    rec = _records_match_the_dump(tiny_run_two_dem_ranks)
+    assert len(rec) == 8
+
+
+def test_truncated_records_keep_every_complete_block(tiny_run, tmp_path):
+    full = output.read_particle_records(os.path.join(tiny_run["run_dir"], "dem", "particles.records"), mmap=False)
+    data = open(full.path, "rb").read()
+    block = full.header["block_bytes"]
+    for cut in (block // 2, 1, 8):        # in the middle of the last block, in its end marker
+        path = tmp_path / "cut.records"
+        path.write_bytes(data[:len(data) - cut])
+        with pytest.warns(UserWarning, match="incomplete block"):
+            rec = output.read_particle_records(str(path))
+        assert len(rec) == len(full) - 1 and rec.dropped_bytes == block - cut
+        assert np.array_equal(rec.blocks, full.blocks[:-1])
+    # a crash after the file grew leaves zeros: not a block
+    path.write_bytes(data[:len(data) - block] + bytes(block))
+    with pytest.warns(UserWarning, match="incomplete block"):
+        assert len(output.read_particle_records(str(path))) == len(full) - 1
+    path.write_bytes(data[:full.header["header_bytes"] - 5])
+    with pytest.raises(ValueError, match="cut short"):
+        output.read_particle_records(str(path))
+    dump = os.path.join(tiny_run["run_dir"], "dem", "particles.dump")
+    with pytest.raises(ValueError, match="not a particle records file"):
+        output.read_particle_records(dump)
+
+
+def _vtk_reads(path):
+    """Number of points and arrays of a .vtp read by the real VTK library (Debian's python3-vtk9,
+    under the system Python), or None if it is not installed."""
+    import shutil
+    import subprocess
+    system_python = shutil.which("python3", path="/usr/bin")
+    if not system_python or subprocess.run([system_python, "-c", "import vtk"], capture_output=True).returncode:
+        return None
+    script = ("import sys, vtk\nr = vtk.vtkXMLPolyDataReader(); r.SetFileName(sys.argv[1]); r.Update()\n"
+              "o = r.GetOutput(); d = o.GetPointData()\n"
+              "print(r.GetErrorCode(), o.GetNumberOfPoints(), o.GetNumberOfVerts(), "
+              "' '.join(d.GetArrayName(i) for i in range(d.GetNumberOfArrays())))")
+    out = subprocess.run([system_python, "-c", script, path], capture_output=True, text=True, check=True).stdout.split()
+    return int(out[0]), int(out[1]), int(out[2]), out[3:]
+
+
+def test_paraview_files_at_the_fluid_write_times(tiny_run):
+    r = tiny_run
+    run = r["run_dir"]
+    assert os.path.isfile(os.path.join(run, "fluid", "fluid.foam"))
+    series = output.read_pvd(os.path.join(run, "dem", "vtk", "particles.pvd"))
+    # the fluid writes every 0.2 strain (writeInterval 10 steps) and at the end; the particles too
+    fluid_times = sorted(float(d) for d in os.listdir(os.path.join(run, "fluid"))
+                         if d.replace(".", "").isdigit())
+    assert [t for t, _ in series] == fluid_times == [0.0, 0.2, 0.4]
+    rec = output.read_particle_records(os.path.join(run, "dem", "particles.records"))
+    checked = 0
+    for time, path in series:
+        v = output.read_vtp(path)
+        assert v["Points"].shape == (r["n_particles"], 3)
+        assert np.array_equal(v["id"], np.arange(1, r["n_particles"] + 1))
+        for name in ("radius", "type", "diameter", "U", "omega", "F_hydro", "F_fluid", "F_subgrid", "F_dem",
+                     "T_hydro", "S_hydro", "S_fluid", "S_subgrid", "S_contact"):
+            assert name in v, name
+        k = np.flatnonzero(np.isclose(rec.times, time, rtol=0, atol=1e-9))
+        if len(k):
+            k = k[0]
+            assert np.array_equal(v["Points"], rec["x"][k]) and np.array_equal(v["U"], rec["U"][k])
+            # symmetric tensors in VTK's order xx yy zz xy yz xz
+            assert np.allclose(v["S_contact"], rec["S_contact"][k][:, [0, 3, 5, 1, 4, 2]], rtol=0, atol=0)
+            checked += 1
+        vtk = _vtk_reads(path)
+        if vtk is not None:
+            assert vtk[:3] == (0, r["n_particles"], r["n_particles"]) and "S_hydro" in vtk[3]
+    assert checked == 2

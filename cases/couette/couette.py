@@ -124,8 +124,12 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
 
 
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, strain: float,
-               dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50) -> dict:
-    """fluid/ and dem/ of the run; returns the scene's description."""
+               dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
+               text_dump: bool = False) -> dict:
+    """fluid/ and dem/ of the run; returns the scene's description. The particles are recorded every
+    dump_every steps in dem/particles.records (fix fdm/output), and written for ParaView with the
+    fluid fields every write_every steps (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also
+    the LIGGGHTS text dump dem/particles.dump of the same steps (for comparisons)."""
     delta = A1 / a_over_delta
     Lx, Ly, Lz = (float(v) for v in pack.box)
     U = SHEAR_RATE * Ly / 2
@@ -133,18 +137,20 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     steps = int(round(strain / (SHEAR_RATE * dt)))
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
                           first_step=(tol_lambda / 10, 3000), n_particles=pack.n, tol_u=1e-5, tol_p=1e-3,
-                          acceleration=acceleration)
+                          acceleration=acceleration, write_interval=write_every)
     pair = ("fdm/subgrid contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
             % (springs.kn, springs.kt, springs.mu_s, springs.h_r, -U, U))
     spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]
-    runs = (output.dump_custom_command("particles", dump_every, "particles.dump")
+    runs = (["fix             output all fdm/output records %d particles.records vtk %d vtk"
+             % (dump_every, write_every)]
+            + (output.dump_custom_command("particles", dump_every, "particles.dump") if text_dump else [])
             + ["thermo_style    custom step f_couple[1] f_couple[2] f_couple[6] f_couple[7] f_couple[8]",
                "thermo          %d" % dump_every,
                "run             %d" % steps])
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
                          fix_options="stresslets yes", runs=runs, name="in.couette")
     return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
-                wall_velocity=U, dt=dt, dump_every=dump_every)
+                wall_velocity=U, dt=dt, dump_every=dump_every, write_every=write_every)
 
 
 def minimum_gaps(snapshots: list[profiles.Snapshot], box: np.ndarray) -> tuple[float, float]:
@@ -167,8 +173,7 @@ def analyse(run_dir: str, scene: dict, pack: packing.Packing, wall_seconds: floa
     iterations, the gaps."""
     fluid = os.path.join(run_dir, "fluid")
     steps = output.steps(fluid)
-    snapshots, _ = output.suspension_snapshots(os.path.join(run_dir, "dem", "particles.dump"), scene["dt"],
-                                               SHEAR_RATE)
+    snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"), SHEAR_RATE)
     box = np.array(scene["box"])
     channel = profiles.Channel((0, 0, 0), tuple(box))
     phi_integral = [profiles.bulk_volume_fraction(s, channel) for s in snapshots]
@@ -222,6 +227,10 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--strain", type=float, default=3.0, help="strain units to run")
     p.add_argument("--seed", type=int, default=1, help="seed of the random packing")
     p.add_argument("--dump-every", type=float, default=0.1, help="strain between two particle snapshots")
+    p.add_argument("--write-every", type=float, default=1.0, help="strain between two writes of the fluid fields "
+                   "and of the particles' ParaView files (dem/vtk/particles.pvd; the fluid fields are deleted after the run unless --keep)")
+    p.add_argument("--text-dump", action="store_true", help="also write the LIGGGHTS text dump dem/particles.dump "
+                   "(the binary records dem/particles.records are what the analysis reads)")
     p.add_argument("--h-layer", type=float, default=5.0, help="H_layer/a1: the core is |y| < L_y/2 - H_layer")
     p.add_argument("--kn", type=float, default=None, help="normal spring [N/m] (default: the rule above)")
     p.add_argument("--kt", type=float, default=None, help="tangential spring [N/m] (default: the rule above)")
@@ -276,8 +285,9 @@ def main(argv: list[str] | None = None) -> dict:
             raise SystemExit("couette: %s already holds a run; --overwrite replaces it" % run_dir)
         shutil.rmtree(run_dir)
     every = max(1, int(round(args.dump_every / (SHEAR_RATE * dt))))
+    write_every = max(1, int(round(args.write_every / (SHEAR_RATE * dt))))
     scene = write_case(run_dir, pack, springs, args.a_over_delta, dt, args.strain, every, args.tol_lambda,
-                       args.acceleration, args.n_max)
+                       args.acceleration, args.n_max, write_every, args.text_dump)
     packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
     print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
           "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,

@@ -407,6 +407,25 @@ TEST(FdmDEMErrors, UnknownKeyword)
     expectFailure("keyword", scene, nullptr, "fix fdm/couple: unknown keyword gravitation", false);
 }
 
+TEST(FdmDEMErrors, FixOutputBadInput)
+{
+    // fix fdm/output (fix_fdm_output.h): the keywords, checked when the fix is defined
+    Scene scene;
+    scene.runs = "fix out all fdm/output records 10 p.records vtk 5\nrun 1";
+    expectFailure("output-missing", scene, nullptr, "fix fdm/output: keyword vtk needs 2 values", false);
+    scene.runs = "fix out all fdm/output records 0 p.records\nrun 1";
+    expectFailure("output-zero", scene, nullptr, "fix fdm/output: records every 0 steps: must be 1 or more", false);
+    scene.runs = "fix out all fdm/output\nrun 1";
+    expectFailure("output-nothing", scene, nullptr, "fix fdm/output: nothing to write", false);
+    scene.runs = "fix out all fdm/output records 1 p.records dump yes\nrun 1";
+    expectFailure("output-keyword", scene, nullptr, "fix fdm/output: unknown keyword dump", false);
+    scene.runs = "unfix couple\nfix out all fdm/output records 1 p.records\nrun 1";
+    expectFailure("output-alone", scene, nullptr, "fix fdm/output needs fix fdm/couple", false);
+    // a records file that cannot be created: named, and the fluid is told
+    scene.runs = "fix out all fdm/output records 1 no-such-folder/p.records\nrun 1";
+    expectFailure("output-unwritable", scene, nullptr, "cannot create the records file no-such-folder/p.records");
+}
+
 FDM_SCRATCH_CLEANUP("fdmDEMTest");
 
 int main(int argc, char** argv)

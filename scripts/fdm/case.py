@@ -128,6 +128,8 @@ boundary
            patches="\n".join(patches)))
 
     write_control_dict(case_dir, write_interval=write_interval)
+    # an empty <case>.foam: what ParaView opens to read an OpenFOAM case (its built-in reader)
+    open(os.path.join(case_dir, os.path.basename(os.path.normpath(case_dir)) + ".foam"), "w").close()
 
     foam_file(os.path.join(case_dir, "system/fvSchemes"), "dictionary", """
 ddtSchemes { default none; }

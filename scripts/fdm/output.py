@@ -1,4 +1,6 @@
-"""Reading fdmFoam's per-step and per-particle records (postProcessing/fdm/*.dat)."""
+"""Reading the outputs of coupled runs: fdmFoam's per-step and per-particle records
+(postProcessing/fdm/*.dat), the binary particle records and ParaView files of fix fdm/output,
+LIGGGHTS text dumps (older runs) and the time breakdowns of the logs."""
 import io
 import os
 import warnings
@@ -138,6 +140,186 @@ def suspension_snapshots(path, dt, strain_rate=1.0, skip_first=True):
             time=step * dt * strain_rate))
         forces.append(couple[:, _F_FDM] + couple[:, _F_SG])
     return snapshots, forces
+
+
+# ------------------------------------------------------------------------------------------------
+# Binary per-particle records of fix fdm/output (dem/particle_records.h, docs/dem.md)
+# ------------------------------------------------------------------------------------------------
+
+RECORDS_MAGIC = b"FDMPREC\n"
+
+
+class ParticleRecords:
+    """The complete blocks of a records file of `fix fdm/output ... records N FILE`.
+
+    `records["x"]` is the (T, N, 3) array of field x (T record steps, N particles by tag, here
+    index tag - 1), `records["radius"]` (T, N), and so on for every field of `records.fields`;
+    `records.steps` and `records.times` are (T,). `records.blocks` is the structured array of the
+    blocks (fields step, time, particles (N,), end), memory-mapped unless read with mmap=False.
+    `records.header` is the file's JSON header (box_lo, box_hi, periodic, dt, every, ...).
+    `dropped_bytes`: bytes after the last complete block (a run killed while writing it)."""
+
+    def __init__(self, path: str, header: dict, blocks: np.ndarray, dropped_bytes: int) -> None:
+        self.path, self.header, self.blocks, self.dropped_bytes = path, header, blocks, dropped_bytes
+
+    @property
+    def fields(self) -> tuple:
+        return self.blocks.dtype["particles"].base.names
+
+    @property
+    def n_particles(self) -> int:
+        return int(self.header["particles"])
+
+    @property
+    def steps(self) -> np.ndarray:
+        return self.blocks["step"]
+
+    @property
+    def times(self) -> np.ndarray:
+        return self.blocks["time"]
+
+    def __len__(self) -> int:
+        return len(self.blocks)
+
+    def __getitem__(self, field: str) -> np.ndarray:
+        if field in ("step", "time"):
+            return self.blocks[field]
+        if field not in self.fields:
+            raise KeyError("%s has no field %r (fields: %s)" % (self.path, field, " ".join(self.fields)))
+        return self.blocks["particles"][field]
+
+    def __repr__(self) -> str:
+        return "ParticleRecords(%s: %d blocks of %d particles, fields %s)" % (
+            self.path, len(self), self.n_particles, " ".join(self.fields))
+
+
+def records_dtype(header: dict) -> np.dtype:
+    """The numpy dtype of one block of a records file, from its header."""
+    particle = np.dtype([(f[0], f[1], tuple(f[2])) if len(f) > 2 else (f[0], f[1])
+                         for f in header["particle_fields"]])
+    if particle.itemsize != header["record_bytes"]:
+        raise ValueError("records header: the particle fields make %d bytes, record_bytes says %d"
+                         % (particle.itemsize, header["record_bytes"]))
+    order = "<" if header.get("byte_order", "little") == "little" else ">"
+    block = np.dtype([("step", order + "i8"), ("time", order + "f8"),
+                      ("particles", particle, (int(header["particles"]),)), ("end", order + "i8")])
+    if block.itemsize != header["block_bytes"]:
+        raise ValueError("records header: a block of %d bytes, block_bytes says %d" % (block.itemsize,
+                                                                                       header["block_bytes"]))
+    return block
+
+
+def read_records_header(path: str) -> dict:
+    """The JSON header of a records file (raises ValueError if it is none)."""
+    import json
+    import struct
+    if not os.path.isfile(path):
+        raise FileNotFoundError("%s not found: did fdmDEM run with fix fdm/output ... records?" % path)
+    with open(path, "rb") as f:
+        head = f.read(12)
+        if len(head) < 12 or head[:8] != RECORDS_MAGIC:
+            raise ValueError("%s is not a particle records file of fix fdm/output (no FDMPREC header)" % path)
+        length = struct.unpack("<I", head[8:12])[0]
+        text = f.read(length)
+    if len(text) < length:
+        raise ValueError("%s: the records header is cut short" % path)
+    header = json.loads(text.decode("ascii"))
+    if header.get("format") != "fdm particle records" or header.get("header_bytes") != 12 + length:
+        raise ValueError("%s: not a particle records header: %s" % (path, text[:200]))
+    if header.get("version") != 1:
+        raise ValueError("%s: records format version %s, this reader knows version 1" % (path, header.get("version")))
+    return header
+
+
+def read_particle_records(path: str, mmap: bool = True) -> ParticleRecords:
+    """Every complete block of a binary records file of fix fdm/output (docs/profiles.md,
+    "Particle records"), memory-mapped (mmap=True: nothing is read until used) or read into memory.
+    A trailing partial block (a run killed while writing it) is dropped with a warning."""
+    header = read_records_header(path)
+    dtype = records_dtype(header)
+    offset = int(header["header_bytes"])
+    size = os.path.getsize(path)
+    count = (size - offset) // dtype.itemsize
+    if count == 0:
+        blocks = np.zeros(0, dtype=dtype)
+    elif mmap:
+        blocks = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=(count,))
+    else:
+        blocks = np.fromfile(path, dtype=dtype, count=count, offset=offset)
+    # a block is complete when its end marker is -1 - step (a file extended by a crash holds zeros)
+    bad = np.flatnonzero(blocks["end"] != ~blocks["step"]) if count else np.zeros(0, dtype=int)
+    if bad.size and bad[-1] != count - 1 or bad.size > 1:
+        raise ValueError("%s: block %d of %d is damaged (its end marker does not match its step)"
+                         % (path, bad[0] + 1, count))
+    if bad.size:
+        count = int(bad[0])
+        blocks = blocks[:count]
+    dropped = size - offset - count * dtype.itemsize
+    if dropped:
+        warnings.warn("%s: the last %d bytes are an incomplete block (the run stopped while writing it): ignored"
+                      % (path, dropped))
+    return ParticleRecords(path, header, blocks, dropped)
+
+
+def record_snapshots(records, strain_rate: float = 1.0):
+    """The blocks of a records file (a path or ParticleRecords) as fdm.profiles.Snapshot objects,
+    time = strain = record time x strain_rate, particles by tag: positions (wrapped into the box),
+    radii, types, U_p, Omega_p, S^H = S_fluid + S_subgrid (the hydrodynamic stresslet, Eq. 52, not
+    traceless) and S^c = S_contact (zero without stresslets). Also returns per block the
+    hydrodynamic forces F_fluid + F_subgrid (N, 3): (snapshots, forces), as suspension_snapshots."""
+    from .profiles import Snapshot
+    r = read_particle_records(records) if isinstance(records, str) else records
+    stresslets = "S_fluid" in r.fields
+    snapshots, forces = [], []
+    for k in range(len(r)):
+        p = r.blocks[k]["particles"]
+        snapshots.append(Snapshot(
+            positions=p["x"], radii=p["radius"], velocities=p["U"], omegas=p["omega"],
+            stresslet_h=p["S_fluid"] + p["S_subgrid"] if stresslets else None,
+            stresslet_c=p["S_contact"] if stresslets else None, types=p["type"],
+            time=float(r.blocks[k]["time"]) * strain_rate))
+        forces.append(np.asarray(p["F_fluid"] + p["F_subgrid"], dtype=float))
+    return snapshots, forces
+
+
+# ------------------------------------------------------------------------------------------------
+# ParaView files of fix fdm/output (vtk M DIR): the .pvd series and the particles' .vtp files
+# ------------------------------------------------------------------------------------------------
+
+def read_pvd(path: str) -> list:
+    """The (time, file path) entries of a .pvd series, file paths resolved against its folder."""
+    import xml.etree.ElementTree as ET
+    root = ET.parse(path).getroot()
+    folder = os.path.dirname(os.path.abspath(path))
+    return [(float(d.get("timestep")), os.path.join(folder, d.get("file"))) for d in root.iter("DataSet")]
+
+
+def read_vtp(path: str) -> dict:
+    """The point arrays of a .vtp written by fix fdm/output (binary appended raw data, UInt64
+    headers): a dict name -> (n,) or (n, components) array, with "Points" (n, 3)."""
+    import re
+    with open(path, "rb") as f:
+        data = f.read()
+    start = data.index(b"<AppendedData")
+    raw = data.index(b"_", start) + 1
+    xml = data[:start].decode("ascii")
+    order = "<" if 'byte_order="LittleEndian"' in xml else ">"
+    if 'header_type="UInt64"' not in xml:
+        raise ValueError("%s: not a .vtp of fix fdm/output (header_type UInt64)" % path)
+    n = int(re.search(r'NumberOfPoints="(\d+)"', xml).group(1))
+    out = {}
+    for m in re.finditer(r'<DataArray type="(Float64|Int64)" Name="([^"]+)"(?: NumberOfComponents="(\d+)")? '
+                         r'format="appended" offset="(\d+)"/>', xml):
+        kind, name, comps, offset = m.group(1), m.group(2), int(m.group(3) or 1), int(m.group(4))
+        nbytes = int(np.frombuffer(data, dtype=order + "u8", count=1, offset=raw + offset)[0])
+        values = np.frombuffer(data, dtype=order + ("f8" if kind == "Float64" else "i8"), count=nbytes // 8,
+                               offset=raw + offset + 8)
+        if name in ("connectivity", "offsets"):
+            continue
+        if values.size != n * comps:
+            raise ValueError("%s: array %s has %d values for %d points" % (path, name, values.size, n))
+        out[name] = values.reshape(n, comps) if comps > 1 else values
+    return out
 
 
 # ------------------------------------------------------------------------------------------------
