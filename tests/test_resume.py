@@ -52,7 +52,7 @@ def make_scene(root, steps=STEPS, every=EVERY, spheres=None):
 
 def fdm_run(root, env, *options, timeout=300):
     return subprocess.run([FDMRUN, "--quiet"] + list(options) + [root], env=env, stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, text=True, timeout=timeout)
+                          stderr=subprocess.STDOUT, text=True, errors="replace", timeout=timeout)
 
 
 def trajectory(root):
@@ -102,7 +102,7 @@ def steps_done(root):
 
 def run_and_kill(root, env, who, at_step):
     """fdmRun in root, SIGKILL of `who` once `at_step` steps are recorded; returns fdmRun's exit code."""
-    proc = subprocess.Popen([FDMRUN, "--quiet", root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    proc = subprocess.Popen([FDMRUN, "--quiet", root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, errors="replace",
                             text=True)
     deadline = time.time() + 240
     while steps_done(root) < at_step and proc.poll() is None and time.time() < deadline:
@@ -184,7 +184,7 @@ def test_truncated_checkpoint_falls_back_to_the_previous_one(tmp_path, env, refe
     assert_same_trajectory(root, reference)
     # the reason is said
     r = subprocess.run(["python3", "-m", "fdm.checkpoint", "select", root], env=dict(
-        env, PYTHONPATH=os.path.join(PROJECT, "scripts")), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        env, PYTHONPATH=os.path.join(PROJECT, "scripts")), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
     assert r.returncode == 0
 
 
@@ -238,9 +238,9 @@ def test_resume_step_mismatch_at_the_handshake(tmp_path, env, reference):
     os.remove(os.path.join(root, "fluid", "coupling.port")) if os.path.exists(
         os.path.join(root, "fluid", "coupling.port")) else None
     fluid = subprocess.Popen(["fdmFoam", "-case", os.path.join(root, "fluid"), "-resume", "45"], env=env,
-                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
     dem = subprocess.run(["fdmDEM", "-in", "in.couette", "-resume", "checkpoint/dem.50"], cwd=os.path.join(root, "dem"),
-                         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", timeout=120)
     out, _ = fluid.communicate(timeout=60)
     assert fluid.returncode != 0 and dem.returncode != 0
     message = "fdmFoam resumes from its checkpoint of step 45 (checkpoint/fluid.45) but fdmDEM from step 50"
