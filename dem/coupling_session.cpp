@@ -129,6 +129,8 @@ void CouplingSession::connectAndHandshake(LAMMPS *lmp)
       hello.dt = lmp->update->dt;
       hello.lastStep = lmp->update->laststep;
       hello.stresslets = request_.stresslets;
+      hello.resumeStep = resumeStep_;
+      hello.checkpointEvery = request_.checkpointEvery;
       hello.nParticles = particles_;
       for (int d = 0; d < 3; d++) {
         hello.lo[d] = lmp->domain->boxlo[d];
@@ -168,6 +170,10 @@ void CouplingSession::connectAndHandshake(LAMMPS *lmp)
 std::string CouplingSession::checkFluidHello(LAMMPS *lmp, const cpl::FluidHello &hello) const
 {
   const Domain *domain = lmp->domain;
+  // (the fluid checks the same and stops first with its own message; this is the DEM's side of it)
+  if (hello.resumeStep != resumeStep_)
+    return "fdmDEM resumes from the checkpoint of step " + std::to_string(resumeStep_) + " but fdmFoam from step " +
+           std::to_string(hello.resumeStep) + " (0: a fresh start): resume both with fdmRun --resume";
   if (hello.nParticlesExpected >= 0 && hello.nParticlesExpected != particles_)
     return "the fluid case expects " + std::to_string(hello.nParticlesExpected) + " particles (constant/fdmProperties "
            "nParticles) but the LIGGGHTS input has " + std::to_string(particles_);

@@ -30,12 +30,20 @@ class CouplingSession {
     bool stresslets = false;         // StepDone must carry the FDM stresslets
     // transport none: the values the fluid would have given
     double viscosity = 0, meshSize = 0, fluidDensity = 1000;
+    long long checkpointEvery = 0;   // fix fdm/couple checkpoint N (0: none), told to the fluid
   };
 
   // The boundary of the fluid case on a box face (coupler's layout::BoundaryKind), or none at all.
   enum FaceKind { facePeriodic = 0, faceWall = 1, faceSlip = 2, faceOther = 3, faceNoFluid = -1 };
 
   static CouplingSession &instance();
+
+  // Resume (fdmDEM -resume FILE, docs/coupling.md "Checkpoint and resume"): the particle checkpoint
+  // fix fdm/couple restores, and the step it holds, which the Hello tells the fluid (0: fresh start).
+  void setResumeFile(const std::string &file) { resumeFile_ = file; }
+  const std::string &resumeFile() const { return resumeFile_; }
+  void setResumeStep(long long step) { resumeStep_ = step; }
+  long long resumeStep() const { return resumeStep_; }
 
   // fix fdm/couple's constructor registers its request, its destructor withdraws it.
   void attach(const void *fix, const Request &request);
@@ -85,6 +93,8 @@ class CouplingSession {
 
   const void *owner_;
   Request request_;
+  std::string resumeFile_;
+  long long resumeStep_ = 0;
   std::unique_ptr<fdm::coupler::Transport> connection_;  // rank 0
   bool connected_;                                       // every rank: handshake done
   int particles_;

@@ -22,6 +22,7 @@ namespace {
 const char usage[] =
     "usage: fdmDEM -in INPUT [-var NAME VALUE ...] [-echo screen] [-log FILE] [other LIGGGHTS options]\n"
     "       mpirun -np N fdmDEM -in INPUT ...\n"
+    "       fdmDEM -in INPUT -resume CHECKPOINT   continue from a checkpoint of fix fdm/couple (fdmRun --resume)\n"
     "LIGGGHTS 3.8 with fix fdm/couple (coupling to the fluid solver fdmFoam) and pair_style fdm/subgrid\n"
     "(sub-grid lubrication and frictional contact); see docs/dem.md.\n";
 }
@@ -39,10 +40,21 @@ int main(int argc, char **argv)
   MPI_Init(&argc, &argv);
 
   // LIGGGHTS writes log.liggghts unless told otherwise: off by default, -log FILE to have one
-  std::vector<char *> args(argv, argv + argc);
+  // -resume FILE is fdmDEM's own (fix fdm/couple restores the particles from FILE); the rest is LIGGGHTS's
+  std::vector<char *> args(argv, argv + 1);
   bool haveLog = false;
-  for (int i = 1; i < argc; i++)
+  for (int i = 1; i < argc; i++) {
+    if (!std::strcmp(argv[i], "-resume")) {
+      if (i + 1 >= argc) {
+        std::fputs("fdmDEM: -resume needs the checkpoint file (fdmRun --resume finds it)\n", stderr);
+        MPI_Abort(MPI_COMM_WORLD, 2);
+      }
+      LAMMPS_NS::CouplingSession::instance().setResumeFile(argv[++i]);
+      continue;
+    }
     if (!std::strcmp(argv[i], "-log") || !std::strcmp(argv[i], "-l")) haveLog = true;
+    args.push_back(argv[i]);
+  }
   static char logFlag[] = "-log", logNone[] = "none";
   if (!haveLog) {
     args.push_back(logFlag);

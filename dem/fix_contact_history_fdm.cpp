@@ -21,3 +21,15 @@ void FixContactHistoryFdm::init()
   computeflag_ = &pair->computeflag;
   allocate_pages();
 }
+
+std::vector<double> FixContactHistoryFdm::packAtom(int i)
+{
+  std::vector<double> record(size_t(1 + npartner_[i] * (1 + dnum_)));
+  record.resize(size_t(pack_exchange(i, record.data())));
+  return record;
+}
+
+void FixContactHistoryFdm::restoreAtom(int i, const double *record)
+{
+  unpack_exchange(i, const_cast<double *>(record));
+}

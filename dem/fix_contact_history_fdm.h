@@ -12,12 +12,23 @@
 
 #include "fix_contact_history.h"
 
+#include <vector>
+
 namespace LAMMPS_NS {
 
 class FixContactHistoryFdm : public FixContactHistory {
  public:
   FixContactHistoryFdm(class LAMMPS *lmp, int narg, char **arg) : FixContactHistory(lmp, narg, arg) {}
   void init();
+
+  // Checkpoint and resume (fix fdm/couple): the contact history of owned atom i as LIGGGHTS
+  // migrates it between ranks (pack_exchange: partner count, then per partner its tag and the
+  // spring elongation), after copying the current history from the neighbour list to the atoms
+  // (syncFromNeighbourList, LIGGGHTS's own pre_exchange); and the reverse for a restored atom,
+  // before the neighbour list is built (it copies the atoms' history into the list).
+  void syncFromNeighbourList() { pre_exchange(); }
+  std::vector<double> packAtom(int i);
+  void restoreAtom(int i, const double *record);
 };
 
 }  // namespace LAMMPS_NS

@@ -13,6 +13,8 @@
 #include "force.h"
 #include "memory.h"
 #include "modify.h"
+#include "dump.h"
+#include "output.h"
 #include "update.h"
 
 #include <algorithm>
@@ -41,7 +43,7 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), pairBlocks_(0),
-  wallBlocks_(0), contacts_(0)
+  wallBlocks_(0), contacts_(0), checkpointEvery_(0), checkpointSeconds_(0), resumed_(false)
 {
   if (igroup != 0) error->all(FLERR, "fix fdm/couple must be applied to group all (every particle is in the fluid)");
   time_integrate = 1;
@@ -112,6 +114,10 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       if (v != "cg" && v != "ldlt") error->all(FLERR, "fix fdm/couple: solver must be cg or ldlt");
       directSolver_ = (v == "ldlt");
       i++;
+    } else if (key == "checkpoint") {
+      checkpointEvery_ = force->inumeric(FLERR, value(1));
+      if (checkpointEvery_ < 0) error->all(FLERR, "fix fdm/couple: checkpoint N needs N >= 0 steps (0: none)");
+      i++;
     } else if (key == "tolerance") {
       tolerance_ = force->numeric(FLERR, value(1));
       if (!(tolerance_ > 0 && tolerance_ < 1))
@@ -135,8 +141,10 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   if (!(options.connectTimeout > 0) || !(options.receiveTimeout > 0))
     error->all(FLERR, "fix fdm/couple: connect_timeout and timeout must be positive (seconds)");
   request.stresslets = stresslets_;
+  request.checkpointEvery = checkpointEvery_;
   hasFluid_ = options.transport != "none";
   session_.attach(this, request);
+  if (!session_.resumeFile().empty() && !session_.connected()) readResumeCheckpoint();
 }
 
 FixFdmCouple::~FixFdmCouple()
@@ -147,7 +155,8 @@ FixFdmCouple::~FixFdmCouple()
 
 int FixFdmCouple::setmask()
 {
-  return FixConst::INITIAL_INTEGRATE | FixConst::FINAL_INTEGRATE;
+  // PRE_EXCHANGE: a resumed run restores its checkpoint in setup_pre_exchange
+  return FixConst::INITIAL_INTEGRATE | FixConst::FINAL_INTEGRATE | FixConst::PRE_EXCHANGE;
 }
 
 void FixFdmCouple::init()
@@ -177,6 +186,13 @@ void FixFdmCouple::init()
   }
   if (!comm->ghost_velocity && comm->me == 0)
     error->warning(FLERR, "fix fdm/couple: 'communicate single vel yes' is needed by the lubrication pair styles");
+  // a resumed run continues the dumps of the interrupted one (fdmRun --resume cut them at the checkpoint)
+  if (resume_)
+    for (int i = 0; i < output->ndump; i++) {
+      char append[] = "append", yes[] = "yes";
+      char *args[] = {append, yes};
+      output->dump[i]->modify_params(2, args);
+    }
 }
 
 void FixFdmCouple::allAgree(const std::string &problemOnRank0)
@@ -350,6 +366,13 @@ void FixFdmCouple::setup(int)
   // Called before every run (not with 'run N pre no'): connect once, then check the particles
   // wherever the input has put them since (set atom ... between runs).
   const bool firstSetup = !session_.connected();
+  if (resume_ && update->laststep != resume_->lastStep)
+    allAgree(comm->me != 0 ? std::string() :
+             "resuming at step " + std::to_string(resume_->step) + " from " + resumeFile_ + ": the run it belongs "
+             "to ends at step " + std::to_string(resume_->lastStep) + " but this run command ends at step " +
+             std::to_string((long long) update->laststep) + ": write it 'run " + std::to_string(resume_->lastStep) +
+             " upto' (a resumed input runs to the same last step; docs/coupling.md)");
+  resume_.reset();
   // the count of init(): LIGGGHTS may have dropped an atom since, which gather() must name
   session_.ensureConnected(lmp, atomsAtInit_);
   natoms_ = session_.particles();
@@ -370,7 +393,8 @@ void FixFdmCouple::setup(int)
   // Overlaps are an input error in the configuration the input script gave (first run, or positions
   // set between runs of fixed particles); later runs continue from where contacts (h_r > 0, finite
   // kn) may legitimately have pressed particles a little into each other.
-  allAgree(comm->me == 0 ? checkConfiguration(particles, firstSetup || !move_) : std::string());
+  // (a resumed session continues a run: its particles may be pressed into contact like any later run's)
+  allAgree(comm->me == 0 ? checkConfiguration(particles, (firstSetup && !resumed_) || !move_) : std::string());
   // A planned position update continues the previous run only from where that run left the
   // particles: if the input has moved them since (set, displace_atoms, read_restart ...), the next
   // step starts afresh (Euler from the current velocities, then Adams-Bashforth again).
@@ -426,6 +450,7 @@ cpl::Step FixFdmCouple::makeStep(const std::vector<Particle> &particles) const
   step.step = update->ntimestep;
   step.dt = update->dt;
   step.lastStep = update->laststep;
+  step.checkpoint = checkpointDue();  // the fluid writes its own at the end of this step
   step.particles.resize(natoms_);
   const bool solved = currentVelocity_.size() == size_t(6) * natoms_;
   for (int p = 0; p < natoms_; p++) {
@@ -700,6 +725,7 @@ void FixFdmCouple::final_integrate()
   scatter();
   run_.gatherScatter += MPI_Wtime() - t0;
   run_.steps++;
+  if (checkpointDue()) writeCheckpoint();
 }
 
 void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
@@ -833,6 +859,9 @@ void FixFdmCouple::post_run()
   const double now = MPI_Wtime();
   session_.addRun(run_.steps, run_.solve, run_.exchange, run_.gatherScatter);
   printTiming("of this run", run_, now - runStart_, 1);
+  if (checkpointEvery_ > 0 && comm->me == 0 && screen)
+    fprintf(screen, "fdm/couple checkpoints: every %lld steps and at the end of the run, %.4g s of writing so far\n",
+            checkpointEvery_, checkpointSeconds_);
   notConverged_ = 0;
   // a following 'run N pre no' skips setup(): its timing starts here
   run_ = Timing();

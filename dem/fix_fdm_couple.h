@@ -4,7 +4,7 @@
      fix ID all fdm/couple [transport socket|file] [host H] [port P] [portfile F] [directory D]
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
                            [stresslets yes|no] [solver cg|ldlt] [tolerance t] [integrator ab2|euler]
-                           [gap_update log|none]
+                           [gap_update log|none] [checkpoint N]
      fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
@@ -29,6 +29,7 @@
 #include "fdm/coupler.h"
 #include "particle_velocity_system.h"
 #include "position_update.h"
+#include "particle_checkpoint.h"
 
 #include <memory>
 #include <string>
@@ -43,6 +44,7 @@ class FixFdmCouple : public Fix {
   int setmask();
   void init();
   void setup(int);
+  void setup_pre_exchange();
   void initial_integrate(int);
   void final_integrate();
   void post_run();
@@ -83,6 +85,11 @@ class FixFdmCouple : public Fix {
   void allAgree(const std::string &problemOnRank0);
   void fail(const std::string &message);
   void printTiming(const char *what, const Timing &t, double wall, int runs) const;
+  // Checkpoint and resume (fix_fdm_couple_checkpoint.cpp, docs/coupling.md)
+  bool checkpointDue() const;
+  void writeCheckpoint();
+  void readResumeCheckpoint();
+  void restoreCheckpoint();
 
   class CouplingSession &session_;  // the connection and what the fluid said (coupling_session.h)
   bool hasFluid_;                   // not transport none
@@ -120,6 +127,14 @@ class FixFdmCouple : public Fix {
   std::vector<double> subgrid_;    // 6N: F^SG, T^SG of the last step, by tag
   std::vector<double> stress_;     // 20N: S^h (6), s^h, S^c (6), S^SG (6), s^SG of the last step, by tag
   long solverIterations_, pairBlocks_, wallBlocks_, contacts_;
+
+  long long checkpointEvery_;      // checkpoint N: every N steps and at the end of each run (0: never)
+  double checkpointSeconds_;       // wall time spent writing checkpoints (rank 0's)
+  // fdmDEM -resume FILE: the checkpoint read by the constructor (every rank), restored before the
+  // first step (setup_pre_exchange), then released
+  std::unique_ptr<fdm::checkpoint::ParticleCheckpoint> resume_;
+  std::string resumeFile_;
+  bool resumed_;                   // this session continues a checkpoint (no overlap check at its start)
 };
 
 }  // namespace LAMMPS_NS

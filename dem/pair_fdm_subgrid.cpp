@@ -504,6 +504,11 @@ void PairFdmSubgrid::addContactStress(int i, const double force[3], const double
   }
 }
 
+FixContactHistoryFdm *PairFdmSubgrid::contactHistory() const
+{
+  return dynamic_cast<FixContactHistoryFdm *>(history_);
+}
+
 void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
                                 double force[3], double nxft[3]) const
 {

@@ -58,6 +58,9 @@ class PairFdmSubgrid : public Pair {
   bool contactActive() const { return hr_ > 0; }
   double roughness() const { return hr_; }
   const std::vector<Wall> &walls() const { return walls_; }
+  // The contact histories, for fix fdm/couple's checkpoints (null without contact, or without walls)
+  class FixContactHistoryFdm *contactHistory() const;
+  class FixPropertyAtom *wallHistory() const { return wallHistory_; }
   // Per-atom contact stresslet S^c (Eq. 52: xx xy xz yy yz zz) of the last compute, if requested.
   void requestContactStress(bool on) { contactStressRequested_ = on; }
   const double *contactStress(int i) const

@@ -207,7 +207,11 @@ def test_used_case_folder_needs_overwrite(tmp_path, env):
     assert "holds a previous run" in out and "--overwrite" in out and "fluid/2" in out, out
     proc = subprocess.run([FDMRUN, "--resume", root], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           text=True, env=env)
-    assert proc.returncode == 2 and "--resume is not implemented yet" in proc.stdout, proc.stdout
+    # a run without checkpoints (no 'checkpoint N' in fix fdm/couple) cannot be resumed: said so,
+    # and nothing is touched (test_resume.py resumes runs that have them)
+    assert proc.returncode == 2 and "has no checkpoint that both codes completed" in proc.stdout \
+        and "checkpoint N" in proc.stdout, proc.stdout
+    assert list(output.steps(fluid)["step"]) == list(first)
 
     proc = subprocess.run([FDMRUN, "--quiet", "--overwrite", root], stdout=subprocess.PIPE,
                           stderr=subprocess.STDOUT, text=True, env=env, timeout=60)

@@ -146,9 +146,10 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
             + (output.dump_custom_command("particles", dump_every, "particles.dump") if text_dump else [])
             + ["thermo_style    custom step f_couple[1] f_couple[2] f_couple[6] f_couple[7] f_couple[8]",
                "thermo          %d" % dump_every,
-               "run             %d" % steps])
+               "run             %d upto" % steps])   # upto: a resumed run ends at the same step
+    # a checkpoint every 10 snapshots and at the end: fdmRun --resume continues a killed run (docs/coupling.md)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
-                         fix_options="stresslets yes", runs=runs, name="in.couette")
+                         fix_options="stresslets yes checkpoint %d" % (10 * dump_every), runs=runs, name="in.couette")
     return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
                 wall_velocity=U, dt=dt, dump_every=dump_every, write_every=write_every)
 

@@ -105,6 +105,14 @@ ForceTorque getForce(const double* r, int F, int T)
     return f;
 }
 
+// An optional whole-number text entry (checkpoint and resume keys, which older peers of protocol 3
+// do not send): its value, or `absent`.
+long long optionalCount(const Message& m, const std::string& key, long long absent)
+{
+    if (m.text.find(key + "=") == std::string::npos) return absent;
+    return std::llround(m.textNumber(key));
+}
+
 const char* faceName(int f)
 {
     static const char* names[layout::nFaces] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
@@ -120,7 +128,8 @@ Message DemHello::toMessage() const
     using namespace layout;
     Message m = makeMessage(MessageType::Hello, 0, 0, 1, helloDemWidth,
                             "role=dem version=" + std::to_string(version) + " dt=" + tenDigits(dt) +
-                            " lastStep=" + std::to_string(lastStep) + " stresslets=" + (stresslets ? "1" : "0"));
+                            " lastStep=" + std::to_string(lastStep) + " stresslets=" + (stresslets ? "1" : "0") +
+                            " resume=" + std::to_string(resumeStep) + " checkpoint=" + std::to_string(checkpointEvery));
     double* r = &m.data[0];
     r[hdNParticles] = double(nParticles);
     for (int d = 0; d < 3; ++d) {
@@ -139,6 +148,8 @@ DemHello DemHello::fromMessage(const Message& m)
     DemHello h;
     h.dt = m.textNumber("dt");
     h.lastStep = std::llround(m.textNumber("lastStep"));
+    h.resumeStep = optionalCount(m, "resume", 0);
+    h.checkpointEvery = optionalCount(m, "checkpoint", 0);
     // protocol 2 on: the DEM side always says whether StepDone carries stresslets
     std::string value;
     try {
@@ -163,7 +174,7 @@ Message FluidHello::toMessage() const
 {
     using namespace layout;
     Message m = makeMessage(MessageType::Hello, 0, 0, 1, helloFluidWidth,
-                            "role=fluid version=" + std::to_string(version));
+                            "role=fluid version=" + std::to_string(version) + " resume=" + std::to_string(resumeStep));
     double* r = &m.data[0];
     r[hfNParticles] = double(nParticlesExpected);
     r[hfAlphaLambda] = alphaLambda;
@@ -191,6 +202,7 @@ FluidHello FluidHello::fromMessage(const Message& m)
     expectShape(m, MessageType::Hello, "Hello of the fluid solver", helloFluidWidth, 1, "");
     expectVersion(m, "Hello of the fluid solver");
     FluidHello h;
+    h.resumeStep = optionalCount(m, "resume", 0);
     const double* r = &m.data[0];
     h.nParticlesExpected = std::llround(r[hfNParticles]);
     h.alphaLambda = r[hfAlphaLambda];
@@ -220,7 +232,8 @@ Message Step::toMessage() const
 {
     using namespace layout;
     Message m = makeMessage(MessageType::Step, step, 0, uint32_t(particles.size()), stepWidth,
-                            "dt=" + tenDigits(dt) + " lastStep=" + std::to_string(lastStep));
+                            "dt=" + tenDigits(dt) + " lastStep=" + std::to_string(lastStep) +
+                            (checkpoint ? " checkpoint=1" : ""));
     for (size_t p = 0; p < particles.size(); ++p) {
         const StepParticle& q = particles[p];
         double* r = &m.data[p * stepWidth];
@@ -240,6 +253,7 @@ Step Step::fromMessage(const Message& m, long expectedCount)
     s.step = m.step;
     s.dt = m.textNumber("dt");
     s.lastStep = std::llround(m.textNumber("lastStep"));
+    s.checkpoint = optionalCount(m, "checkpoint", 0) != 0;
     s.particles.resize(m.count);
     for (size_t p = 0; p < s.particles.size(); ++p) {
         const double* r = &m.data[p * stepWidth];

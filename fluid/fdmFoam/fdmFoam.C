@@ -22,6 +22,8 @@ Usage
     fdmFoam [-parallel] [-case dir]   (start it before fdmDEM; see scripts/fdmRun)
     fdmFoam -postProcess [-func name] [-latestTime]   (function objects on a
         finished case; those of system/controlDict also run during a run)
+    fdmFoam -resume STEP   (continue from the checkpoint of DEM step STEP,
+        checkpoint/fluid.STEP, with fdmDEM -resume; fdmRun --resume does both)
 
 \*---------------------------------------------------------------------------*/
 
@@ -34,6 +36,7 @@ Usage
 #include "fluidCoupling.H"
 #include "andersonAcceleration.H"
 #include "innerConvergence.H"
+#include "fluidCheckpoint.H"
 #include <chrono>
 
 namespace
@@ -55,6 +58,13 @@ int main(int argc, char *argv[])
         " the particle code fdmDEM (LIGGGHTS) through the fdm coupler."
     );
 
+    argList::addOption
+    (
+        "resume", "step",
+        "continue from the checkpoint of this DEM step (checkpoint/fluid.<step>;"
+        " fdmRun --resume)"
+    );
+
     // fdmFoam -postProcess -func ...: the function objects on a finished case
     // (createFields.H needs the PISO controls, not fdmProperties)
     #define CREATE_CONTROL createPisoControl.H
@@ -65,6 +75,9 @@ int main(int argc, char *argv[])
     #include "createMesh.H"
 
     pisoControl piso(mesh);
+
+    // -resume STEP: the time of the checkpoint, before the fields are read
+    #include "resumeCheckpoint.H"
 
     #include "createFields.H"
     #include "readFdmProperties.H"
@@ -78,7 +91,8 @@ int main(int argc, char *argv[])
     coupling.handshake
     (
         grid, U, nParticlesExpected, alphaLambda, rho.value(),
-        rho.value()*nu.value()      // eta
+        rho.value()*nu.value(),     // eta
+        label(resumed.step)
     );
 
     #include "createOutput.H"
@@ -91,8 +105,11 @@ int main(int argc, char *argv[])
     innerConvergence convergence;
     scalarList radii;
 
-    scalar fluidTime = 0, particleTime = 0, outputTime = 0;
+    scalar fluidTime = 0, particleTime = 0, outputTime = 0, checkpointTime = 0;
     label nStepsDone = 0, nInnerTotal = 0;
+    // steps of the run before this session (a resumed run continues its count)
+    const label stepsBefore = label(resumed.stepsDone);
+    label lastCheckpoint = -1;
     const double runStart = wallClock();
     // waiting for the particle code to connect is not part of the run
     const scalar exchangeBeforeRun = coupling.exchangeTime();
@@ -126,7 +143,7 @@ int main(int argc, char *argv[])
         forcing.pseudoTimeCoefficient(rDTau, rDTauInside, rDTauOutside);
         stepParticleTime += wallClock() - stepStart;
 
-        const bool firstStep = (nStepsDone == 0);
+        const bool firstStep = (stepsBefore + nStepsDone == 0);
         const label nMax = firstStep ? nInnerMaxFirst : nInnerMax;
         convergence.reset
         (
@@ -248,6 +265,14 @@ int main(int argc, char *argv[])
         runTime.functionObjects().execute();
         outputTime += wallClock() - tOut;
 
+        if (coupling.checkpoint())
+        {
+            const double tCheckpoint = wallClock();
+            #include "writeCheckpoint.H"
+            checkpointTime += wallClock() - tCheckpoint;
+            lastCheckpoint = coupling.step();
+        }
+
         ++nStepsDone;
         nInnerTotal += innerIteration;
         fluidTime += stepFluidTime;
@@ -275,9 +300,17 @@ int main(int argc, char *argv[])
         }
     }
 
-    // Final state, so that a run can be restarted from it
+    // Final state, so that a run can be restarted from it (unless the last
+    // step's checkpoint holds it: its binary fields stay as they are)
     forcing.indicator(particleIndicator);
-    runTime.writeNow();
+    if (lastCheckpoint >= 0 && lastCheckpoint == coupling.step())
+    {
+        particleIndicator.write();
+    }
+    else
+    {
+        runTime.writeNow();
+    }
     runTime.functionObjects().end();
 
     const scalar total = wallClock() - runStart;
@@ -288,8 +321,14 @@ int main(int argc, char *argv[])
         << "    fluid solve      " << fluidTime << " s (" << pct(fluidTime) << " %)" << nl
         << "    particle forcing " << particleTime << " s (" << pct(particleTime) << " %)" << nl
         << "    exchange + DEM   " << exchange << " s (" << pct(exchange) << " %)" << nl
-        << "    output           " << outputTime << " s (" << pct(outputTime) << " %)" << nl
-        << endl;
+        << "    output           " << outputTime << " s (" << pct(outputTime) << " %)" << nl;
+    if (coupling.checkpointEvery() > 0)
+    {
+        Info<< "    checkpoints      " << checkpointTime << " s ("
+            << pct(checkpointTime) << " %; every "
+            << coupling.checkpointEvery() << " steps and at the end)" << nl;
+    }
+    Info<< endl;
 
     Info<< "End\n" << endl;
     return 0;

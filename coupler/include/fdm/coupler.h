@@ -156,6 +156,11 @@ struct DemHello {
     double dt = 0;             // DEM time step [s] (sent with 10 significant digits)
     long long lastStep = 0;    // last step of the current run
     bool stresslets = false;   // StepDone must carry the FDM stresslets
+    // Checkpoint and resume (docs/coupling.md, "Checkpoint and resume"); optional text entries,
+    // 0 when absent: the step both codes resume from (0: a fresh start), and the checkpoint
+    // interval of fix fdm/couple (0: none; for the fluid's log only, each Step says when)
+    long long resumeStep = 0;
+    long long checkpointEvery = 0;
     long long nParticles = 0;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the box [m]
     bool periodic[3] = {false, false, false};
@@ -182,6 +187,7 @@ struct FluidHello {
     bool periodic[3] = {false, false, false};
     double viscosity = 0;                      // eta = rho_f nu [Pa s]
     BoxFace faces[layout::nFaces];             // xlo, xhi, ylo, yhi, zlo, zhi
+    long long resumeStep = 0;                  // the checkpoint step the fluid resumes from (0: fresh)
 
     Message toMessage() const;
     static FluidHello fromMessage(const Message& m);
@@ -210,6 +216,7 @@ struct Step {
     uint64_t step = 0;
     double dt = 0;                             // [s] (sent with 10 significant digits)
     long long lastStep = 0;
+    bool checkpoint = false;                   // both codes write a checkpoint at the end of this step
     std::vector<StepParticle> particles;
 
     Message toMessage() const;

@@ -31,7 +31,9 @@ Foam::fluidCoupling::fluidCoupling(const Time& runTime, const dictionary& dict)
     dt_(0),
     nParticles_(0),
     stresslets_(false),
-    volumesSent_(false)
+    volumesSent_(false),
+    checkpoint_(false),
+    checkpointEvery_(0)
 {
     if (!Pstream::master())
     {
@@ -234,7 +236,8 @@ void Foam::fluidCoupling::handshake
     label nParticlesExpected,
     scalar alphaLambda,
     scalar rhoFluid,
-    scalar eta
+    scalar eta,
+    label resumeStep
 )
 {
     namespace layout = cpl::layout;
@@ -305,6 +308,22 @@ void Foam::fluidCoupling::handshake
                         + Foam::name(nParticles_);
                 }
                 stresslets = hello.stresslets ? 1 : 0;
+                checkpointEvery_ = label(hello.checkpointEvery);
+                if (problem.empty() && label(hello.resumeStep) != resumeStep)
+                {
+                    problem = resumeStep > 0
+                      ? "fdmFoam resumes from its checkpoint of step "
+                        + Foam::name(resumeStep) + " (checkpoint/fluid."
+                        + Foam::name(resumeStep) + ") but fdmDEM "
+                        + (hello.resumeStep > 0
+                           ? "from step " + Foam::name(label(hello.resumeStep))
+                           : string("starts afresh"))
+                      : "fdmDEM resumes from its checkpoint of step "
+                        + Foam::name(label(hello.resumeStep))
+                        + " but fdmFoam starts afresh";
+                    problem += ": both codes must resume the same step"
+                        " (fdmRun --resume picks the newest both have)";
+                }
             }
             if (problem.empty())
             {
@@ -326,6 +345,7 @@ void Foam::fluidCoupling::handshake
                     reply.periodic[d] = grid.periodic()[d];
                 }
                 reply.viscosity = eta;
+                reply.resumeStep = resumeStep;
                 for (label f = 0; f < label(layout::nFaces); ++f)
                 {
                     reply.faces[f] = faces[f];
@@ -347,6 +367,7 @@ void Foam::fluidCoupling::handshake
     }
     Pstream::scatter(nParticles_);
     Pstream::scatter(stresslets);
+    Pstream::scatter(checkpointEvery_);
     stresslets_ = stresslets != 0;
 
     Info<< "Coupled with fdmDEM: " << nParticles_ << " particles, "
@@ -453,6 +474,7 @@ bool Foam::fluidCoupling::receiveStep(List<fdmParticle>& particles)
     step_ = label(step.step);
     dt_ = step.dt;
     lastStep_ = label(step.lastStep);
+    checkpoint_ = step.checkpoint;
     particles.setSize(step.particles.size());
     forAll(particles, p)
     {

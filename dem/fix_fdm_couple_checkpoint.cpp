@@ -1,0 +1,269 @@
+// fix fdm/couple: checkpoint and resume (docs/coupling.md, "Checkpoint and resume").
+//
+// With `checkpoint N` the fix writes checkpoint/dem.<step> (in fdmDEM's working directory) at the end
+// of every N-th step and of the last step of each run, and tells fdmFoam in that step's Step message
+// to write its own (fields, lambda) at the same step. `fdmDEM -resume FILE` (fdmRun --resume) reads
+// one back: the constructor of the fix sets the time step to the checkpoint's, so that the input's
+// `run L upto` continues to the same last step; before the first step (setup_pre_exchange, i.e.
+// before LIGGGHTS wraps, migrates and lists the atoms) every rank restores its particles, their contact
+// history and the position update's history, so that the next step is the one the interrupted run
+// would have made. The file itself (atomic write, layout, checks) is particle_checkpoint.h.
+#include "fix_fdm_couple.h"
+
+#include "coupling_session.h"
+#include "fix_contact_history_fdm.h"
+#include "message_text.h"
+#include "pair_fdm_subgrid.h"
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "fix_property_atom.h"
+#include "update.h"
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace LAMMPS_NS;
+namespace ckpt = fdm::checkpoint;
+
+namespace {
+
+const char *directory = "checkpoint";
+const char *prefix = "dem.";
+// per particle in the array "atoms": x (3), v (3), omega (3), image, radius, mass, density, type
+const int atomWidth = 14;
+
+// Every rank's records [tag, count, values...] on rank 0, by tag: values[tag - 1].
+std::vector<std::vector<double> > gatherByTag(const std::vector<double> &local, int natoms, MPI_Comm world, int me,
+                                              int nprocs)
+{
+  const int count = int(local.size());
+  std::vector<int> counts(nprocs), displs(nprocs);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  std::vector<double> all;
+  if (me == 0) {
+    int total = 0;
+    for (int p = 0; p < nprocs; p++) { displs[p] = total; total += counts[p]; }
+    all.resize(size_t(total));
+  }
+  MPI_Gatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+  std::vector<std::vector<double> > byTag(me == 0 ? size_t(natoms) : 0);
+  for (size_t k = 0; k + 1 < all.size();) {
+    const long tag = std::lround(all[k]);
+    const size_t n = size_t(std::lround(all[k + 1]));
+    if (tag >= 1 && tag <= natoms) byTag[tag - 1].assign(all.begin() + long(k + 2), all.begin() + long(k + 2 + n));
+    k += 2 + n;
+  }
+  return byTag;
+}
+
+}  // namespace
+
+bool FixFdmCouple::checkpointDue() const
+{
+  return checkpointEvery_ > 0 && update->ntimestep > 0 &&
+         (update->ntimestep % checkpointEvery_ == 0 || update->ntimestep == update->laststep);
+}
+
+void FixFdmCouple::writeCheckpoint()
+{
+  // every rank: its particles, their contact history; rank 0 adds the fix's own state and writes
+  const double t0 = MPI_Wtime();
+  FixContactHistoryFdm *history = pair_ ? pair_->contactHistory() : nullptr;
+  FixPropertyAtom *wallHistory = pair_ ? pair_->wallHistory() : nullptr;
+  const int wallWidth = wallHistory ? 3 * int(pair_->walls().size()) : 0;
+  // the history of this step is in the neighbour list; LIGGGHTS copies it to the atoms only
+  // before atoms migrate: do it now (idempotent, as at every re-neighbouring)
+  if (history) history->syncFromNeighbourList();
+
+  std::vector<double> atoms, contacts, walls;
+  for (int i = 0; i < atom->nlocal; i++) {
+    const double tag = atom->tag[i];
+    atoms.insert(atoms.end(), {tag, double(atomWidth)});
+    for (int d = 0; d < 3; d++) atoms.push_back(atom->x[i][d]);
+    for (int d = 0; d < 3; d++) atoms.push_back(atom->v[i][d]);
+    for (int d = 0; d < 3; d++) atoms.push_back(atom->omega[i][d]);
+    atoms.push_back(double(atom->image[i]));
+    atoms.insert(atoms.end(), {atom->radius[i], atom->rmass[i], atom->density[i], double(atom->type[i])});
+    if (history) {
+      const std::vector<double> record = history->packAtom(i);
+      contacts.insert(contacts.end(), {tag, double(record.size())});
+      contacts.insert(contacts.end(), record.begin(), record.end());
+    }
+    if (wallWidth) {
+      walls.insert(walls.end(), {tag, double(wallWidth)});
+      for (int k = 0; k < wallWidth; k++) walls.push_back(wallHistory->array_atom[i][k]);
+    }
+  }
+  const auto atomsByTag = gatherByTag(atoms, natoms_, world, comm->me, comm->nprocs);
+  const auto contactsByTag = gatherByTag(contacts, natoms_, world, comm->me, comm->nprocs);
+  const auto wallsByTag = gatherByTag(walls, natoms_, world, comm->me, comm->nprocs);
+
+  std::string problem;
+  if (comm->me == 0) {
+    ckpt::ParticleCheckpoint c;
+    c.step = update->ntimestep;
+    c.lastStep = update->laststep;
+    c.natoms = natoms_;
+    c.dt = update->dt;
+    for (int d = 0; d < 3; d++) {
+      c.boxlo[d] = domain->boxlo[d];
+      c.boxhi[d] = domain->boxhi[d];
+    }
+    std::vector<double> &a = c.arrays["atoms"];
+    std::vector<double> &lengths = c.arrays["contactHistoryLength"];
+    std::vector<double> &records = c.arrays["contactHistory"];
+    std::vector<double> &wallValues = c.arrays["wallHistory"];
+    for (int t = 0; t < natoms_; t++) {
+      a.insert(a.end(), atomsByTag[t].begin(), atomsByTag[t].end());
+      if (history) {
+        lengths.push_back(double(contactsByTag[t].size()));
+        records.insert(records.end(), contactsByTag[t].begin(), contactsByTag[t].end());
+      }
+      if (wallWidth) wallValues.insert(wallValues.end(), wallsByTag[t].begin(), wallsByTag[t].end());
+    }
+    // the position update's history (U_n, U_{n-1}, x_n, the planned rates) and the last outputs
+    c.arrays["state"] = {havePlan_ ? 1.0 : 0.0, haveVelocities_ ? 1.0 : 0.0, double(lastIterations_), lastResidual_,
+                         adamsBashforth_ ? 1.0 : 0.0, gapUpdate_ ? 1.0 : 0.0, double(wallWidth)};
+    c.arrays["currentVelocity"] = currentVelocity_;
+    c.arrays["previousVelocity"] = previousVelocity_;
+    c.arrays["moveRate"] = havePlan_ ? moveRate_ : std::vector<double>();
+    c.arrays["planPositions"] = havePlan_ ? planPositions_ : std::vector<double>();
+    c.arrays["solution"] = solution_;
+    c.arrays["hydro"] = hydro_;
+    c.arrays["subgrid"] = subgrid_;
+    c.arrays["fluidStress"] = fluidStress_;
+    c.arrays["stress"] = stress_;
+    const std::string file = std::string(directory) + "/" + prefix + std::to_string((long long) c.step);
+    try {
+      ::mkdir(directory, 0755);
+      ckpt::writeAtomically(file, ckpt::encode(c));
+      // the previous one stays until this one is complete, and is kept: the fluid's checkpoint of
+      // this step may be the one a kill interrupted (fdmRun --resume takes the newest step both have)
+      ckpt::prune(directory, prefix, c.step, 2);
+    } catch (const ckpt::CheckpointError &e) {
+      problem = std::string("checkpoint of step ") + std::to_string((long long) c.step) + ": " + e.what();
+    }
+    checkpointSeconds_ += MPI_Wtime() - t0;
+  }
+  if (!problem.empty()) fail(problem);
+  MPI_Barrier(world);
+}
+
+void FixFdmCouple::readResumeCheckpoint()
+{
+  // every rank reads rank 0's bytes of the file; checks it belongs to this scene; sets the time step
+  resumeFile_ = session_.resumeFile();
+  std::vector<char> bytes;
+  std::string problem;
+  if (comm->me == 0) {
+    try {
+      bytes = ckpt::readFile(resumeFile_);
+    } catch (const ckpt::CheckpointError &e) {
+      problem = e.what();
+    }
+  }
+  long long size = (long long) bytes.size();
+  MPI_Bcast(&size, 1, MPI_LONG_LONG, 0, world);
+  bytes.resize(size_t(size));
+  MPI_Bcast(bytes.data(), int(size), MPI_CHAR, 0, world);
+  ckpt::ParticleCheckpoint c;
+  if (problem.empty()) {
+    try {
+      c = ckpt::decode(bytes, resumeFile_);
+      c.array("atoms", (long long) atomWidth * c.natoms, resumeFile_);
+    } catch (const ckpt::CheckpointError &e) {
+      problem = e.what();
+    }
+  }
+  const std::string other = resumeFile_ + " is from another scene: ";
+  if (problem.empty() && c.natoms != (long long) atom->natoms)
+    problem = other + "it holds " + std::to_string(c.natoms) + " particles, the LIGGGHTS input has " +
+              std::to_string((long long) atom->natoms);
+  for (int d = 0; d < 3 && problem.empty(); d++)
+    if (std::fabs(c.boxlo[d] - domain->boxlo[d]) + std::fabs(c.boxhi[d] - domain->boxhi[d]) >
+        1e-12 * (domain->boxhi[d] - domain->boxlo[d]))
+      problem = other + "its box spans " + fdm::text::number(c.boxlo[d]) + " .. " + fdm::text::number(c.boxhi[d]) +
+                " in " + "xyz"[d] + ", the LIGGGHTS input's " + fdm::text::number(domain->boxlo[d]) + " .. " +
+                fdm::text::number(domain->boxhi[d]);
+  if (problem.empty() && c.dt != update->dt)
+    problem = resumeFile_ + " was written with the time step " + fdm::text::number(c.dt) + " s but the input's is " +
+              fdm::text::number(update->dt) + " s: a resumed run must take the same steps";
+  // the particles the input created must be those of the checkpoint (radius, density by ID)
+  long long firstBad = std::numeric_limits<long long>::max();
+  if (problem.empty()) {
+    const std::vector<double> &a = c.arrays.at("atoms");
+    for (int i = 0; i < atom->nlocal; i++) {
+      const double *r = &a[size_t(atomWidth) * (atom->tag[i] - 1)];
+      if (r[10] != atom->radius[i] || r[12] != atom->density[i]) firstBad = std::min(firstBad, (long long) atom->tag[i]);
+    }
+  }
+  long long bad = firstBad;
+  MPI_Allreduce(&firstBad, &bad, 1, MPI_LONG_LONG, MPI_MIN, world);
+  if (problem.empty() && bad != std::numeric_limits<long long>::max()) {
+    const double *r = &c.arrays.at("atoms")[size_t(atomWidth) * (bad - 1)];
+    problem = other + "particle " + std::to_string(bad) + " has radius " + fdm::text::number(r[10]) + " and density " +
+              fdm::text::number(r[12]) + " there but not in the LIGGGHTS input";
+  }
+  if (!problem.empty()) error->all(FLERR, ("fdm/couple: cannot resume: " + problem).c_str());
+
+  update->reset_timestep(bigint(c.step));
+  session_.setResumeStep(c.step);
+  resumed_ = true;
+  resume_.reset(new ckpt::ParticleCheckpoint(std::move(c)));
+  if (comm->me == 0 && screen)
+    fprintf(screen, "fdm/couple: resuming from %s (step %lld of a run to step %lld)\n", resumeFile_.c_str(),
+            resume_->step, resume_->lastStep);
+}
+
+void FixFdmCouple::setup_pre_exchange()
+{
+  if (resume_) restoreCheckpoint();
+}
+
+void FixFdmCouple::restoreCheckpoint()
+{
+  // every rank, its own atoms (LIGGGHTS then wraps, migrates and lists them); rank 0, the fix's state
+  const ckpt::ParticleCheckpoint &c = *resume_;
+  const std::vector<double> &a = c.arrays.at("atoms");
+  const std::vector<double> &state = c.array("state", 7, resumeFile_);
+  const int wallWidth = int(state[6]);
+  FixContactHistoryFdm *history = pair_ ? pair_->contactHistory() : nullptr;
+  FixPropertyAtom *wallHistory = pair_ ? pair_->wallHistory() : nullptr;
+  const std::vector<double> &lengths = c.arrays.at("contactHistoryLength");
+  if ((history != nullptr) != !lengths.empty() || (wallHistory ? 3 * int(pair_->walls().size()) : 0) != wallWidth)
+    error->all(FLERR, ("fdm/couple: cannot resume: " + resumeFile_ + " was written " +
+                       (lengths.empty() ? "without" : "with") + " contact and with " + std::to_string(wallWidth / 3) +
+                       " walls, the input's pair_style differs").c_str());
+  std::vector<size_t> offset(size_t(c.natoms) + 1, 0);
+  for (size_t t = 0; t < lengths.size(); t++) offset[t + 1] = offset[t] + size_t(lengths[t]);
+  for (int i = 0; i < atom->nlocal; i++) {
+    const long t = atom->tag[i] - 1;
+    const double *r = &a[size_t(atomWidth) * t];
+    for (int d = 0; d < 3; d++) {
+      atom->x[i][d] = r[d];
+      atom->v[i][d] = r[3 + d];
+      atom->omega[i][d] = r[6 + d];
+    }
+    atom->image[i] = tagint(std::llround(r[9]));
+    if (history) history->restoreAtom(i, &c.arrays.at("contactHistory")[offset[t]]);
+    for (int k = 0; k < wallWidth; k++) wallHistory->array_atom[i][k] = c.arrays.at("wallHistory")[size_t(wallWidth) * t + k];
+  }
+  havePlan_ = state[0] != 0;
+  haveVelocities_ = state[1] != 0;
+  lastIterations_ = int(state[2]);
+  lastResidual_ = state[3];
+  currentVelocity_ = c.arrays.at("currentVelocity");
+  previousVelocity_ = c.arrays.at("previousVelocity");
+  moveRate_ = c.arrays.at("moveRate");
+  planPositions_ = c.arrays.at("planPositions");
+  solution_ = c.arrays.at("solution");
+  hydro_ = c.arrays.at("hydro");
+  subgrid_ = c.arrays.at("subgrid");
+  fluidStress_ = c.arrays.at("fluidStress");
+  stress_ = c.arrays.at("stress");
+}

@@ -1,0 +1,277 @@
+"""Checkpoints of a coupled run and what `fdmRun --resume` does with them (docs/coupling.md,
+"Checkpoint and resume").
+
+fdmFoam writes CASE/fluid/checkpoint/fluid.<step> (a text marker; the binary fields are in the
+step's time directory), fdmDEM CASE/dem/checkpoint/dem.<step> (one binary file, layout in
+dem/particle_checkpoint.h). Both are written to a temporary name and renamed once complete, and
+each code keeps its two newest.
+
+    python3 -m fdm.checkpoint select CASE        the newest step both codes have complete (prints it;
+                                                 says on stderr which newer ones were passed over and why)
+    python3 -m fdm.checkpoint truncate CASE STEP cut every record at STEP: fdmFoam's steps.dat and
+                                                 particles.dat and the function objects' records keep
+                                                 the steps up to STEP, the DEM's dumps the frames before
+                                                 STEP (the resumed run writes STEP's frame again), and
+                                                 time directories and checkpoints after STEP go
+"""
+import os
+import re
+import shutil
+import sys
+import zlib
+
+DEM_MAGIC = b"FDM-DEM-CHECKPOINT 1\n"
+DEM_TRAILER = b"end FDM-DEM-CHECKPOINT\n"
+FLUID_KEYS = ("step", "time", "timeIndex", "timeName", "stepsDone", "cells", "processors", "particles")
+
+
+class CheckpointError(Exception):
+    pass
+
+
+def _steps(directory, prefix):
+    out = []
+    if os.path.isdir(directory):
+        for name in os.listdir(directory):
+            m = re.fullmatch(re.escape(prefix) + r"(\d+)", name)
+            if m:
+                out.append(int(m.group(1)))
+    return sorted(out)
+
+
+def dem_file(case_dir, step):
+    return os.path.join(case_dir, "dem", "checkpoint", "dem.%d" % step)
+
+
+def fluid_marker(case_dir, step):
+    return os.path.join(case_dir, "fluid", "checkpoint", "fluid.%d" % step)
+
+
+def dem_problem(path):
+    """None if the particle checkpoint at path is complete and intact, else what is wrong."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError as e:
+        return "cannot be read (%s)" % e.strerror
+    if not data.startswith(DEM_MAGIC):
+        return "is not a particle checkpoint of fdmDEM"
+    lines, pos = [], len(DEM_MAGIC)
+    while True:
+        end = data.find(b"\n", pos)
+        if end < 0:
+            return "is truncated inside its header (%d bytes)" % len(data)
+        line = data[pos:end].decode(errors="replace")
+        pos = end + 1
+        if line.startswith("data "):
+            m = re.fullmatch(r"data (\d+) crc32=(\d+)", line)
+            if not m:
+                return "has a damaged header line %r" % line
+            size, crc = int(m.group(1)), int(m.group(2))
+            break
+        lines.append(line)
+    expected = pos + size + len(DEM_TRAILER)
+    if len(data) < expected:
+        return "is truncated: %d bytes where its header says %d" % (len(data), expected)
+    if data[pos + size:] != DEM_TRAILER:
+        return "is damaged: no end line after its data"
+    if zlib.crc32(data[pos:pos + size]) != crc:
+        return "is damaged: the CRC-32 of its data differs from the one written with it"
+    return None
+
+
+def read_fluid_marker(path):
+    """The entries of a fluid checkpoint marker as a dict; CheckpointError if it is incomplete."""
+    try:
+        with open(path) as f:
+            words = [line.split() for line in f if line.strip() and not line.startswith("#")]
+    except OSError as e:
+        raise CheckpointError("%s cannot be read (%s)" % (path, e.strerror))
+    entries = {w[0]: w[1] for w in words if len(w) == 2}
+    if not words or words[-1] != ["end"] or any(k not in entries for k in FLUID_KEYS):
+        raise CheckpointError("%s is not a complete fdmFoam checkpoint marker" % path)
+    return entries
+
+
+def fluid_problem(case_dir, step):
+    """None if fdmFoam's checkpoint of step is complete (marker and field files), else what is wrong."""
+    try:
+        m = read_fluid_marker(fluid_marker(case_dir, step))
+    except CheckpointError as e:
+        return str(e)
+    fluid = os.path.join(case_dir, "fluid")
+    procs = int(m["processors"])
+    dirs = [os.path.join(fluid, m["timeName"])] if procs == 1 else \
+        [os.path.join(fluid, "processor%d" % p, m["timeName"]) for p in range(procs)]
+    for d in dirs:
+        for field in ("U", "p", "lambda"):
+            if not os.path.isfile(os.path.join(d, field)) or os.path.getsize(os.path.join(d, field)) == 0:
+                return "its field %s is missing or empty in %s" % (field, os.path.relpath(d, case_dir))
+    return None
+
+
+def select(case_dir):
+    """(step, notes): the newest step whose checkpoints of both codes are complete, and why newer ones
+    were passed over. CheckpointError if there is none."""
+    fluid_steps = _steps(os.path.join(case_dir, "fluid", "checkpoint"), "fluid.")
+    dem_steps = _steps(os.path.join(case_dir, "dem", "checkpoint"), "dem.")
+    notes = []
+    for step in sorted(set(fluid_steps) | set(dem_steps), reverse=True):
+        problems = []
+        if step not in dem_steps:
+            problems.append("fdmDEM has no checkpoint of it (killed before or while writing it?)")
+        else:
+            p = dem_problem(dem_file(case_dir, step))
+            if p:
+                problems.append("dem/checkpoint/dem.%d %s" % (step, p))
+        if step not in fluid_steps:
+            problems.append("fdmFoam has no checkpoint of it (killed before or while writing it?)")
+        else:
+            p = fluid_problem(case_dir, step)
+            if p:
+                problems.append("fdmFoam's checkpoint: %s" % p)
+        if not problems:
+            return step, notes
+        notes.append("step %d passed over: %s" % (step, "; ".join(problems)))
+    raise CheckpointError("%s has no checkpoint that both codes completed%s: was the run started with "
+                          "'checkpoint N' in fix fdm/couple? (docs/coupling.md)"
+                          % (case_dir, " (" + "; ".join(notes) + ")" if notes else ""))
+
+
+def _is_time(name):
+    try:
+        float(name)
+        return True
+    except ValueError:
+        return False
+
+
+def _cut_lines(path, keep):
+    """Keep the comment lines and the complete lines whose first number passes keep(value)."""
+    with open(path) as f:
+        text = f.read()
+    lines = text.splitlines(keepends=True)
+    if lines and not lines[-1].endswith("\n"):
+        lines = lines[:-1]  # cut by the kill
+    out, dropped = [], 0
+    for line in lines:
+        words = line.split()
+        if not words or line.lstrip().startswith("#"):
+            out.append(line)
+            continue
+        try:
+            value = float(words[0])
+        except ValueError:
+            out.append(line)
+            continue
+        if keep(value):
+            out.append(line)
+        else:
+            dropped += 1
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.writelines(out)
+    os.replace(tmp, path)
+    return dropped
+
+
+def _cut_dump(path, step):
+    """Keep the frames of a LIGGGHTS text dump before `step`; returns the frames dropped."""
+    with open(path, "rb") as f:
+        data = f.read()
+    starts = [m.start() for m in re.finditer(rb"^ITEM: TIMESTEP\n", data, re.M)]
+    keep_to, dropped = len(data), 0
+    for s in starts:
+        end = data.find(b"\n", s + 15)
+        try:
+            frame_step = int(data[s + 15:end])
+        except ValueError:
+            frame_step = step
+        if frame_step >= step:
+            keep_to = min(keep_to, s)
+            dropped += 1
+    if keep_to < len(data):
+        tmp = path + ".tmp"
+        with open(tmp, "wb") as f:
+            f.write(data[:keep_to])
+        os.replace(tmp, path)
+    return dropped
+
+
+def truncate(case_dir, step):
+    """Cut every record of the run at the checkpoint `step` (module docstring); returns a summary."""
+    fluid = os.path.join(case_dir, "fluid")
+    marker = read_fluid_marker(fluid_marker(case_dir, step))
+    t_step = float(marker["time"])
+    eps = 1e-9 * max(abs(t_step), 1e-300)
+    summary = []
+    # fdmFoam's records: by DEM step
+    for name in ("steps.dat", "particles.dat"):
+        path = os.path.join(fluid, "postProcessing", "fdm", name)
+        if os.path.isfile(path):
+            summary.append("%s: %d lines after step %d removed" % (name, _cut_lines(path, lambda v: v <= step + 0.5),
+                                                                   step))
+    # function objects: postProcessing/<name>/<start time>/<file>, first column the time
+    post = os.path.join(fluid, "postProcessing")
+    if os.path.isdir(post):
+        for fo in sorted(os.listdir(post)):
+            if fo == "fdm" or not os.path.isdir(os.path.join(post, fo)):
+                continue
+            for start in os.listdir(os.path.join(post, fo)):
+                d = os.path.join(post, fo, start)
+                if _is_time(start) and float(start) > t_step + eps:
+                    shutil.rmtree(d)
+                    continue
+                if os.path.isdir(d):
+                    for f in os.listdir(d):
+                        if os.path.isfile(os.path.join(d, f)):
+                            _cut_lines(os.path.join(d, f), lambda v: v <= t_step + eps)
+    # fields written after the checkpoint (the resumed run writes them again)
+    for base in [fluid] + [os.path.join(fluid, p) for p in os.listdir(fluid) if p.startswith("processor")]:
+        for name in os.listdir(base):
+            if _is_time(name) and float(name) > t_step + eps and os.path.isdir(os.path.join(base, name)):
+                shutil.rmtree(os.path.join(base, name))
+    # the DEM's dumps (files it created, listed by fdmRun): frames from the checkpoint step on
+    listed = os.path.join(case_dir, ".fdmRun-dem-outputs")
+    if os.path.isfile(listed):
+        with open(listed) as f:
+            for rel in f.read().split("\n"):
+                path = os.path.join(case_dir, "dem", rel)
+                if rel and os.path.isfile(path):
+                    with open(path, "rb") as g:
+                        head = g.read(15)
+                    if head == b"ITEM: TIMESTEP\n":
+                        summary.append("%s: %d frames from step %d on removed" % (rel.lstrip("./"),
+                                                                                  _cut_dump(path, step), step))
+    # checkpoints after this one (an earlier attempt's, or incomplete)
+    for directory, prefix in ((os.path.join(fluid, "checkpoint"), "fluid."),
+                              (os.path.join(case_dir, "dem", "checkpoint"), "dem.")):
+        if os.path.isdir(directory):
+            for name in os.listdir(directory):
+                m = re.fullmatch(re.escape(prefix) + r"(\d+)(\.tmp)?", name)
+                if name.endswith(".tmp") or (m and int(m.group(1)) > step):
+                    os.remove(os.path.join(directory, name))
+    return summary
+
+
+def main(argv):
+    if len(argv) >= 2 and argv[0] == "select":
+        try:
+            step, notes = select(argv[1])
+        except CheckpointError as e:
+            print(e, file=sys.stderr)
+            return 1
+        for n in notes:
+            print("fdmRun --resume: " + n, file=sys.stderr)
+        print(step)
+        return 0
+    if len(argv) >= 3 and argv[0] == "truncate":
+        for line in truncate(argv[1], int(argv[2])):
+            print(line)
+        return 0
+    print(__doc__, file=sys.stderr)
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,247 @@
+"""Checkpoint and resume of a coupled run (issue 16 item 1; docs/coupling.md "Checkpoint and resume").
+
+The scene: three spheres (a = 1) in plane Couette flow between walls moving at -/+1.5 along x
+(shear rate 0.5), x and z periodic, a/Delta = 2: two of them are brought into frictional contact by
+the shear (tangential springs: contact history) and one sits near a wall (wall lubrication and the
+log-gap position update); Adams-Bashforth 2 (U_{n-1}, x_{n-1}: the position update's history). 50
+steps, a checkpoint every 5.
+
+test_killed_run_resumes_to_the_same_trajectory: the run is killed (SIGKILL, of fdmFoam and of fdmDEM
+in turn) at a random step, resumed with fdmRun --resume, and gives the uninterrupted run's particle
+trajectories (positions of every frame to 1e-8 of the box, in practice to rounding) and records with
+every step once. 2 trials (FDM_FULL=1: 10). The faults: a truncated checkpoint falls back to the
+previous one, one of another scene is refused by name, a peer killed during its checkpoint leaves
+the previous one to resume from.
+"""
+import os
+import random
+import shutil
+import signal
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from conftest import FULL, PROJECT
+from fdm import case, output
+
+STEPS = 50
+EVERY = 5
+FDMRUN = os.path.join(PROJECT, "scripts", "fdmRun")
+
+
+def make_scene(root, steps=STEPS, every=EVERY, spheres=None):
+    """fluid/ and dem/ of the small Couette scene in root."""
+    U = 3.0
+    box = case.Box((0, 0, 0), (8.0, 6.0, 6.0), 0.5, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
+    if spheres is None:
+        # 1 (below the mid-plane, carried to -x) and 2 (above, to +x) meet; 3 is near the lower wall
+        spheres = [(5.0, 2.55, 3.0, 1.0), (3.0, 3.45, 3.0, 1.0), (1.0, 1.15, 1.2, 1.0)]
+    case.write_fluid_case(os.path.join(root, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=1e-4, n_max=60,
+                          first_step=(1e-5, 300), n_particles=len(spheres), tol_u=1e-7, tol_p=1e-6)
+    pair = "fdm/subgrid contact 400 200 0.5 0.05 wall ylo %r 0 0 wall yhi %r 0 0" % (-U, U)
+    runs = output.dump_custom_command("particles", 1, "particles.dump") + [
+        "thermo_style    custom step f_couple[1] f_couple[6] f_couple[7] f_couple[8]",  # contacts: column 5
+        "thermo          1",
+        "run             %d upto" % steps]
+    case.write_dem_input(os.path.join(root, "dem"), box, spheres, dt=0.05, pair_style=pair,
+                         fix_options="stresslets yes checkpoint %d" % every, runs=runs, name="in.couette")
+    return root
+
+
+def fdm_run(root, env, *options, timeout=300):
+    return subprocess.run([FDMRUN, "--quiet"] + list(options) + [root], env=env, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True, errors="replace", timeout=timeout)
+
+
+def trajectory(root):
+    """{step: positions (N, 3)} of the DEM dump, and the list of steps in file order."""
+    frames = output.read_dump(os.path.join(root, "dem", "particles.dump"))
+    return ({s: np.column_stack([c["x"], c["y"], c["z"]])[np.argsort(c["id"])] for s, c in frames},
+            [s for s, _ in frames])
+
+
+def records_once(root):
+    """The fluid's records hold each step once, in order: steps 1..STEPS, and one particle record
+    per step and particle."""
+    steps = output.steps(os.path.join(root, "fluid"))["step"].astype(int)
+    assert list(steps) == list(range(1, STEPS + 1)), steps
+    parts = output.particles(os.path.join(root, "fluid"))
+    pairs = list(zip(parts["step"].astype(int), parts["tag"].astype(int)))
+    assert len(pairs) == len(set(pairs)) == 3 * STEPS
+
+
+def find_pid(root, who):
+    """The process id of fdmFoam or fdmDEM of the run in root (from /proc), or None."""
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            cmd = open("/proc/%s/cmdline" % pid, "rb").read().split(b"\0")
+            cwd = os.readlink("/proc/%s/cwd" % pid)
+        except OSError:
+            continue
+        if not cmd or os.path.basename(cmd[0].decode()) != who:
+            continue
+        if who == "fdmFoam" and os.path.join(root, "fluid").encode() in cmd:
+            return int(pid)
+        if who == "fdmDEM" and cwd == os.path.join(root, "dem"):
+            return int(pid)
+    return None
+
+
+def steps_done(root):
+    path = os.path.join(root, "fluid", "postProcessing", "fdm", "steps.dat")
+    try:
+        with open(path) as f:
+            return sum(1 for line in f if line.strip() and not line.startswith("#"))
+    except OSError:
+        return 0
+
+
+def run_and_kill(root, env, who, at_step):
+    """fdmRun in root, SIGKILL of `who` once `at_step` steps are recorded; returns fdmRun's exit code."""
+    proc = subprocess.Popen([FDMRUN, "--quiet", root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, errors="replace",
+                            text=True)
+    deadline = time.time() + 240
+    while steps_done(root) < at_step and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.01)
+    pid = find_pid(root, who)
+    assert pid, "%s of %s not found (fdmRun: %s)" % (who, root, proc.poll())
+    os.kill(pid, signal.SIGKILL)
+    proc.communicate(timeout=60)
+    return proc.returncode
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory, env):
+    root = str(tmp_path_factory.mktemp("reference"))
+    make_scene(root)
+    t0 = time.time()
+    r = fdm_run(root, env)
+    assert r.returncode == 0, r.stdout
+    wall = time.time() - t0
+    log = open(os.path.join(root, "log.fluid")).read()
+    print("reference run: %.1f s wall; %s" % (wall, [l for l in log.splitlines() if "checkpoints" in l]))
+    records_once(root)
+    return root
+
+
+def assert_same_trajectory(root, reference):
+    got, order = trajectory(root)
+    ref, ref_order = trajectory(reference)
+    assert order == ref_order == list(range(0, STEPS + 1)), order   # every frame once, in order
+    worst = max(float(np.max(np.abs(got[s] - ref[s]))) for s in ref_order)
+    final = float(np.max(np.abs(got[STEPS] - ref[STEPS]) / np.abs(ref[STEPS])))
+    print("largest position difference over the trajectory %.3g (box 8 x 6 x 6), relative at step %d %.3g"
+          % (worst, STEPS, final))
+    assert final < 1e-8 and worst < 1e-8 * 8
+    return worst
+
+
+def test_checkpoint_interval_and_contact(reference):
+    """The scene exercises what a checkpoint must carry: contacts (history) and the AB2 plan."""
+    names = sorted(os.listdir(os.path.join(reference, "dem", "checkpoint")))
+    assert names == ["dem.45", "dem.50"], names   # every 5 steps and at the end, the two newest kept
+    markers = sorted(os.listdir(os.path.join(reference, "fluid", "checkpoint")))
+    assert markers == ["fluid.45", "fluid.50"], markers
+    log = open(os.path.join(reference, "log.dem")).read()
+    contacts = [float(l.split()[4]) for l in log.splitlines() if l.strip() and l.split()[0].isdigit()
+                and len(l.split()) == 5]
+    assert max(contacts, default=0) >= 1, "no contact in the scene: its history would not be tested"
+
+
+@pytest.mark.parametrize("trial", range(10 if FULL else 2))
+def test_killed_run_resumes_to_the_same_trajectory(tmp_path, env, reference, trial):
+    rng = random.Random(16 + trial)
+    who = ("fdmFoam", "fdmDEM")[trial % 2]
+    at_step = rng.randint(3, STEPS - 3)
+    root = make_scene(str(tmp_path))
+    code = run_and_kill(root, env, who, at_step)
+    assert code != 0
+    done = steps_done(root)
+    t0 = time.time()
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode == 0, r.stdout
+    print("trial %d: %s killed after %d steps recorded; resumed in %.1f s" % (trial, who, done, time.time() - t0))
+    records_once(root)
+    assert_same_trajectory(root, reference)
+
+
+def test_truncated_checkpoint_falls_back_to_the_previous_one(tmp_path, env, reference):
+    root = str(tmp_path / "run")
+    shutil.copytree(reference, root)
+    newest = os.path.join(root, "dem", "checkpoint", "dem.50")
+    size = os.path.getsize(newest)
+    with open(newest, "r+b") as f:
+        f.truncate(size // 2)
+    r = fdm_run(root, env, "--resume")   # the run ended at 50: resuming at 45 repeats 46..50
+    assert r.returncode == 0, r.stdout
+    log = open(os.path.join(root, "log.fluid")).read()
+    assert "Resuming from" in log and "fluid.45" in log
+    records_once(root)
+    assert_same_trajectory(root, reference)
+    # the reason is said
+    r = subprocess.run(["python3", "-m", "fdm.checkpoint", "select", root], env=dict(
+        env, PYTHONPATH=os.path.join(PROJECT, "scripts")), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
+    assert r.returncode == 0
+
+
+def test_truncated_checkpoint_is_named(tmp_path, env, reference):
+    root = str(tmp_path / "run")
+    shutil.copytree(reference, root)
+    for step in (45, 50):
+        path = os.path.join(root, "dem", "checkpoint", "dem.%d" % step)
+        with open(path, "r+b") as f:
+            f.truncate(os.path.getsize(path) - 100)
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode != 0
+    assert "dem/checkpoint/dem.50 is truncated" in r.stdout and "has no checkpoint that both codes completed" \
+        in r.stdout, r.stdout
+
+
+def test_checkpoint_of_another_scene_is_refused(tmp_path, env, reference):
+    root = str(tmp_path / "run")
+    shutil.copytree(reference, root)
+    # the input now has 2 particles: the checkpoint holds 3
+    make_scene(str(tmp_path / "other"), spheres=[(5.0, 2.55, 3.0, 1.0), (2.6, 3.45, 3.0, 1.0)])
+    shutil.copy(str(tmp_path / "other" / "dem" / "spheres.data"), os.path.join(root, "dem", "spheres.data"))
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode != 0
+    assert "dem.50 is from another scene: it holds 3 particles, the LIGGGHTS input has 2" in r.stdout, r.stdout
+
+
+def test_peer_killed_during_its_checkpoint_resumes_from_the_previous(tmp_path, env, reference):
+    """fdmDEM killed while writing its checkpoint of step 50 (fdmFoam had written its own): the
+    temporary file is left, the fluid's checkpoint 50 has no partner, so the run resumes from 45."""
+    root = str(tmp_path / "run")
+    shutil.copytree(reference, root)
+    ckpt = os.path.join(root, "dem", "checkpoint")
+    with open(os.path.join(ckpt, "dem.50"), "rb") as f:
+        head = f.read(1000)
+    os.remove(os.path.join(ckpt, "dem.50"))
+    with open(os.path.join(ckpt, "dem.50.tmp"), "wb") as f:
+        f.write(head)
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode == 0, r.stdout
+    assert "fluid.45" in open(os.path.join(root, "log.fluid")).read()
+    assert not os.path.exists(os.path.join(ckpt, "dem.50.tmp"))
+    records_once(root)
+    assert_same_trajectory(root, reference)
+
+
+def test_resume_step_mismatch_at_the_handshake(tmp_path, env, reference):
+    """Both codes started by hand on different checkpoints: the handshake refuses."""
+    root = str(tmp_path / "run")
+    shutil.copytree(reference, root)
+    os.remove(os.path.join(root, "fluid", "coupling.port")) if os.path.exists(
+        os.path.join(root, "fluid", "coupling.port")) else None
+    fluid = subprocess.Popen(["fdmFoam", "-case", os.path.join(root, "fluid"), "-resume", "45"], env=env,
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
+    dem = subprocess.run(["fdmDEM", "-in", "in.couette", "-resume", "checkpoint/dem.50"], cwd=os.path.join(root, "dem"),
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", timeout=120)
+    out, _ = fluid.communicate(timeout=60)
+    assert fluid.returncode != 0 and dem.returncode != 0
+    message = "fdmFoam resumes from its checkpoint of step 45 (checkpoint/fluid.45) but fdmDEM from step 50"
+    assert message in out and message in dem.stdout, out[-2000:] + dem.stdout[-2000:]
