@@ -118,6 +118,11 @@ void FixFdmOutput::init()
   if (!atom->sphere_flag) error->all(FLERR, "fix fdm/output requires atom_style sphere");
 }
 
+bool FixFdmOutput::appending() const
+{
+  return append_ || !LAMMPS_NS::CouplingSession::instance().resumeFile().empty();
+}
+
 void FixFdmOutput::open()
 {
   // once, at the first run: the particle count and the box are those of the coupled session
@@ -136,7 +141,9 @@ void FixFdmOutput::open()
                            ", " + std::to_string(domain->periodicity[1]) + ", " + std::to_string(domain->periodicity[2]) +
                            "], \"stresslets\": \"full (not traceless), components xx xy xz yy yz zz, force x length\""
                            ", \"positions\": \"x wrapped into the periodic box; x + image * (box_hi - box_lo) unwrapped\"";
-        records_.reset(new rec::Writer(recordPath_, layout_, meta, append_, update->ntimestep));
+        // a resumed run (fdmDEM -resume, fdmRun --resume) continues the records of the run it
+        // resumes: blocks up to the checkpoint step are kept, later ones cut
+        records_.reset(new rec::Writer(recordPath_, layout_, meta, appending(), update->ntimestep));
         if (records_->blocksKept() && screen)
           fprintf(screen, "fix fdm/output: appending to %s after its %ld blocks up to step %lld\n", recordPath_.c_str(),
                   records_->blocksKept(), (long long) update->ntimestep);
@@ -145,7 +152,7 @@ void FixFdmOutput::open()
         if (::mkdir(vtkDir_.c_str(), 0755) != 0 && errno != EEXIST)
           throw rec::Error("cannot create the folder " + vtkDir_ + ": " + std::strerror(errno));
         series_.reset(new fdm::vtk::Series(vtkDir_ + "/particles.pvd"));
-        if (append_) series_->load(update->get_cur_time() * (1 + 1e-12));
+        if (appending()) series_->load(update->get_cur_time() * (1 + 1e-12));
       }
     } catch (const rec::Error &e) {
       fail(e.what());

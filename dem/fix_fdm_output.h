@@ -40,6 +40,7 @@ class FixFdmOutput : public Fix {
 
  private:
   void open();
+  bool appending() const;                     // append yes, or a resumed run
   bool gather(std::vector<double> &byTag);   // rank 0: natoms_ x width_ values by tag
   void writeRecords(const std::vector<double> &byTag);
   void writeVtk(const std::vector<double> &byTag);

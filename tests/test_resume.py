@@ -44,6 +44,7 @@ def make_scene(root, steps=STEPS, every=EVERY, spheres=None):
     runs = output.dump_custom_command("particles", 1, "particles.dump") + [
         "thermo_style    custom step f_couple[1] f_couple[6] f_couple[7] f_couple[8]",  # contacts: column 5
         "thermo          1",
+        "fix             out all fdm/output records 1 particles.records",
         "run             %d upto" % steps]
     case.write_dem_input(os.path.join(root, "dem"), box, spheres, dt=0.05, pair_style=pair,
                          fix_options="stresslets yes checkpoint %d" % every, runs=runs, name="in.couette")
@@ -128,6 +129,15 @@ def reference(tmp_path_factory, env):
     return root
 
 
+def assert_same_records(root, reference):
+    """fix fdm/output's binary records of a resumed run: every step once, as in the uninterrupted
+    run (the resumed fdmDEM appends after the checkpoint step, whatever the input's append says)."""
+    got = output.read_particle_records(os.path.join(root, "dem", "particles.records"), mmap=False)
+    ref = output.read_particle_records(os.path.join(reference, "dem", "particles.records"), mmap=False)
+    assert list(got.steps) == list(ref.steps) == list(range(1, STEPS + 1)), got.steps
+    assert np.array_equal(got["x"], ref["x"])
+
+
 def assert_same_trajectory(root, reference):
     got, order = trajectory(root)
     ref, ref_order = trajectory(reference)
@@ -167,6 +177,7 @@ def test_killed_run_resumes_to_the_same_trajectory(tmp_path, env, reference, tri
     print("trial %d: %s killed after %d steps recorded; resumed in %.1f s" % (trial, who, done, time.time() - t0))
     records_once(root)
     assert_same_trajectory(root, reference)
+    assert_same_records(root, reference)
 
 
 def test_truncated_checkpoint_falls_back_to_the_previous_one(tmp_path, env, reference):
