@@ -170,7 +170,7 @@ def fluid_alone(root, env):
     ("constant/fdmProperties", "gradP0  ", "gradPO  ", "gradPO", "indicator alphaLambda pseudoTimeFactor"),
     ("indicator", "{ b ", "{ bb ", "bb", "b c"),
     ("innerIterations", "tolLambda   ", "tolLamda   ", "tolLamda",
-     "tolLambda tolVelocity nMax nMin firstStep acceleration depth report"),
+     "tolLambda tolVelocity nMax nMin firstStep acceleration depth meanFlowCorrection report"),
     ("innerIterations/firstStep", "innerIterations\n{", "innerIterations\n{\n    firstStep { nmax 10; }", "nmax",
      "tolLambda tolVelocity nMax"),
     ("output", "coupling\n{", "output { particleEvery 2; }\ncoupling\n{", "particleEvery", "particlesEvery"),

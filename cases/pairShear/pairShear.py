@@ -50,7 +50,8 @@ def paper_contact(a1=1.0, kn=2e4, kt=200.0):
 
 def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0, size=(12.0, 8.0, 6.0), dt=0.05,
                    tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True,
-                   gap_update="log", integrator="ab2", r_x0=None, acceleration="anderson"):
+                   gap_update="log", integrator="ab2", r_x0=None, acceleration="anderson",
+                   mean_flow_correction=True, tol_velocity=0.0):
     """One coupled run from r_x = r_x0 (default -r_x_end) to +r_x_end (r_x_end = 6, the paper's, or
     less in a box shorter than 14 a1: the minimum image in the periodic x must stay unambiguous);
     returns the relative trajectory and the gaps."""
@@ -78,8 +79,9 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
     # the relative x-velocity is about shear * r_y: enough steps to go from r_x0 to r_x_end, with margin
     steps = min(max_steps, int(math.ceil((r_x_end - r_x_start) / (shear * max(r_y0, 0.3)) / dt * 1.6)))
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
-                          first_step=(tol_lambda / 10, 3000), n_particles=2, tol_u=1e-5, tol_p=1e-4,
-                          acceleration=acceleration)
+                          first_step=(tol_lambda / 10 if tol_lambda > 0 else 0.0, 3000), n_particles=2,
+                          tol_u=1e-5, tol_p=1e-4, acceleration=acceleration, tol_velocity=tol_velocity,
+                          mean_flow_correction=mean_flow_correction)
     pair = "fdm/subgrid%s wall ylo %r 0 0 wall yhi %r 0 0" % ("" if cutoff is None else " cutoff %g" % cutoff, -U, U)
     if not lubrication:
         pair += " lubrication no"

@@ -37,6 +37,7 @@ Usage
 #include "andersonAcceleration.H"
 #include "innerConvergence.H"
 #include "fluidCheckpoint.H"
+#include "meanFlowCorrection.H"
 #include <chrono>
 
 namespace
@@ -103,6 +104,8 @@ int main(int argc, char *argv[])
         andersonDepth, alphaLambda, alphaLambda/grid.delta()
     );
     innerConvergence convergence;
+    meanFlowCorrection meanFlow(grid, U, nu.value(), correctMeanFlow);
+    Info<< meanFlow.description().c_str() << endl;
     scalarList radii;
 
     scalar fluidTime = 0, particleTime = 0, outputTime = 0, checkpointTime = 0;
@@ -181,6 +184,9 @@ int main(int argc, char *argv[])
                     #include "pEqn.H"
                 }
             }
+            // The slowest modes, the plane-averaged channel profile, solved
+            // exactly (meanFlowCorrection.H)
+            meanFlow.correct(U, lambda, gradP0.value()/rho.value());
             double t1 = wallClock();
             stepFluidTime += t1 - t0;
 
@@ -224,7 +230,8 @@ int main(int argc, char *argv[])
                     << residual << " flow change "
                     << convergence.flowChange() << " particle change "
                     << convergence.particleChange() << " velocity error "
-                    << convergence.errorEstimate() << endl;
+                    << convergence.errorEstimate() << " mean-flow change "
+                    << meanFlow.lastChange() << endl;
             }
 
             converged = innerIteration >= nInnerMin && convergence.converged();

@@ -80,10 +80,13 @@ runTimeModifiable false;
 def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicator=(5.0, 0.3),
                      tol_lambda=1e-4, n_max=500, n_min=1, first_step=None, tol_u=1e-6, tol_p=5e-6,
                      pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
-                     n_correctors=2, extra_fdm="", acceleration="anderson", tol_velocity=0.0):
+                     n_correctors=2, extra_fdm="", acceleration="anderson", tol_velocity=0.0,
+                     mean_flow_correction=True):
     """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/). acceleration: the inner
     iteration's, "anderson" (default) or "none" (the plain iteration of paper 4.3); tol_velocity: the
-    innerIterations tolVelocity (0 = not checked, the first step included), docs/fluid.md."""
+    innerIterations tolVelocity (0 = not checked, the first step included); mean_flow_correction: the
+    exact plane-averaged profile of a channel at every inner iteration (a no-op in other boxes),
+    docs/fluid.md."""
     x0, y0, z0 = box.lo
     x1, y1, z1 = box.hi
     names = ("x", "y", "z")
@@ -196,6 +199,7 @@ innerIterations
     nMin        %(nmin)d;
     nMax        %(nmax)d;%(first)s
     acceleration %(accel)s;
+    meanFlowCorrection %(meanflow)s;
 }
 coupling
 {
@@ -210,7 +214,8 @@ coupling
 """ % dict(b=indicator[0], c=indicator[1], grad=foam_vector(grad_p0), ptf=pseudo_time_factor,
            ptfo=pseudo_time_factor if pseudo_time_factor_outside is None else pseudo_time_factor_outside,
            np=n_particles, tol=tol_lambda, nmin=n_min, nmax=n_max, first=first, extra=extra_fdm,
-           accel=acceleration, tolv=tol_velocity))
+           accel=acceleration, tolv=tol_velocity,
+           meanflow="yes" if mean_flow_correction else "no"))
 
     foam_file(os.path.join(case_dir, "0/U"), "volVectorField", """
 dimensions      [0 1 -1 0 0 0 0];

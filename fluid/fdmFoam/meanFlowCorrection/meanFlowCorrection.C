@@ -1,0 +1,168 @@
+#include "meanFlowCorrection.H"
+#include "channelProfile.H"
+#include "surfaceFields.H"
+
+// * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
+
+Foam::meanFlowCorrection::meanFlowCorrection
+(
+    const uniformCartesianMesh& grid,
+    const volVectorField& U,
+    scalar nu,
+    bool enabled
+)
+:
+    grid_(grid),
+    nu_(nu),
+    axis_(-1),
+    lastChange_(0)
+{
+    const Vector<bool>& periodic = grid.periodic();
+    label nPeriodic = 0, wallAxis = -1;
+    for (direction d = 0; d < 3; ++d)
+    {
+        if (periodic[d])
+        {
+            ++nPeriodic;
+        }
+        else
+        {
+            wallAxis = d;
+        }
+    }
+    if (!enabled || nPeriodic != 2)
+    {
+        return;
+    }
+
+    // Faces in the order xlo, xhi, ylo, yhi, zlo, zhi
+    const List<labelList> facePatches = grid.boxFacePatches();
+    lowPatches_ = facePatches[2*wallAxis];
+    highPatches_ = facePatches[2*wallAxis + 1];
+    for (const labelList* face : {&lowPatches_, &highPatches_})
+    {
+        if (face->empty())
+        {
+            return;
+        }
+        for (const label patchi : *face)
+        {
+            if (!U.boundaryField()[patchi].fixesValue())
+            {
+                return;
+            }
+        }
+    }
+    axis_ = wallAxis;
+
+    const scalar lo = grid.bounds().min()[axis_];
+    const label n = grid.nCells()[axis_];
+    const vectorField& C = grid.mesh().C().primitiveField();
+    plane_.setSize(C.size());
+    forAll(C, celli)
+    {
+        plane_[celli] =
+            min(n - 1, max(label(0), label((C[celli][axis_] - lo)/grid.delta())));
+    }
+}
+
+
+// * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
+
+Foam::vector Foam::meanFlowCorrection::wallVelocity
+(
+    const volVectorField& U,
+    const labelList& patches
+) const
+{
+    vector sum(Zero);
+    scalar area = 0;
+    for (const label patchi : patches)
+    {
+        const scalarField& magSf = grid_.mesh().boundary()[patchi].magSf();
+        sum += gSum(magSf*U.boundaryField()[patchi]);
+        area += gSum(magSf);
+    }
+    return sum/max(area, VSMALL);
+}
+
+
+Foam::string Foam::meanFlowCorrection::description() const
+{
+    if (!active())
+    {
+        return
+            "mean-flow correction off (it needs a channel: two periodic "
+            "directions and walls with fixed velocities on the other faces)";
+    }
+    const char* names[] = {"x", "y", "z"};
+    return
+        string("mean-flow correction on: the profile of the flow averaged over ")
+      + "planes normal to " + names[axis_] + " (" + name(grid_.nCells()[axis_])
+      + " planes) solved exactly at every inner iteration";
+}
+
+
+void Foam::meanFlowCorrection::correct
+(
+    volVectorField& U,
+    const volVectorField& lambda,
+    const vector& gradP0OverRho
+)
+{
+    if (!active())
+    {
+        return;
+    }
+    const label n = grid_.nCells()[axis_];
+    vectorField& u = U.primitiveFieldRef();
+    const vectorField& l = lambda.primitiveField();
+
+    // Plane sums of u and lambda over all processors (equal cell volumes)
+    List<vector> uSum(n, Zero), lambdaSum(n, Zero);
+    forAll(u, celli)
+    {
+        uSum[plane_[celli]] += u[celli];
+        lambdaSum[plane_[celli]] += l[celli];
+    }
+    Pstream::listCombineGather(uSum, plusEqOp<vector>());
+    Pstream::listCombineScatter(uSum);
+    Pstream::listCombineGather(lambdaSum, plusEqOp<vector>());
+    Pstream::listCombineScatter(lambdaSum);
+
+    const Vector<label>& nCells = grid_.nCells();
+    const scalar cellsPerPlane = scalar(nCells.x())*nCells.y()*nCells.z()/n;
+    const vector uLow = wallVelocity(U, lowPatches_);
+    const vector uHigh = wallVelocity(U, highPatches_);
+
+    List<vector> shift(n, Zero);
+    scalar largest = 0;
+    for (direction d = 0; d < 3; ++d)
+    {
+        if (d == axis_)
+        {
+            continue;
+        }
+        std::vector<double> source(n);
+        for (label j = 0; j < n; ++j)
+        {
+            source[j] = lambdaSum[j][d]/cellsPerPlane - gradP0OverRho[d];
+        }
+        const std::vector<double> profile = fdm::channel::solveProfile
+        (
+            source, nu_, grid_.delta(), uLow[d], uHigh[d]
+        );
+        for (label j = 0; j < n; ++j)
+        {
+            shift[j][d] = profile[j] - uSum[j][d]/cellsPerPlane;
+            largest = max(largest, mag(shift[j][d]));
+        }
+    }
+
+    forAll(u, celli)
+    {
+        u[celli] += shift[plane_[celli]];
+    }
+    U.correctBoundaryConditions();
+    lastChange_ = largest/max(gMax(mag(u)), VSMALL);
+}
