@@ -204,9 +204,10 @@ class Resistance:
             M = M + np.array(out["R"])
         n = np.array([-1.0, 0.0, 0.0])     # from sphere 2 to sphere 1 (the pair style's n for i = 1)
         t = np.array([0.0, 1.0, 0.0])
-        load = np.concatenate([t, np.cross(-a * n, t), -t, np.cross(a * n, -t)])
+        lever = a + 0.5 * gap                # the contact point in the middle of the gap (docs/contact.md 2)
+        load = np.concatenate([t, np.cross(-lever * n, t), -t, np.cross(lever * n, -t)])
         u = np.linalg.solve(M, load)
-        slip = u[0:3] - u[6:9] - np.cross(a * u[3:6] + a * u[9:12], n)
+        slip = u[0:3] - u[6:9] - np.cross(lever * u[3:6] + lever * u[9:12], n)
         return 1.0 / float(slip @ t)
 
     def table(self, kind, lubrication, points=40, jobs=2):
