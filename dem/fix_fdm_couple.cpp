@@ -499,6 +499,20 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
   }
   gatherOnRoot(pairs, allPairs, world, comm->me, comm->nprocs);
   gatherOnRoot(walls, allWalls, world, comm->me, comm->nprocs);
+  // implicit contact springs (docs/contact.md 2b): c1 the weight of U_{n+1} in the next position
+  // update (planNextMove: ab2 once a previous step exists), gamma = -c0/c1 the weight of U_n
+  fdm::ParticleVelocitySystem::Springs springs;
+  const bool multistep = adamsBashforth_ && havePlan_ && haveVelocities_ && planPositions_.size() == size_t(3) * natoms_;
+  if (pair_ && pair_->implicitContact() && move_) {
+    std::vector<double> springPairs, springWalls;
+    pair_->collectSpringBlocks(multistep ? 1.5 : 1.0, update->dt, springPairs, springWalls);
+    gatherOnRoot(springPairs, springs.pairs, world, comm->me, comm->nprocs);
+    gatherOnRoot(springWalls, springs.walls, world, comm->me, comm->nprocs);
+    if (multistep) {
+      springs.gamma = 1.0 / 3.0;
+      springs.previous = currentVelocity_;
+    }
+  }
   MPI_Reduce(&contacts, &contacts_, 1, MPI_LONG, MPI_SUM, 0, world);
   if (comm->me != 0) return;
 
@@ -526,7 +540,7 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
       settings.stresslets = stresslets_;
       system_.reset(new fdm::ParticleVelocitySystem(settings));
     }
-    system_->assemble(std::move(loads), std::move(allPairs), std::move(allWalls));
+    system_->assemble(std::move(loads), std::move(allPairs), std::move(allWalls), std::move(springs));
   } catch (const fdm::ParticleVelocitySystem::Error &e) {
     fail(e.what());
   }
@@ -604,13 +618,16 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   // rank 0, after the last inner iteration: the sub-grid force and torque (Eq. 21 and D.6) and,
   // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
   subgrid_ = system_->subgridForces();
+  // the implicit part of the contact forces (Eq. C2) and of their stresslet (Eq. 52)
+  std::vector<double> springStress(size_t(6) * natoms_, 0.0);
+  springs_ = system_->springForces(stresslets_ ? &springStress : nullptr);
   if (!stresslets_) return;
   std::vector<double> subgrid(size_t(7) * natoms_, 0.0);  // S^SG, s^SG: 7 per particle
   system_->addSubgridStresslets(subgrid);
   for (int p = 0; p < natoms_; p++) {
     double *out = &stress_[size_t(20) * p];
     for (int c = 0; c < 7; c++) out[c] = fluidStress_[size_t(7) * p + c] + subgrid[size_t(7) * p + c];
-    for (int c = 0; c < 6; c++) out[7 + c] = particles[p].contactStress[c];
+    for (int c = 0; c < 6; c++) out[7 + c] = particles[p].contactStress[c] + springStress[size_t(6) * p + c];
     for (int c = 0; c < 7; c++) out[13 + c] = subgrid[size_t(7) * p + c];
   }
 }
@@ -795,12 +812,18 @@ void FixFdmCouple::scatter()
   contacts_ = counters[3];
   MPI_Bcast(&lastIterations_, 1, MPI_INT, 0, world);
   MPI_Bcast(&lastResidual_, 1, MPI_DOUBLE, 0, world);
+  // the implicit part of the contact forces: f and torque become the forces that moved the particles
+  springs_.resize(size_t(6) * natoms_, 0.0);
+  MPI_Bcast(springs_.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
   // the velocities of the converged inner iteration are the particles' velocities of this step
   for (int i = 0; i < atom->nlocal; i++) {
-    const double *u = &solution_[size_t(6) * (atom->tag[i] - 1)];
+    const size_t t = size_t(6) * (atom->tag[i] - 1);
+    const double *u = &solution_[t];
     for (int d = 0; d < 3; d++) {
       atom->v[i][d] = u[d];
       atom->omega[i][d] = u[3 + d];
+      atom->f[i][d] += springs_[t + d];
+      atom->torque[i][d] += springs_[t + 3 + d];
     }
   }
   fillPerAtomArray();

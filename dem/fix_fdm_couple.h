@@ -125,6 +125,7 @@ class FixFdmCouple : public Fix {
   // Eq. (31) on rank 0 (particle_velocity_system.h): assembled once per step, solved every inner iteration.
   std::unique_ptr<fdm::ParticleVelocitySystem> system_;
   std::vector<double> subgrid_;    // 6N: F^SG, T^SG of the last step, by tag
+  std::vector<double> springs_;    // 6N: implicit part of the contact forces of the last step (Eq. C2), by tag
   std::vector<double> stress_;     // 20N: S^h (6), s^h, S^c (6), S^SG (6), s^SG of the last step, by tag
   long solverIterations_, pairBlocks_, wallBlocks_, contacts_;
 

@@ -2,6 +2,7 @@
 // docs/dem.md).
 #include "pair_fdm_subgrid.h"
 
+#include "contact_springs.h"
 #include "coupling_session.h"
 #include "fix_contact_history_fdm.h"
 #include "particle_velocity_system.h"
@@ -45,7 +46,7 @@ std::string fmt(double x)
 
 PairFdmSubgrid::PairFdmSubgrid(LAMMPS *lmp) :
   Pair(lmp), computeflag(0), lubrication_(true), cutoffCells_(0.65), wallCutoffCells_(0.75), kn_(0), kt_(0), mu_(0), hr_(0),
-  unstableStepIsError_(true), viscosity_(0),
+  unstableStepIsError_(true), implicit_(true), viscosity_(0),
   meshSize_(0), rangeGap_(0), rmin_(0), rmax_(0), distanceFactor_(1.0), history_(nullptr), wallHistory_(nullptr),
   contactStressRequested_(false), nmaxStress_(0), contactStress_(nullptr), contactsLast_(0), reported_(false),
   checkedTimeStep_(0)
@@ -82,6 +83,7 @@ void PairFdmSubgrid::settings(int narg, char **arg)
   };
   walls_.clear();
   unstableStepIsError_ = true;
+  implicit_ = true;
   for (int i = 0; i < narg; i++) {
     const std::string key = arg[i];
     if (key == "lubrication") {
@@ -133,6 +135,12 @@ void PairFdmSubgrid::settings(int narg, char **arg)
       const std::string v = arg[++i];
       if (v != "error" && v != "warn") error->all(FLERR, "pair_style fdm/subgrid: unstable_step error|warn");
       unstableStepIsError_ = (v == "error");
+    } else if (key == "contact_integration") {
+      need(i, 1, "contact_integration implicit|explicit");
+      const std::string v = arg[++i];
+      if (v != "implicit" && v != "explicit")
+        error->all(FLERR, ("pair_style fdm/subgrid: contact_integration " + v + ": implicit or explicit").c_str());
+      implicit_ = (v == "implicit");
     } else {
       error->all(FLERR, ("pair_style fdm/subgrid: unknown keyword " + key + " (see docs/dem.md)").c_str());
     }
@@ -284,7 +292,8 @@ void PairFdmSubgrid::init_style()
               fmt(w.velocity[2]) + ")";
     if (contactActive())
       line += "; contact ON (kn " + fmt(kn_) + " N/m, kt " + fmt(kt_) + " N/m, mu_s " + fmt(mu_) + ", h_r " + fmt(hr_) +
-              " m" + (walls_.empty() ? "" : ", also with the walls") + ")";
+              " m" + (walls_.empty() ? "" : ", also with the walls") + "; springs " +
+              (implicit_ ? "implicit in Eq. 31" : "explicit") + ")";
     else
       line += "; contact OFF (h_r = 0: no contact search)";
     line += "\n";
@@ -341,14 +350,16 @@ void PairFdmSubgrid::pairResistance(double a, double h, double &normal, double &
   normal = 1.0 / (u(0) - u(6));
   // unit force along +y at the contact points (a, 0, 0) of sphere 1 and (-a, 0, 0) relative to sphere
   // 2's centre, opposite: torques a e_z on both
+  // (the contact point in the middle of the gap, lever arms l = a + h/2, as the contact law has them)
+  const double l = a + 0.5 * h;
   load.setZero();
   load(1) = 1;
-  load(5) = a;
+  load(5) = l;
   load(7) = -1;
-  load(11) = a;
+  load(11) = l;
   u = lu.solve(load);
-  // slip of the contact points along y: (u1 + w1 x a e_x) - (u2 + w2 x (-a e_x))
-  slip = 1.0 / ((u(1) + a * u(5)) - (u(7) - a * u(11)));
+  // slip of the contact points along y: (u1 + w1 x l e_x) - (u2 + w2 x (-l e_x))
+  slip = 1.0 / ((u(1) + l * u(5)) - (u(7) - l * u(11)));
 }
 
 void PairFdmSubgrid::wallResistance(double a, double h, double &normal, double &slip) const
@@ -383,7 +394,7 @@ void PairFdmSubgrid::wallResistance(double a, double h, double &normal, double &
 
 void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
 {
-  // docs/contact.md 3c: an explicit spring k against the implicit resistance zeta of its mode is
+  // contact_integration explicit (docs/contact.md 3c): an explicit spring k against the implicit resistance zeta of its mode is
   // stable for r = dt k/zeta < 1 (ab2) or 2 (euler). zeta grows as the gap closes, so it is smallest
   // at the contact gap h_r (where a contact starts) and largest at h = 0 (the lubrication is frozen at
   // 1e-5 a): a step beyond the limit at h_r is stable only for contacts pressed deeper (a warning),
@@ -421,6 +432,19 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
     if (m.zetaContact / m.k < worst->zetaContact / worst->k) worst = &m;
   const double limit = factor * worst->zetaContact / worst->k;
   if (dt <= limit) return;
+  if (implicit_) {
+    // implicit springs (docs/contact.md 2b, Eq. C4): no stability limit from them; say how far
+    // beyond the explicit limit the step is (the contacts then settle within a few steps)
+    if (comm->me == 0) {
+      const std::string line = "pair fdm/subgrid: time step " + fmt(dt) + " s is " + fmt(dt / limit) + " times the "
+                               "explicit springs' stability limit " + fmt(limit) + " s (the " + worst->name +
+                               " at the contact gap h_r): stable with the implicit springs (contact_integration "
+                               "implicit; docs/contact.md 3c), the contact relaxation zeta/k is shorter than a step\n";
+      if (screen) fputs(line.c_str(), screen);
+      if (logfile) fputs(line.c_str(), logfile);
+    }
+    return;
+  }
   double limitTouching = 1e300;
   const Mode *never = nullptr;
   for (const Mode &m : modes)
@@ -480,6 +504,7 @@ void PairFdmSubgrid::compute(int eflag, int vflag)
   else evflag = vflag_fdotr = 0;
   computeflag = 1;
   contactsLast_ = 0;
+  contacts_.clear();
   if (contactStressRequested_) {
     if (atom->nmax > nmaxStress_) {
       nmaxStress_ = atom->nmax;
@@ -509,7 +534,7 @@ FixContactHistoryFdm *PairFdmSubgrid::contactHistory() const
   return dynamic_cast<FixContactHistoryFdm *>(history_);
 }
 
-void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
+bool PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
                                 double force[3], double nxft[3]) const
 {
   // The tangential spring and the Coulomb cap shared by pair and wall contacts: the elongation
@@ -524,7 +549,8 @@ void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const dou
   double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
   const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
   const double ftMax = mu_ * normalForce;
-  if (ftNorm > ftMax) {
+  const bool slides = ftNorm > ftMax;
+  if (slides) {
     const double scale = ftMax / ftNorm;
     for (int d = 0; d < 3; d++) {
       ft[d] *= scale;
@@ -535,6 +561,7 @@ void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const dou
   nxft[0] = n[1] * ft[2] - n[2] * ft[1];
   nxft[1] = n[2] * ft[0] - n[0] * ft[2];
   nxft[2] = n[0] * ft[1] - n[1] * ft[0];
+  return slides;
 }
 
 void PairFdmSubgrid::contactForces()
@@ -569,18 +596,25 @@ void PairFdmSubgrid::contactForces()
       const double r = std::sqrt(rsq);
       const double n[3] = {del[0] / r, del[1] / r, del[2] / r};  // from j to i
       const double normalForce = kn_ * (reach - r);
-      // relative velocity of the contact points: v_i - v_j - (a_i w_i + a_j w_j) x n
+      // the contact point in the middle of the gap: lever arms l = a + h/2 (l_i + l_j = r), so that a
+      // rigid motion of the pair does not slip the contact points (docs/contact.md 2, Eq. C1)
+      const double halfGap = 0.5 * (r - radius[i] - radius[j]);
+      const double leverI = radius[i] + halfGap, leverJ = radius[j] + halfGap;
+      // relative velocity of the contact points: v_i - v_j - (l_i w_i + l_j w_j) x n
       double w[3], vr[3];
-      for (int d = 0; d < 3; d++) w[d] = radius[i] * omega[i][d] + radius[j] * omega[j][d];
+      for (int d = 0; d < 3; d++) w[d] = leverI * omega[i][d] + leverJ * omega[j][d];
       const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - v[j][d] - wxn[d];
       double force[3], nxft[3];
-      contactLaw(n, normalForce, vr, dt, shear, force, nxft);
+      const bool slides = contactLaw(n, normalForce, vr, dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
-        torque[i][d] -= radius[i] * nxft[d];
+        torque[i][d] -= leverI * nxft[d];
       }
       const double weightI = radius[i] / (radius[i] + radius[j]);
+      if (implicit_ && (j < nlocal || atom->tag[i] < atom->tag[j]))
+        contacts_.push_back(Contact{i, j, {n[0], n[1], n[2]}, leverI, leverJ, {-del[0], -del[1], -del[2]}, weightI,
+                                    !slides});
       if (contactStressRequested_) {
         const double branch[3] = {-del[0], -del[1], -del[2]};  // x_j - x_i
         addContactStress(i, force, branch, weightI);
@@ -589,7 +623,7 @@ void PairFdmSubgrid::contactForces()
         const double minus[3] = {-force[0], -force[1], -force[2]};
         for (int d = 0; d < 3; d++) {
           f[j][d] -= force[d];
-          torque[j][d] -= radius[j] * nxft[d];
+          torque[j][d] -= leverJ * nxft[d];
         }
         if (contactStressRequested_) addContactStress(j, minus, del, 1.0 - weightI);
       }
@@ -628,16 +662,49 @@ void PairFdmSubgrid::wallContactForces()
       const double wxn[3] = {aw[1] * n[2] - aw[2] * n[1], aw[2] * n[0] - aw[0] * n[2], aw[0] * n[1] - aw[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - wall.velocity[d] - wxn[d];
       double force[3], nxft[3];
-      contactLaw(n, normalForce, vr, dt, shear, force, nxft);
+      const bool slides = contactLaw(n, normalForce, vr, dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];
       }
-      if (contactStressRequested_) {
-        const double branch[3] = {-h * n[0], -h * n[1], -h * n[2]};
-        addContactStress(i, force, branch, 1.0);
-      }
+      const double branch[3] = {-h * n[0], -h * n[1], -h * n[2]};
+      if (contactStressRequested_) addContactStress(i, force, branch, 1.0);
+      if (implicit_)
+        contacts_.push_back(Contact{i, -1 - int(k), {n[0], n[1], n[2]}, radius[i], 0.0,
+                                    {branch[0], branch[1], branch[2]}, 1.0, !slides});
       contactsLast_++;
+    }
+  }
+}
+
+void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<double> &pairs,
+                                         std::vector<double> &walls) const
+{
+  // Eqs. (C1)-(C3) of docs/contact.md: the springs at the end of the step, for the contacts the last
+  // compute found (the neighbour lists and local indices have not changed since). A sliding
+  // contact, or one without friction (kt = 0 or mu_s = 0), has only its normal spring implicit: its
+  // tangential force stays the explicit Coulomb force of the compute.
+  pairs.clear();
+  walls.clear();
+  if (!implicitContact()) return;
+  const int *tag = atom->tag;
+  double R[144], term[6];
+  for (const Contact &c : contacts_) {
+    const double kt = c.sticks && mu_ > 0 ? kt_ : 0.0;
+    if (c.j >= 0) {
+      fdm::contact::pairSpringBlock(c.n, c.leverI, c.leverJ, kn_, kt, c1 * dt, R);
+      pairs.push_back(tag[c.i]);
+      pairs.push_back(tag[c.j]);
+      pairs.insert(pairs.end(), R, R + 144);
+      pairs.insert(pairs.end(), c.branch, c.branch + 3);
+      pairs.push_back(c.weight);
+    } else {
+      const Wall &w = walls_[size_t(-1 - c.j)];
+      fdm::contact::wallSpringBlock(c.n, c.leverI, kn_, kt, c1 * dt, dt, w.velocity, R, term);
+      walls.push_back(tag[c.i]);
+      walls.insert(walls.end(), R, R + 36);
+      walls.insert(walls.end(), term, term + 6);
+      walls.insert(walls.end(), c.branch, c.branch + 3);
     }
   }
 }

@@ -5,10 +5,13 @@
    Syntax (docs/dem.md):
      pair_style fdm/subgrid [lubrication yes|no] [cutoff k] [wall_cutoff k] [contact kn kt mu_s h_r]
                             [wall FACE ux uy uz] ... [unstable_step error|warn]
+                            [contact_integration implicit|explicit]
      pair_coeff * *
 
    The contact forces go into f and torque at every force evaluation, like any LIGGGHTS pair style
-   (they enter F^c of Eq. 32). The sub-grid blocks are not forces: they are the matrix R^SG of
+   (they enter F^c of Eq. 32). With contact_integration implicit (the default) the springs are also
+   taken into Eq. (31) at the end of the step (contact_springs.h, docs/contact.md 2b): the fix asks
+   for their blocks (collectSpringBlocks) and adds the implicit part of the force after the solve. The sub-grid blocks are not forces: they are the matrix R^SG of
    Eq. (31), which fix fdm/couple solves implicitly. The fix asks for them once per time step
    (collectBlocks); the viscosity and mesh size are those the fluid solver announced at the
    handshake, asked of the coupling session (coupling_session.h), which also says which box faces
@@ -54,6 +57,12 @@ class PairFdmSubgrid : public Pair {
   // the records of fdm::subgrid (particle_velocity_system.h), with their stress rows if withStress.
   void collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls);
 
+  // The implicit contact springs of the last compute (records of fdm::springs, particle_velocity_system.h):
+  // R_c = c1 dt B^T K B (Eq. C3 of docs/contact.md) with c1 the weight of U_{n+1} in the next
+  // position update (3/2 ab2, 1 euler). Each contact once (the side of the lower tag keeps it).
+  void collectSpringBlocks(double c1, double dt, std::vector<double> &pairs, std::vector<double> &walls) const;
+  bool implicitContact() const { return contactActive() && implicit_; }
+
   bool lubricationActive() const { return lubrication_ && model_; }
   bool contactActive() const { return hr_ > 0; }
   double roughness() const { return hr_; }
@@ -81,7 +90,8 @@ class PairFdmSubgrid : public Pair {
   void fluidParameters();
   void contactForces();
   void wallContactForces();
-  void contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
+  // returns true if the contact slides (its tangential force at the Coulomb cap)
+  bool contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
                   double force[3], double nxft[3]) const;
   void addContactStress(int i, const double force[3], const double branch[3], double weight);
   std::string wallName(const Wall &w) const;
@@ -96,6 +106,7 @@ class PairFdmSubgrid : public Pair {
   double cutoffCells_, wallCutoffCells_;
   double kn_, kt_, mu_, hr_;
   bool unstableStepIsError_;   // unstable_step error (default) | warn
+  bool implicit_;              // contact_integration implicit (default) | explicit
   std::vector<Wall> walls_;
 
   // from the fluid solver at the handshake (coupling session)
@@ -112,6 +123,13 @@ class PairFdmSubgrid : public Pair {
   long contactsLast_;
   bool reported_;
   double checkedTimeStep_;     // the time step last checked (checked again if it changes)
+  // the contacts of the last compute, for the implicit spring blocks (local index j, or -1 - wall)
+  struct Contact {
+    int i, j;
+    double n[3], leverI, leverJ, branch[3], weight;
+    bool sticks;
+  };
+  std::vector<Contact> contacts_;
 };
 
 }  // namespace LAMMPS_NS

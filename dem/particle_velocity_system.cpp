@@ -23,6 +23,7 @@ struct ParticleVelocitySystem::Matrices {
   std::vector<int> diagonalIndex;       // position of entry (k, k) in matrix.valuePtr()
   std::vector<double> subgridDiagonal;  // R^SG(k, k)
   Eigen::VectorXd wallRhs;              // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
+  Eigen::VectorXd springRhs;            // known part of the implicit springs: gamma R_c U_n + dt B^T K U_w (Eq. C2)
   Eigen::VectorXd diagonal;             // (rho_f/rho_p) J/alpha_lambda of this step
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
@@ -32,7 +33,7 @@ struct ParticleVelocitySystem::Matrices {
 };
 
 ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
-  settings_(settings), n_(0), pairRecord_(subgrid::pairRecord), wallRecord_(subgrid::wallRecord), pairBlocks_(0),
+  settings_(settings), n_(0), springGamma_(0), pairRecord_(subgrid::pairRecord), wallRecord_(subgrid::wallRecord), pairBlocks_(0),
   wallBlocks_(0), iterations_(0), factorisations_(0), m_(new Matrices)
 {
   if (!(settings_.alphaLambda > 0) || !(settings_.rhoFluid > 0) || !(settings_.tolerance > 0))
@@ -57,6 +58,12 @@ int ParticleVelocitySystem::tagIndex(double tag) const
 void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vector<double> pairs,
                                       std::vector<double> walls)
 {
+  assemble(std::move(particles), std::move(pairs), std::move(walls), Springs());
+}
+
+void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vector<double> pairs,
+                                      std::vector<double> walls, Springs springs)
+{
   // R^SG once per time step (paper section 4.4.2): the positions do not move during the inner iterations
   const int N = int(particles.size());
   if (N != n_) u_.assign(size_t(6) * N, 0.0);
@@ -64,6 +71,18 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   particles_.swap(particles);
   pairs_.swap(pairs);
   walls_.swap(walls);
+  springPairs_.swap(springs.pairs);
+  springWalls_.swap(springs.walls);
+  springPrevious_.swap(springs.previous);
+  springGamma_ = springs.gamma;
+  if (springPairs_.size() % springs::pairRecord != 0 || springWalls_.size() % springs::wallRecord != 0)
+    throw Error(Error::badBlock, -1, "pair fdm/subgrid sent " + std::to_string(springPairs_.size()) + " pair and " +
+                                     std::to_string(springWalls_.size()) + " wall contact-spring values, not whole "
+                                     "records of " + std::to_string(springs::pairRecord) + " and " +
+                                     std::to_string(springs::wallRecord));
+  if (springGamma_ != 0 && springPrevious_.size() != size_t(6) * N)
+    throw Error(Error::badBlock, -1, "the implicit contact springs need U_n of " + std::to_string(N) +
+                                     " particles, got " + std::to_string(springPrevious_.size()) + " values");
   if (pairs_.size() % pairRecord_ != 0 || walls_.size() % wallRecord_ != 0)
     throw Error(Error::badBlock, -1, "pair fdm/subgrid sent " + std::to_string(pairs_.size()) + " pair and " +
                                      std::to_string(walls_.size()) + " wall block values, not whole records of " +
@@ -103,6 +122,42 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
     for (int i = 0; i < 6; i++) {
       for (int j = 0; j < 6; j++) triplets.push_back(Eigen::Triplet<double>(base + i, base + j, R[6 * i + j]));
       m.wallRhs(base + i) += rhs[i];  // F = -R_w (U - U_w, Omega): the wall velocity is a force
+    }
+  }
+  // the implicit contact springs (Eqs. C2, C3): R_c into the matrix, gamma R_c U_n + wall term into F^tot
+  m.springRhs = Eigen::VectorXd::Zero(6 * N);
+  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord) {
+    const double *rec = &springPairs_[b];
+    const int i1 = tagIndex(rec[0]), i2 = tagIndex(rec[1]);
+    const int base[2] = {6 * i1, 6 * i2};
+    const double *R = rec + 2;
+    for (int k = 0; k < springs::pairRecord - 2; k++)
+      if (!std::isfinite(R[k]))
+        throw Error(Error::badBlock, i1, "pair fdm/subgrid sent a non-finite contact-spring block for particles " +
+                                         particleId(i1) + " and " + particleId(i2) + " at " + point(particles_[i1].x) +
+                                         " and " + point(particles_[i2].x));
+    for (int i = 0; i < 12; i++)
+      for (int j = 0; j < 12; j++) {
+        const double r = R[12 * i + j];
+        triplets.push_back(Eigen::Triplet<double>(base[i / 6] + i % 6, base[j / 6] + j % 6, r));
+        if (springGamma_ != 0)
+          m.springRhs(base[i / 6] + i % 6) += springGamma_ * r * springPrevious_[size_t(base[j / 6] + j % 6)];
+      }
+  }
+  for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord) {
+    const double *rec = &springWalls_[b];
+    const int p = tagIndex(rec[0]), base = 6 * p;
+    const double *R = rec + 1, *term = rec + 37;
+    for (int k = 0; k < springs::wallRecord - 1; k++)
+      if (!std::isfinite(R[k]))
+        throw Error(Error::badBlock, p, "pair fdm/subgrid sent a non-finite contact-spring wall block for particle " +
+                                        particleId(p) + " at " + point(particles_[p].x));
+    for (int i = 0; i < 6; i++) {
+      for (int j = 0; j < 6; j++) {
+        triplets.push_back(Eigen::Triplet<double>(base + i, base + j, R[6 * i + j]));
+        if (springGamma_ != 0) m.springRhs(base + i) += springGamma_ * R[6 * i + j] * springPrevious_[size_t(base + j)];
+      }
+      m.springRhs(base + i) += term[i];
     }
   }
   m.matrix.resize(6 * N, 6 * N);
@@ -190,7 +245,7 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
       rhs(6 * p + 3 + d) = fluidForces[size_t(6) * p + 3 + d] + q.torque[d];
     }
   }
-  rhs += m.wallRhs;
+  rhs += m.wallRhs + m.springRhs;
 
   Eigen::VectorXd u;
   if (settings_.solver == ldlt) {
@@ -237,8 +292,59 @@ std::vector<double> ParticleVelocitySystem::subgridForces() const
   // -(R^SG u - wall term): the whole matrix times u, less its fluid diagonal
   const Matrices &m = *m_;
   const Eigen::Map<const Eigen::VectorXd> u(u_.data(), 6 * n_);
-  const Eigen::VectorXd forces = m.wallRhs - m.matrix * u + m.diagonal.cwiseProduct(u);
+  Eigen::VectorXd forces = m.wallRhs - m.matrix * u + m.diagonal.cwiseProduct(u);
+  // less the implicit springs' part of the matrix (contact forces, not sub-grid ones)
+  const std::vector<double> springs = springForces();
+  for (int k = 0; k < 6 * n_; k++) forces(k) -= springs[size_t(k)] - m.springRhs(k);
   return std::vector<double>(forces.data(), forces.data() + forces.size());
+}
+
+std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *stresslets) const
+{
+  // Eq. (C2): -R_c (u - gamma U_n) + dt B^T K U_w per contact; the stresslet of Eq. (52) of that force
+  std::vector<double> out(size_t(6) * n_, 0.0);
+  if (stresslets && stresslets->size() != size_t(6) * n_)
+    throw Error(Error::notSolved, -1, "contact stresslets: " + std::to_string(stresslets->size()) + " values for " +
+                                      std::to_string(n_) + " particles (6 each)");
+  static const int comp[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  auto addStress = [&](int p, const double *force, const double *branch, double weight) {
+    if (!stresslets) return;
+    for (int c = 0; c < 6; c++) {
+      const int a = comp[c][0], b = comp[c][1];
+      (*stresslets)[size_t(6) * p + c] += 0.5 * weight * (force[a] * branch[b] + branch[a] * force[b]);
+    }
+  };
+  auto velocity = [&](int k) {
+    return u_[size_t(k)] - (springGamma_ != 0 ? springGamma_ * springPrevious_[size_t(k)] : 0.0);
+  };
+  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord) {
+    const double *rec = &springPairs_[b];
+    const int p[2] = {int(std::lround(rec[0])) - 1, int(std::lround(rec[1])) - 1};
+    const double *R = rec + 2, *branch = rec + 146, weight = rec[149];
+    double w[12], f[12];
+    for (int k = 0; k < 12; k++) w[k] = velocity(6 * p[k / 6] + k % 6);
+    for (int i = 0; i < 12; i++) {
+      f[i] = 0;
+      for (int j = 0; j < 12; j++) f[i] -= R[12 * i + j] * w[j];
+      out[size_t(6) * p[i / 6] + i % 6] += f[i];
+    }
+    // x_j - x_i from particle 1; from particle 2 the branch and the force both change sign
+    addStress(p[0], f, branch, weight);
+    addStress(p[1], f, branch, 1.0 - weight);
+  }
+  for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord) {
+    const double *rec = &springWalls_[b];
+    const int p = int(std::lround(rec[0])) - 1;
+    const double *R = rec + 1, *term = rec + 37, *branch = rec + 43;
+    double f[6];
+    for (int i = 0; i < 6; i++) {
+      f[i] = term[i];
+      for (int j = 0; j < 6; j++) f[i] -= R[6 * i + j] * velocity(6 * p + j);
+      out[size_t(6) * p + i] += f[i];
+    }
+    addStress(p, f, branch, 1.0);
+  }
+  return out;
 }
 
 void ParticleVelocitySystem::addSubgridStresslets(std::vector<double> &stresslets) const

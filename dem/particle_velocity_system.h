@@ -40,6 +40,16 @@ const int wallRecord = 1 + 36 + 6;
 const int wallStressRecord = 7 * 6 + 7;
 }  // namespace subgrid
 
+// The records of the implicit contact springs (contact_springs.h, docs/contact.md 2b), built by
+// pair_style fdm/subgrid with contact_integration implicit: R_c of Eq. (C3) enters the matrix, its
+// known part (Eq. C2) the right-hand side; they are kept apart from R^SG in the outputs.
+namespace springs {
+// pair: [tag1, tag2, R_c (12 x 12), branch x2 - x1 (3), weight a1/(a1 + a2) of Eq. (52)]
+const int pairRecord = 2 + 144 + 4;
+// wall: [tag, R_c (6 x 6), wall-velocity term dt B^T K U_w (6), branch from the centre to the wall (3)]
+const int wallRecord = 1 + 36 + 6 + 3;
+}  // namespace springs
+
 class ParticleVelocitySystem {
  public:
   enum Solver { ldlt, cg };
@@ -76,8 +86,19 @@ class ParticleVelocitySystem {
   explicit ParticleVelocitySystem(const Settings &settings);
   ~ParticleVelocitySystem();
 
-  // Once per time step: the particles and R^SG from the gathered block records (layouts above).
-  // The last solution stays the warm start unless the number of particles changed.
+  // The implicit contact springs of a step (Eqs. C2, C3 of docs/contact.md): their records (layouts
+  // above) and U_n with its weight gamma (1/3 with ab2, 0 with euler) in the known part.
+  struct Springs {
+    std::vector<double> pairs, walls;
+    std::vector<double> previous;      // 6N: U_n by tag (may be empty if gamma = 0)
+    double gamma = 0;
+  };
+
+  // Once per time step: the particles and R^SG from the gathered block records (layouts above),
+  // and the implicit contact springs if any. The last solution stays the warm start unless the
+  // number of particles changed.
+  void assemble(std::vector<Particle> particles, std::vector<double> pairs, std::vector<double> walls,
+                Springs springs);
   void assemble(std::vector<Particle> particles, std::vector<double> pairs, std::vector<double> walls);
   // Once per time step, after assemble(): Vu and Ju of every particle (Eq. 31's diagonal). Factorises
   // (ldlt) or sets up the preconditioner (cg) if the diagonal changed since the last call.
@@ -101,6 +122,11 @@ class ParticleVelocitySystem {
   // After the last solve: adds the sub-grid stresslets S^SG = -rows u (+ wall term) (Eq. 13) to
   // `stresslets`, 7 per particle (S xx xy xz yy yz zz, s). Needs Settings::stresslets.
   void addSubgridStresslets(std::vector<double> &stresslets) const;
+  // After the last solve: the implicit part of the contact forces, -R_c (u - gamma U_n) + wall term
+  // (Eq. C2), 6 per particle (F, T; 0 without springs), and its contact stresslet (Eq. 52, 6 per
+  // particle: xx xy xz yy yz zz) added to `stresslets` if not null.
+  std::vector<double> springForces(std::vector<double> *stresslets = nullptr) const;
+  long springBlocks() const { return long(springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord); }
 
  private:
   int tagIndex(double tag) const;
@@ -110,6 +136,8 @@ class ParticleVelocitySystem {
   int n_;
   std::vector<Particle> particles_;
   std::vector<double> pairs_, walls_;  // the block records of this step
+  std::vector<double> springPairs_, springWalls_, springPrevious_;  // implicit contact springs of this step
+  double springGamma_;
   int pairRecord_, wallRecord_;
   long pairBlocks_, wallBlocks_;
   std::vector<double> Vu_, Ju_;        // of this step, for the messages

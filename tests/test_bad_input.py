@@ -263,9 +263,9 @@ PAIR_BOX = case.Box((0, 0, 0), (6, 4, 4), 0.5)
 
 
 def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
-    """kn = 1e6 N/m, dt = 1 s: beyond dt k/zeta < 1 (ab2) even with the largest resistance a contact
+    """Explicit springs, kn = 1e6 N/m, dt = 1 s: beyond dt k/zeta < 1 (ab2) even with the largest resistance a contact
     can have: an error at the start, with the limit and how it was computed; both codes stop."""
-    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 0 0.5 0.01")
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 0 0.5 0.01 contact_integration explicit")
     status, out, wall = run_fdm(root, env)
     assert status != 0
     dem = open(os.path.join(root, "log.dem"), errors="replace").read()
@@ -280,9 +280,9 @@ def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
 
 
 def test_time_step_beyond_contact_stability_at_the_contact_gap(tmp_path, env):
-    """kn = 1e4 N/m, dt = 1 s: beyond the limit at h_r (~0.05 s), within it for contacts pressed
+    """Explicit springs, kn = 1e4 N/m, dt = 1 s: beyond the limit at h_r (~0.05 s), within it for contacts pressed
     deeper (~50 s at zero gap): a warning, and the run goes on."""
-    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e4 0 0.5 0.01",
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e4 0 0.5 0.01 contact_integration explicit",
                      runs=("run 1",))
     status, out, wall = run_fdm(root, env)
     assert status == 0, out
@@ -301,3 +301,17 @@ def test_particles_too_small_for_the_mesh(tmp_path, env):
     assert re.search(r"WARNING: pair_style fdm/subgrid: particle radius over mesh size a/Delta from 1 to 1 \(radii "
                      r"0.5 .. 0.5 m, Delta 0.5 m\) is outside the range the cut-off sub-grid model covers, a/Delta "
                      r"2 .. 20", dem), dem[-3000:]
+
+
+def test_time_step_beyond_explicit_limit_with_implicit_springs(tmp_path, env):
+    """The same kn = 1e6 N/m, dt = 1 s with the implicit springs (the default): no error, a note of
+    how far beyond the explicit springs' limit the step is, and the run goes on."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 0 0.5 0.01",
+                     runs=("run 1",))
+    status, out, wall = run_fdm(root, env)
+    assert status == 0, out
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    m = re.search(r"pair fdm/subgrid: time step 1 s is (\S+) times the explicit springs' stability limit (\S+) s \(the "
+                  r"normal spring of two spheres at the contact gap h_r\): stable with the implicit springs", dem)
+    assert m and float(m.group(1)) > 1000 and 1e-4 < float(m.group(2)) < 1e-3, dem[-3000:]
+    assert "ERROR" not in dem and "WARNING: pair_style fdm/subgrid: time step" not in dem

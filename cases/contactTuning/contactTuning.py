@@ -98,6 +98,8 @@ def run_scene(scene, variables, workdir, name=None, timeout=900):
     os.makedirs(run_dir)
     out = scene + ".dat"
     cmd = [fdmdem(), "-in", os.path.join(HERE, "in." + scene)]
+    # the sections of docs/contact.md 3a-3c measure the explicit springs unless asked otherwise
+    variables = dict(dict(cint="explicit"), **variables)
     for key, v in dict(variables, out=out).items():
         cmd += ["-var", key, _value(v)]
     with open(os.path.join(run_dir, "command"), "w") as f:
@@ -202,9 +204,10 @@ class Resistance:
             M = M + np.array(out["R"])
         n = np.array([-1.0, 0.0, 0.0])     # from sphere 2 to sphere 1 (the pair style's n for i = 1)
         t = np.array([0.0, 1.0, 0.0])
-        load = np.concatenate([t, np.cross(-a * n, t), -t, np.cross(a * n, -t)])
+        lever = a + 0.5 * gap                # the contact point in the middle of the gap (docs/contact.md 2)
+        load = np.concatenate([t, np.cross(-lever * n, t), -t, np.cross(lever * n, -t)])
         u = np.linalg.solve(M, load)
-        slip = u[0:3] - u[6:9] - np.cross(a * u[3:6] + a * u[9:12], n)
+        slip = u[0:3] - u[6:9] - np.cross(lever * u[3:6] + lever * u[9:12], n)
         return 1.0 / float(slip @ t)
 
     def table(self, kind, lubrication, points=40, jobs=2):
@@ -282,6 +285,12 @@ def amplification_theory(r, integrator):
         return abs(1 - r)
     roots = np.roots([1.0, -(1 - 1.5 * r), -0.5 * r])
     return float(max(abs(roots)))
+
+
+def implicit_factor(r, integrator):
+    """Growth factor per step of the linearised contact with implicit springs (docs/contact.md 3c,
+    Eq. C4): (1 + r/2)/(1 + 3r/2) with ab2, 1/(1 + r) with euler; below 1 at every r, no oscillation."""
+    return (1 + 0.5 * r) / (1 + 1.5 * r) if integrator == "ab2" else 1.0 / (1 + r)
 
 
 def limit_factor(integrator):
@@ -439,7 +448,7 @@ def normal_sweep(res, workdir, full, jobs, integrator):
 # ---------------------------------------------------------------------------------------------
 
 def sliding_run(res, workdir, ratio, integrator="ab2", lubrication=True, Fn=LOAD, kt=None, r_target=0.25, steps=400,
-                p=BASE):
+                p=BASE, cint="explicit"):
     """Ft = ratio mu_s Fn per contact."""
     kn, kt, mu, hr = p["kn"], kt or p["kt"], p["mu"], p["hr"]
     Ft = ratio * mu * Fn
@@ -447,7 +456,7 @@ def sliding_run(res, workdir, ratio, integrator="ab2", lubrication=True, Fn=LOAD
     zeta_t = res.zeta_sandwich_tangential(g_w, lubrication)
     dt = r_target * zeta_t / (2 * kt)
     variables = dict(kn=kn, kt=kt, mu=mu, hr=hr, Fn=Fn, Ft=Ft, dt=dt, steps=steps, a=p["a"], eta=p["eta"],
-                     delta=p["delta"], lub="yes" if lubrication else "no", integ=integrator)
+                     delta=p["delta"], lub="yes" if lubrication else "no", integ=integrator, cint=cint)
     r = run_scene("sliding", variables, workdir)
     out = dict(ratio=ratio, Ft=Ft, Fn=Fn, mu=mu, kt=kt, dt=dt, integrator=integrator, lubrication=lubrication,
                zeta_t=zeta_t, ok=r["ok"])
@@ -537,9 +546,10 @@ class StabilityConfig:
     """A steady contact perturbed a little, run at a given dt; `mode` is 'normal' (gap) or
     'tangential' (stuck spring between two walls)."""
 
-    def __init__(self, res, name, geometry, lubrication, integrator, p=BASE):
+    def __init__(self, res, name, geometry, lubrication, integrator, p=BASE, cint="explicit"):
         self.res, self.name, self.geometry, self.lubrication, self.integrator, self.p = (
             res, name, geometry, lubrication, integrator, p)
+        self.cint = cint
         self.kn, self.kt, self.hr = p["kn"], p["kt"], p["hr"]
         if geometry == "tangential":
             self.Fn = LOAD
@@ -571,7 +581,8 @@ class StabilityConfig:
     def run(self, workdir, dt, steps=400):
         p = self.p
         common = dict(kn=self.kn, kt=self.kt, mu=p["mu"], hr=self.hr, dt=dt, steps=steps, a=p["a"], eta=p["eta"],
-                      delta=p["delta"], lub="yes" if self.lubrication else "no", integ=self.integrator)
+                      delta=p["delta"], lub="yes" if self.lubrication else "no", integ=self.integrator,
+                      cint=self.cint)
         if self.geometry == "tangential":
             r = run_scene("sliding", dict(common, Fn=self.Fn, Ft=self.Ft), workdir)
         elif self.geometry == "pair_tangential":
@@ -608,7 +619,8 @@ class StabilityConfig:
             else:
                 out["zeta_from_outputs"] = float(-(d[0, 4] + d[0, 5]) / d[0, 2])
         out.update(c)
-        out["factor_theory"] = amplification_theory(out["r"], self.integrator)
+        out["factor_theory"] = (implicit_factor(out["r"], self.integrator) if self.cint == "implicit"
+                                else amplification_theory(out["r"], self.integrator))
         return out
 
     def find_limit(self, workdir, rel_tol=0.01, steps=400):
@@ -692,6 +704,122 @@ def stability_study(res, workdir, full, jobs):
             r["config"] = "pair, no lubrication"
         grid += runs
     return dict(limits=limits, grid=grid, bisection_tolerance=tolerance)
+
+
+# ---------------------------------------------------------------------------------------------
+# (d) implicit springs (contact_integration implicit, docs/contact.md 2b and 3c)
+# ---------------------------------------------------------------------------------------------
+
+def implicit_stability(res, workdir, jobs, multiples=(10, 100, 1000)):
+    """The scenes of the stability study (ab2; the pair also euler) run with implicit springs at
+    `multiples` times their explicit limit, and with explicit springs at 10 times it."""
+    configs = []
+    for cint in ("implicit", "explicit"):
+        configs += [StabilityConfig(res, "pair, lubrication", "pair", True, "ab2", cint=cint),
+                    StabilityConfig(res, "pair, lubrication", "pair", True, "euler", cint=cint),
+                    StabilityConfig(res, "pair, no lubrication", "pair", False, "ab2", cint=cint),
+                    StabilityConfig(res, "wall, lubrication", "wall", True, "ab2", cint=cint),
+                    StabilityConfig(res, "tangential (two walls), lubrication", "tangential", True, "ab2", cint=cint),
+                    StabilityConfig(res, "pair tangential, lubrication", "pair_tangential", True, "ab2", cint=cint)]
+    # the free pair, loaded along a fixed direction, buckles: once the kick has tilted the line of
+    # centres the spheres roll on each other (growth ~0.22/s here, the same with explicit springs at
+    # a small dt): its tangential spring is judged over the physical time of the explicit runs only
+    jobs_list = [(c, m) for c in configs
+                 for m in (multiples if c.cint == "implicit" and c.geometry != "pair_tangential" else (10,))]
+
+    def one(item):
+        c, m = item
+        steps = 40 if c.geometry == "pair_tangential" else 400
+        out = c.run(workdir, m * c.dt_estimate, steps)
+        out.update(name=c.name, geometry=c.geometry, integrator=c.integrator, cint=c.cint, multiple=m,
+                   dt_explicit_limit=c.dt_estimate)
+        return out
+    return parallel(jobs, one, jobs_list)
+
+
+def implicit_equilibrium(res, workdir, jobs, multiple=10):
+    """Loaded contacts run to their steady state at `multiple` times the explicit limit of the
+    normal spring at the steady gap (zeta(h_ss)/kn, ab2): the steady gap h_r - F/kn, the contact
+    force, F1 + F2 = 0 at every step."""
+    p = BASE
+    cases = [dict(geometry="pair", kn=2000.0, lubrication=True),
+             dict(geometry="wall", kn=2000.0, lubrication=True),
+             dict(geometry="pair", kn=2000.0 / 3.0, lubrication=False),    # overlap of h_r/2
+             # overlap with the frozen lubrication (tau = 707 s): from inside the roughness layer (an
+             # approach from 0.05 a at this dt would move the spheres by ~1000 m in the first step)
+             dict(geometry="pair", kn=2000.0 / 3.0, lubrication=True, gap0=0.005),
+             # 100 times stiffer (F/kn = h_r/200) at the explicit limit of kn = 2000 N/m: 200 times its own
+             dict(geometry="pair", kn=2e5, lubrication=True, dt=0.4646754831724052)]
+
+    def one(c):
+        zeta_of = res.zeta_pair if c["geometry"] == "pair" else res.zeta_wall
+        g_ss = p["hr"] - LOAD / c["kn"]
+        zeta_ss = zeta_of(g_ss, c["lubrication"])
+        dt = c.get("dt", multiple * zeta_ss / c["kn"])
+        steps = 300
+        r = run_scene("normal" if c["geometry"] == "pair" else "wall",
+                      dict(kn=c["kn"], kt=p["kt"], mu=p["mu"], hr=p["hr"], F=LOAD, dt=dt, steps=steps,
+                           gap0=c.get("gap0", 0.05),
+                           a=p["a"], eta=p["eta"], delta=p["delta"], lub="yes" if c["lubrication"] else "no",
+                           integ="ab2", cint="implicit"), workdir)
+        out = dict(c, dt=dt, dt_explicit_limit=zeta_ss / c["kn"], gap_theory=g_ss, ok=r["ok"], steps=steps)
+        if not r["ok"]:
+            out["log"] = r["log"]
+            return out
+        d = r["data"]
+        gap = d[:, 1]
+        force = -d[-1, 4] if c["geometry"] == "pair" else d[-1, 3]
+        compression = LOAD / c["kn"]
+        out.update(gap_end=float(gap[-1]), gap_error=float((gap[-1] - g_ss) / compression),
+                   normal_force_error=float((force - LOAD) / LOAD), min_gap=float(gap.min()),
+                   force_balance=float(np.max(np.abs(d[:, 4] + d[:, 5])) / LOAD) if c["geometry"] == "pair" else None,
+                   settled_step=settle_index(gap, g_ss, 1e-6 * compression))
+        return out
+    return parallel(jobs, one, cases)
+
+
+def implicit_convergence(res, workdir, jobs, T=3.0, dts=(0.2, 0.1, 0.05, 0.025, 0.0125), dt_ref=0.0005, gap0=0.0099):
+    """Two spheres pressed together from the gap gap0 (inside the roughness layer: the spring acts
+    from the start; k_n = 2000 N/m, lubrication, ab2) over the time T (6 tau): the gap history with
+    explicit and implicit springs at several dt (all below the explicit limit 0.46 s) against an
+    explicit run at dt_ref: max |gap - gap_ref| over the common times, in F/k_n, and the order of
+    convergence from the two smallest dt."""
+    p = BASE
+    kn = p["kn"]
+
+    def run(item):
+        cint, dt = item
+        steps = int(round(T / dt))
+        r = run_scene("normal", dict(kn=kn, kt=p["kt"], mu=p["mu"], hr=p["hr"], F=LOAD, dt=dt, steps=steps, gap0=gap0,
+                                     a=p["a"], eta=p["eta"], delta=p["delta"], lub="yes", integ="ab2", cint=cint),
+                      workdir)
+        return cint, dt, r
+    runs = parallel(jobs, run, [("explicit", dt_ref)] + [(c, dt) for c in ("explicit", "implicit") for dt in dts])
+    ref = runs[0][2]["data"]
+    # the positions printed at step n are those moved in step n, with the velocities of step n - 1:
+    # step 1 still holds gap0 (the input's velocities are 0), so the time of step n is (n - 1) dt
+    t_ref, g_ref = (ref[:, 0] - 1) * dt_ref, ref[:, 1]
+    out = dict(T=T, dt_ref=dt_ref, kn=kn, gap0=gap0, runs=[])
+    for cint, dt, r in runs[1:]:
+        d = r["data"]
+        t, g = (d[:, 0] - 1) * dt, d[:, 1]
+        g_at = np.interp(t, t_ref, g_ref)
+        out["runs"].append(dict(cint=cint, dt=dt, error=float(np.max(np.abs(g - g_at)) / (LOAD / kn)),
+                                gap_end=float(g[-1])))
+    for cint in ("explicit", "implicit"):
+        e = [(x["dt"], x["error"]) for x in out["runs"] if x["cint"] == cint]
+        (d1, e1), (d2, e2) = e[-2], e[-1]
+        out["order_" + cint] = float(np.log(e1 / e2) / np.log(d1 / d2))
+    return out
+
+
+def implicit_study(res, workdir, jobs):
+    t = time.time()
+    out = dict(stability=implicit_stability(res, workdir, jobs), equilibrium=implicit_equilibrium(res, workdir, jobs),
+               convergence=implicit_convergence(res, workdir, jobs),
+               sliding=[sliding_run(res, workdir, q, cint="implicit", r_target=10.0) for q in (0.5, 1.5)])
+    out["seconds"] = time.time() - t
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -880,11 +1008,15 @@ def main(argv=None):
                    help="position update of fix fdm/couple for the normal and sliding sweeps (the stability "
                         "study runs both)")
     p.add_argument("--jobs", type=int, default=2, help="fdmDEM runs at once")
-    p.add_argument("--only", nargs="+", choices=("normal", "sliding", "stability"), default=None)
+    p.add_argument("--only", nargs="+", choices=("normal", "sliding", "stability", "implicit"), default=None,
+                   help="parts to run (default: normal sliding stability; implicit: the implicit springs, "
+                        "docs/contact.md 3c, written to results_implicit.json unless --out)")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
-    p.add_argument("--out", default=os.path.join(HERE, "results.json"))
+    p.add_argument("--out", default=None)
     args = p.parse_args(argv)
     parts = args.only or ["normal", "sliding", "stability"]
+    if args.out is None:
+        args.out = os.path.join(HERE, "results_implicit.json" if parts == ["implicit"] else "results.json")
 
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()
@@ -906,12 +1038,14 @@ def main(argv=None):
         t = time.time()
         results["stability"] = stability_study(res, args.workdir, args.full, args.jobs)
         results["stability"]["seconds"] = time.time() - t
-    if len(parts) == 3:
+    if "implicit" in parts:
+        results["implicit"] = implicit_study(res, args.workdir, args.jobs)
+    if len(parts) == 3 and "implicit" not in parts:
         results["figures"] = summarise(results)
     results["wall_seconds"] = time.time() - t0
     with open(args.out, "w") as f:
         json.dump(results, f, indent=1, default=_json_default)
-    if len(parts) == 3:
+    if len(parts) == 3 and "implicit" not in parts:
         print_report(results)
         plot(results, os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_contactTuning.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))

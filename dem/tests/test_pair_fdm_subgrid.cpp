@@ -289,7 +289,7 @@ TEST(PairFdmSubgrid, ContactForcesAreEqualOppositeAndEnterEq31)
     FakeFluid fluid(dir);
     const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
-    expectContains(run.output, "contact ON (kn 100 N/m, kt 80 N/m, mu_s 0.5, h_r 0.05 m)");
+    expectContains(run.output, "contact ON (kn 100 N/m, kt 80 N/m, mu_s 0.5, h_r 0.05 m; springs implicit in Eq. 31)");
     expectContains(run.output, "1 contacts");
     const auto rows = readDump(dir + "/c.dump", 29);
     ASSERT_EQ(rows.size(), 3u);

@@ -1,0 +1,76 @@
+// Implicit contact-spring blocks (see contact_springs.h; docs/contact.md 2b, Eqs. C1-C3).
+#include "contact_springs.h"
+
+namespace fdm {
+namespace contact {
+
+namespace {
+
+// K = kn n n^T + kt (I - n n^T)
+void stiffness(const double n[3], double kn, double kt, double K[3][3])
+{
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) K[a][b] = (kn - kt) * n[a] * n[b] + (a == b ? kt : 0.0);
+}
+
+// [n]x: the matrix of w -> n x w
+void cross(const double n[3], double C[3][3])
+{
+  C[0][0] = 0;     C[0][1] = -n[2]; C[0][2] = n[1];
+  C[1][0] = n[2];  C[1][1] = 0;     C[1][2] = -n[0];
+  C[2][0] = -n[1]; C[2][1] = n[0];  C[2][2] = 0;
+}
+
+// R = s B^T K B for B (3 x m, row-major)
+void congruence(const double *B, int m, const double K[3][3], double s, double *R)
+{
+  double KB[3][12];
+  for (int a = 0; a < 3; a++)
+    for (int c = 0; c < m; c++) KB[a][c] = K[a][0] * B[c] + K[a][1] * B[m + c] + K[a][2] * B[2 * m + c];
+  for (int r = 0; r < m; r++)
+    for (int c = 0; c < m; c++)
+      R[m * r + c] = s * (B[r] * KB[0][c] + B[m + r] * KB[1][c] + B[2 * m + r] * KB[2][c]);
+  // exactly symmetric (the products above round differently in the two triangles)
+  for (int r = 0; r < m; r++)
+    for (int c = r + 1; c < m; c++) R[m * c + r] = R[m * r + c] = 0.5 * (R[m * r + c] + R[m * c + r]);
+}
+
+}  // namespace
+
+void pairSpringBlock(const double n[3], double leverI, double leverJ, double kn, double kt, double c1dt,
+                     double R[144])
+{
+  // Eq. (C1): v_r = U_i - U_j - (l_i Omega_i + l_j Omega_j) x n = U_i + l_i n x Omega_i - U_j + l_j n x Omega_j
+  double K[3][3], C[3][3], B[36];
+  stiffness(n, kn, kt, K);
+  cross(n, C);
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) {
+      B[12 * a + b] = a == b ? 1.0 : 0.0;
+      B[12 * a + 3 + b] = leverI * C[a][b];
+      B[12 * a + 6 + b] = a == b ? -1.0 : 0.0;
+      B[12 * a + 9 + b] = leverJ * C[a][b];
+    }
+  congruence(B, 12, K, c1dt, R);
+}
+
+void wallSpringBlock(const double n[3], double lever, double kn, double kt, double c1dt, double dt,
+                     const double wallVelocity[3], double R[36], double wallTerm[6])
+{
+  double K[3][3], C[3][3], B[18];
+  stiffness(n, kn, kt, K);
+  cross(n, C);
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) {
+      B[6 * a + b] = a == b ? 1.0 : 0.0;
+      B[6 * a + 3 + b] = lever * C[a][b];
+    }
+  congruence(B, 6, K, c1dt, R);
+  // dt B^T K U_w (Eq. C2)
+  double f[3];
+  for (int a = 0; a < 3; a++) f[a] = dt * (K[a][0] * wallVelocity[0] + K[a][1] * wallVelocity[1] + K[a][2] * wallVelocity[2]);
+  for (int r = 0; r < 6; r++) wallTerm[r] = B[r] * f[0] + B[6 + r] * f[1] + B[12 + r] * f[2];
+}
+
+}  // namespace contact
+}  // namespace fdm

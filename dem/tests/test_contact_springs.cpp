@@ -1,0 +1,287 @@
+// Tests of the implicit contact-spring blocks (contact_springs.h, docs/contact.md 2b, Eqs. C1-C4) and
+// of their place in Eq. (31) (particle_velocity_system.h): symmetric positive semi-definite,
+// frame-invariant, no force for a rigid motion of the pair, the block times u equal to the spring
+// force of the contact points' relative velocity as the contact law has it, and the overdamped
+// spring stepped through Eq. (31) decaying by the factor of Eq. (C4) at any dt.
+#include "contact_springs.h"
+#include "particle_velocity_system.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <random>
+
+using fdm::ParticleVelocitySystem;
+namespace contact = fdm::contact;
+namespace springs = fdm::springs;
+
+namespace {
+
+typedef Eigen::Matrix<double, 12, 12, Eigen::RowMajor> Matrix12;
+typedef Eigen::Matrix<double, 6, 6, Eigen::RowMajor> Matrix6;
+
+Eigen::Vector3d randomUnit(std::mt19937 &rng)
+{
+  std::normal_distribution<double> g;
+  Eigen::Vector3d n(g(rng), g(rng), g(rng));
+  return n.normalized();
+}
+
+Eigen::Matrix3d randomRotation(std::mt19937 &rng)
+{
+  std::normal_distribution<double> g;
+  Eigen::Matrix3d A;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) A(i, j) = g(rng);
+  Eigen::HouseholderQR<Eigen::Matrix3d> qr(A);
+  Eigen::Matrix3d Q = qr.householderQ();
+  if (Q.determinant() < 0) Q.col(0) *= -1;
+  return Q;
+}
+
+Matrix12 pairBlock(const Eigen::Vector3d &n, double li, double lj, double kn, double kt, double c1dt)
+{
+  Matrix12 R;
+  contact::pairSpringBlock(n.data(), li, lj, kn, kt, c1dt, R.data());
+  return R;
+}
+
+// the contact law's relative velocity of the contact points (pair_fdm_subgrid.cpp)
+Eigen::Vector3d slip(const Eigen::Vector3d &n, double li, double lj, const Eigen::Matrix<double, 12, 1> &u)
+{
+  const Eigen::Vector3d Ui = u.segment<3>(0), Wi = u.segment<3>(3), Uj = u.segment<3>(6), Wj = u.segment<3>(9);
+  return Ui - Uj - (li * Wi + lj * Wj).cross(n);
+}
+
+}  // namespace
+
+TEST(ContactSprings, PairBlockIsSymmetricPositiveSemiDefiniteWithTheRankOfItsSprings)
+{
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 20; trial++) {
+    const Eigen::Vector3d n = randomUnit(rng);
+    for (double kt : {0.0, 700.0}) {
+      const Matrix12 R = pairBlock(n, 1.0, 1.4, 2e4, kt, 0.015);
+      EXPECT_EQ((R - R.transpose()).cwiseAbs().maxCoeff(), 0.0);
+      Eigen::SelfAdjointEigenSolver<Matrix12> eig(R);
+      const double largest = eig.eigenvalues().maxCoeff();
+      EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * largest);
+      int rank = 0;
+      for (int k = 0; k < 12; k++) rank += eig.eigenvalues()(k) > 1e-10 * largest;
+      EXPECT_EQ(rank, kt > 0 ? 3 : 1);  // one spring per direction of the contact point's slip
+    }
+  }
+}
+
+TEST(ContactSprings, PairBlockIsFrameInvariant)
+{
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 20; trial++) {
+    const Eigen::Vector3d n = randomUnit(rng);
+    const Eigen::Matrix3d Q = randomRotation(rng);
+    Matrix12 P = Matrix12::Zero();
+    for (int b = 0; b < 4; b++) P.block<3, 3>(3 * b, 3 * b) = Q;
+    const Matrix12 R = pairBlock(n, 0.9, 1.3, 2e4, 300, 0.01), Rq = pairBlock(Q * n, 0.9, 1.3, 2e4, 300, 0.01);
+    EXPECT_LT((Rq - P * R * P.transpose()).cwiseAbs().maxCoeff(), 1e-12 * R.cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(ContactSprings, RigidMotionOfThePairLoadsNoSpring)
+{
+  // contact points in the middle of the gap, l = a + h/2: for gaps inside the roughness layer and
+  // overlaps alike, U = V + W x x, Omega = W gives no force at all
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (double h : {0.005, 1e-6, 0.0, -0.003}) {
+    const double ai = 1.0, aj = 1.4;
+    const Eigen::Vector3d n = randomUnit(rng), xj(u(rng), u(rng), u(rng));
+    const Eigen::Vector3d xi = xj + (ai + aj + h) * n;  // n from j to i
+    const Eigen::Vector3d V(u(rng), u(rng), u(rng)), W(u(rng), u(rng), u(rng));
+    Eigen::Matrix<double, 12, 1> rigid;
+    rigid << V + W.cross(xi), W, V + W.cross(xj), W;
+    const Matrix12 R = pairBlock(n, ai + h / 2, aj + h / 2, 2e4, 2e4, 0.01);
+    EXPECT_LT((R * rigid).cwiseAbs().maxCoeff(), 1e-12 * R.cwiseAbs().maxCoeff() * rigid.cwiseAbs().maxCoeff()) << h;
+    // a relative motion does load it
+    Eigen::Matrix<double, 12, 1> relative = rigid;
+    relative.segment<3>(0) += 1e-3 * n;
+    EXPECT_GT((R * relative).norm(), 1e-4 * R.cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(ContactSprings, BlockTimesVelocityIsTheSpringForceOfTheContactPointsSlip)
+{
+  // R u = c1 dt B^T K v_r (Eq. C3): on i the force c1 dt K v_r and the torque -l_i n x (that), on j
+  // minus the force and -l_j n x (minus the force) -- the explicit law's force and torques
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> r(-1, 1);
+  const double kn = 3e4, kt = 1e3, c1dt = 0.02, li = 1.002, lj = 1.402;
+  for (int trial = 0; trial < 10; trial++) {
+    const Eigen::Vector3d n = randomUnit(rng);
+    Eigen::Matrix<double, 12, 1> u;
+    for (int k = 0; k < 12; k++) u(k) = r(rng);
+    const Eigen::Vector3d vr = slip(n, li, lj, u);
+    const Eigen::Matrix3d K = kn * n * n.transpose() + kt * (Eigen::Matrix3d::Identity() - n * n.transpose());
+    const Eigen::Vector3d f = -c1dt * K * vr;  // the change of the spring force on i over the step
+    Eigen::Matrix<double, 12, 1> expected;
+    expected << f, -li * n.cross(f), -f, -lj * n.cross(f);  // T_j = -l_j n x (force on i), as the law has it
+    const Eigen::Matrix<double, 12, 1> got = -pairBlock(n, li, lj, kn, kt, c1dt) * u;
+    EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-11 * expected.cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(ContactSprings, WallBlockAndWallVelocity)
+{
+  // symmetric PSD; a sphere sliding steadily with the wall (U_{n+1} = U_n = U_w, no rotation) and
+  // a sphere spinning about the wall normal load no spring with ab2 (c1 = 3/2, gamma = 1/3) and euler
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> r(-1, 1);
+  const double dt = 0.01;
+  for (int trial = 0; trial < 10; trial++) {
+    const Eigen::Vector3d n = randomUnit(rng);
+    Eigen::Vector3d Uw(r(rng), r(rng), r(rng));
+    Uw -= Uw.dot(n) * n;  // in the wall's plane
+    for (double c1 : {1.5, 1.0}) {
+      const double gamma = c1 == 1.5 ? 1.0 / 3.0 : 0.0;
+      Matrix6 R;
+      Eigen::Matrix<double, 6, 1> term;
+      contact::wallSpringBlock(n.data(), 1.2, 2e4, 500, c1 * dt, dt, Uw.data(), R.data(), term.data());
+      EXPECT_EQ((R - R.transpose()).cwiseAbs().maxCoeff(), 0.0);
+      Eigen::SelfAdjointEigenSolver<Matrix6> eig(R);
+      EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff());
+      Eigen::Matrix<double, 6, 1> u;
+      u << Uw, 0.7 * n;
+      const Eigen::Matrix<double, 6, 1> force = -R * (u - gamma * u) + term;  // Eq. (C2)
+      EXPECT_LT(force.cwiseAbs().maxCoeff(), 1e-12 * R.cwiseAbs().maxCoeff()) << c1;
+    }
+  }
+}
+
+namespace {
+
+// Two spheres (Stokes drag zeta each, no rotation) pressed together by F along x, the normal
+// spring implicit, stepped as fix fdm/couple does: x_{n+1} = x_n + dt (c1 U_n + c0 U_{n-1}), the
+// explicit force at x_{n+1}, then Eq. (31) with the spring blocks. Returns the gap history.
+std::vector<double> pressedPair(double dt, double kn, double hr, double F, double zeta, int steps, bool ab2)
+{
+  ParticleVelocitySystem::Settings settings;
+  settings.alphaLambda = 1;
+  settings.rhoFluid = 1;
+  ParticleVelocitySystem system(settings);
+  double x[2] = {0, 2 + hr};  // radius 1, gap h_r: the contact starts
+  std::vector<double> U(12, 0.0), Uprev;
+  std::vector<double> gaps;
+  for (int n = 0; n < steps; n++) {
+    const bool multistep = ab2 && n >= 2;  // the first move (n = 1) is Euler, as the fix's
+    if (n > 0)
+      for (int p = 0; p < 2; p++) x[p] += dt * (multistep ? 1.5 * U[6 * p] - 0.5 * Uprev[6 * p] : U[6 * p]);
+    const double gap = x[1] - x[0] - 2;
+    gaps.push_back(gap);
+    std::vector<ParticleVelocitySystem::Particle> particles(2);
+    const double spring = gap < hr ? kn * (hr - gap) : 0.0;  // on 0 along -x
+    particles[0].force[0] = F - spring;
+    particles[1].force[0] = -F + spring;
+    for (int p = 0; p < 2; p++) {
+      particles[p].x[0] = x[p];
+      particles[p].radius = 1;
+      particles[p].mass = particles[p].density = 1;
+    }
+    ParticleVelocitySystem::Springs s;
+    const bool nextMultistep = ab2 && n > 0;
+    if (gap < hr) {
+      const double nvec[3] = {-1, 0, 0};  // from 1 to 0
+      double R[144];
+      contact::pairSpringBlock(nvec, 1 + gap / 2, 1 + gap / 2, kn, 0, (nextMultistep ? 1.5 : 1.0) * dt, R);
+      s.pairs = {1, 2};
+      s.pairs.insert(s.pairs.end(), R, R + 144);
+      s.pairs.insert(s.pairs.end(), {x[1] - x[0], 0, 0, 0.5});
+      if (nextMultistep) {
+        s.gamma = 1.0 / 3.0;
+        s.previous = U;
+      }
+    }
+    system.assemble(particles, {}, {}, s);
+    system.setVolumes({zeta, zeta}, {zeta, zeta});
+    Uprev = U;
+    U = system.solve(std::vector<double>(12, 0.0));
+  }
+  return gaps;
+}
+
+}  // namespace
+
+TEST(ContactSprings, ImplicitSpringDecaysByTheFactorOfEqC4AtAnyTimeStep)
+{
+  // zeta (dh/dt)/2 = ... : the pair's normal mode has the resistance zeta/2, so r = dt kn/(zeta/2);
+  // per step the gap error decays by (1 + r/2)/(1 + 3r/2) (ab2) or 1/(1 + r) (euler), without
+  // oscillation, for r far beyond the explicit limits (1 and 2), to the gap h_r - F/kn
+  const double kn = 2000, hr = 0.01, F = 10, zeta = 10;
+  for (bool ab2 : {true, false})
+    for (double r : {0.5, 10.0, 1000.0}) {
+      const double dt = r * 0.5 * zeta / kn;
+      const std::vector<double> gap = pressedPair(dt, kn, hr, F, zeta, 200, ab2);
+      const double target = hr - F / kn;
+      const double theory = ab2 ? (1 + r / 2) / (1 + 1.5 * r) : 1 / (1 + r);
+      int checked = 0;
+      for (int n = ab2 ? 2 : 1; n < 40; n++) {  // with ab2 after the first (Euler) move
+        const double e0 = gap[n] - target, e1 = gap[n + 1] - target;
+        if (!(std::fabs(e0) > 1e-7 * F / kn) || gap[n] >= hr) continue;  // in contact, above round-off
+        EXPECT_NEAR(e1 / e0, theory, 1e-6) << "ab2 " << ab2 << " r " << r << " step " << n;
+        checked++;
+      }
+      EXPECT_GE(checked, 2) << "ab2 " << ab2 << " r " << r;
+      EXPECT_NEAR(gap.back(), target, 1e-12 * F / kn) << "ab2 " << ab2 << " r " << r;
+    }
+}
+
+TEST(ContactSprings, SpringForcesAndStressletInEq31)
+{
+  // the system's implicit contact force equals -R_c (u - gamma U_n) + wall term, the sub-grid
+  // force does not include it, and the pair's stresslets add up to sym(f x (x2 - x1))
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> r(-1, 1);
+  ParticleVelocitySystem::Settings settings;
+  settings.alphaLambda = 0.5;
+  settings.rhoFluid = 1000;
+  ParticleVelocitySystem system(settings);
+  std::vector<ParticleVelocitySystem::Particle> particles(2);
+  for (int p = 0; p < 2; p++) {
+    particles[p].radius = 1;
+    particles[p].mass = particles[p].density = 1000;
+    for (int d = 0; d < 3; d++) particles[p].force[d] = r(rng);
+  }
+  const Eigen::Vector3d n = randomUnit(rng), branch = -2.004 * n;
+  Matrix12 R = pairBlock(n, 1.002, 1.002, 2e4, 2e3, 0.015);
+  ParticleVelocitySystem::Springs s;
+  s.pairs = {1, 2};
+  s.pairs.insert(s.pairs.end(), R.data(), R.data() + 144);
+  s.pairs.insert(s.pairs.end(), {branch(0), branch(1), branch(2), 0.5});
+  s.gamma = 1.0 / 3.0;
+  for (int k = 0; k < 12; k++) s.previous.push_back(r(rng));
+  const std::vector<double> previous = s.previous;
+  system.assemble(particles, {}, {}, s);
+  system.setVolumes({0.3, 0.4}, {0.2, 0.1});
+  std::vector<double> fluid(12);
+  for (double &f : fluid) f = r(rng);
+  const std::vector<double> u = system.solve(fluid);
+  std::vector<double> stress(12, 0.0);
+  const std::vector<double> spring = system.springForces(&stress);
+  Eigen::Map<const Eigen::Matrix<double, 12, 1> > U(u.data()), Un(previous.data());
+  const Eigen::Matrix<double, 12, 1> expected = -R * (U - Un / 3.0);
+  for (int k = 0; k < 12; k++) EXPECT_NEAR(spring[k], expected(k), 1e-12 * expected.cwiseAbs().maxCoeff());
+  // Eq. (31): diagonal u = fluid + F^c + implicit part
+  for (int k = 0; k < 12; k++) {
+    const int p = k / 6, c = k % 6;
+    const double load = fluid[k] + (c < 3 ? particles[p].force[c] : 0.0);
+    EXPECT_NEAR(system.diagonal(k) * u[k], load + spring[k], 1e-10);
+  }
+  for (double f : system.subgridForces()) EXPECT_NEAR(f, 0.0, 1e-10);
+  const Eigen::Vector3d f(spring[0], spring[1], spring[2]);
+  static const int comp[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  for (int c = 0; c < 6; c++) {
+    const int a = comp[c][0], b = comp[c][1];
+    EXPECT_NEAR(stress[c] + stress[6 + c], 0.5 * (f(a) * branch(b) + branch(a) * f(b)), 1e-12);
+    EXPECT_NEAR(stress[c], stress[6 + c], 1e-12);  // equal spheres
+  }
+}
