@@ -1,6 +1,7 @@
 // fix fdm/couple: the particle side of the coupled FDM method (Orsi, Lobry & Peters 2023, 4.2-4.4).
 // See fix_fdm_couple.h for what it does and docs/dem.md for its use.
 #include "fix_fdm_couple.h"
+#include "gather_to_root.h"
 
 #include "coupling_session.h"
 #include "message_text.h"
@@ -228,16 +229,7 @@ void FixFdmCouple::gather(std::vector<Particle> &particles)
     if (withStress)
       for (int c = 0; c < 6; c++) *b++ = pair_->contactStress(i)[c];
   }
-  const int count = int(buf.size());
-  std::vector<int> counts(comm->nprocs), displs(comm->nprocs);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
-  std::vector<double> all;
-  if (comm->me == 0) {
-    int total = 0;
-    for (int p = 0; p < comm->nprocs; p++) { displs[p] = total; total += counts[p]; }
-    all.resize(total);
-  }
-  MPI_Gatherv(buf.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+  const std::vector<double> all = fdm::gatherToRoot(buf, world);
   if (comm->me != 0) return;
   particles.assign(size_t(natoms_), Particle());
   std::vector<char> seen(size_t(natoms_), 0);

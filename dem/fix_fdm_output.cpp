@@ -1,5 +1,6 @@
 // fix fdm/output: per-particle records and ParaView files of a coupled run (fix_fdm_output.h, docs/dem.md).
 #include "fix_fdm_output.h"
+#include "gather_to_root.h"
 
 #include "coupling_session.h"
 
@@ -228,16 +229,7 @@ bool FixFdmOutput::gather(std::vector<double> &byTag)
     b[gRadius] = atom->radius[i];
     for (int c = 0; c < coupleColumns_; c++) b[gCouple + c] = couple ? couple[i][c] : 0.0;
   }
-  const int count = int(buf.size());
-  std::vector<int> counts(comm->nprocs), displs(comm->nprocs);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
-  std::vector<double> all;
-  if (comm->me == 0) {
-    int total = 0;
-    for (int p = 0; p < comm->nprocs; p++) { displs[p] = total; total += counts[p]; }
-    all.resize(total);
-  }
-  MPI_Gatherv(buf.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+  const std::vector<double> all = fdm::gatherToRoot(buf, world);
   if (comm->me != 0) return false;
   if (long(all.size()) != natoms_ * width_)
     fail(std::to_string(all.size() / width_) + " particles where the run has " + std::to_string(natoms_) +

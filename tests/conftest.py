@@ -40,6 +40,20 @@ def periodic_array():
     return load_case_module("periodicArray")
 
 
+@pytest.fixture(scope="module")
+def ct():
+    """cases/contactTuning/contactTuning.py: the DEM-only contact scenes."""
+    return load_case_module("contactTuning")
+
+
+@pytest.fixture(scope="module")
+def res(ct, tmp_path_factory):
+    """The contact modes' resistances (Stokes drag + sub-grid lubrication) at the cut-offs fdmDEM uses."""
+    cutoff, wall_cutoff = ct.probe_cutoffs(str(tmp_path_factory.mktemp("probe")))
+    p = ct.BASE
+    return ct.Resistance(p["a"], p["eta"], p["delta"], cutoff, wall_cutoff)
+
+
 def pytest_configure(config):
     config.addinivalue_line("markers", "full: full-size validation, run by ./Alltest --full only")
 

@@ -9,22 +9,10 @@ import re
 
 import pytest
 
-from conftest import load_case_module
 from fdm import case
 
 from test_bad_input import make_case, run_fdm, logs
 
-
-@pytest.fixture(scope="module")
-def ct():
-    return load_case_module("contactTuning")
-
-
-@pytest.fixture(scope="module")
-def res(ct, tmp_path_factory):
-    cutoff, wall_cutoff = ct.probe_cutoffs(str(tmp_path_factory.mktemp("probe")))
-    p = ct.BASE
-    return ct.Resistance(p["a"], p["eta"], p["delta"], cutoff, wall_cutoff)
 
 
 @pytest.mark.parametrize("name, geometry, integrator", [

@@ -7,19 +7,7 @@ import math
 
 import pytest
 
-from conftest import load_case_module
 
-
-@pytest.fixture(scope="module")
-def ct():
-    return load_case_module("contactTuning")
-
-
-@pytest.fixture(scope="module")
-def res(ct, tmp_path_factory):
-    cutoff, wall_cutoff = ct.probe_cutoffs(str(tmp_path_factory.mktemp("probe")))
-    p = ct.BASE
-    return ct.Resistance(p["a"], p["eta"], p["delta"], cutoff, wall_cutoff)
 
 
 @pytest.mark.parametrize("geometry, kn, lubrication", [
