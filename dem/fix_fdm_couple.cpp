@@ -494,7 +494,11 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
   // implicit contact springs (docs/contact.md 2b): c1 the weight of U_{n+1} in the next position
   // update (planNextMove: ab2 once a previous step exists), gamma = -c0/c1 the weight of U_n
   fdm::ParticleVelocitySystem::Springs springs;
-  const bool multistep = adamsBashforth_ && havePlan_ && haveVelocities_ && planPositions_.size() == size_t(3) * natoms_;
+  // decided on rank 0, which plans the position update (planPositions_ is rank 0's alone): every
+  // rank must build its spring blocks with the same weight
+  int multistepFlag = adamsBashforth_ && havePlan_ && haveVelocities_ && planPositions_.size() == size_t(3) * natoms_;
+  MPI_Bcast(&multistepFlag, 1, MPI_INT, 0, world);
+  const bool multistep = multistepFlag != 0;
   if (pair_ && pair_->implicitContact() && move_) {
     std::vector<double> springPairs, springWalls;
     pair_->collectSpringBlocks(multistep ? 1.5 : 1.0, update->dt, springPairs, springWalls);
