@@ -463,22 +463,6 @@ cpl::Step FixFdmCouple::makeStep(const std::vector<Particle> &particles) const
   return step;
 }
 
-namespace {
-// Gathers every rank's doubles on rank 0 (in rank order).
-void gatherOnRoot(const std::vector<double> &local, std::vector<double> &all, MPI_Comm world, int me, int nprocs)
-{
-  const int count = int(local.size());
-  std::vector<int> counts(nprocs), displs(nprocs);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
-  if (me == 0) {
-    int total = 0;
-    for (int p = 0; p < nprocs; p++) { displs[p] = total; total += counts[p]; }
-    all.assign(size_t(total), 0.0);
-  }
-  MPI_Gatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
-}
-}  // namespace
-
 void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
 {
   // Every rank builds the sub-grid blocks of its own pairs and wall gaps from its neighbour list;
@@ -489,8 +473,8 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
     pair_->collectBlocks(stresslets_, pairs, walls);
     contacts = pair_->contactsLast();
   }
-  gatherOnRoot(pairs, allPairs, world, comm->me, comm->nprocs);
-  gatherOnRoot(walls, allWalls, world, comm->me, comm->nprocs);
+  allPairs = fdm::gatherToRoot(pairs, world);
+  allWalls = fdm::gatherToRoot(walls, world);
   // implicit contact springs (docs/contact.md 2b): c1 the weight of U_{n+1} in the next position
   // update (planNextMove: ab2 once a previous step exists), gamma = -c0/c1 the weight of U_n
   fdm::ParticleVelocitySystem::Springs springs;
@@ -502,8 +486,8 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
   if (pair_ && pair_->implicitContact() && move_) {
     std::vector<double> springPairs, springWalls;
     pair_->collectSpringBlocks(multistep ? 1.5 : 1.0, update->dt, springPairs, springWalls);
-    gatherOnRoot(springPairs, springs.pairs, world, comm->me, comm->nprocs);
-    gatherOnRoot(springWalls, springs.walls, world, comm->me, comm->nprocs);
+    springs.pairs = fdm::gatherToRoot(springPairs, world);
+    springs.walls = fdm::gatherToRoot(springWalls, world);
     if (multistep) {
       springs.gamma = 1.0 / 3.0;
       springs.previous = currentVelocity_;

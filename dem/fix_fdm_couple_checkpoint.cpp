@@ -12,6 +12,7 @@
 
 #include "coupling_session.h"
 #include "fix_contact_history_fdm.h"
+#include "gather_to_root.h"
 #include "message_text.h"
 #include "pair_fdm_subgrid.h"
 
@@ -38,19 +39,9 @@ const char *prefix = "dem.";
 const int atomWidth = 14;
 
 // Every rank's records [tag, count, values...] on rank 0, by tag: values[tag - 1].
-std::vector<std::vector<double> > gatherByTag(const std::vector<double> &local, int natoms, MPI_Comm world, int me,
-                                              int nprocs)
+std::vector<std::vector<double> > gatherByTag(const std::vector<double> &local, int natoms, MPI_Comm world, int me)
 {
-  const int count = int(local.size());
-  std::vector<int> counts(nprocs), displs(nprocs);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
-  std::vector<double> all;
-  if (me == 0) {
-    int total = 0;
-    for (int p = 0; p < nprocs; p++) { displs[p] = total; total += counts[p]; }
-    all.resize(size_t(total));
-  }
-  MPI_Gatherv(local.data(), count, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+  const std::vector<double> all = fdm::gatherToRoot(local, world);
   std::vector<std::vector<double> > byTag(me == 0 ? size_t(natoms) : 0);
   for (size_t k = 0; k + 1 < all.size();) {
     const long tag = std::lround(all[k]);
@@ -99,9 +90,9 @@ void FixFdmCouple::writeCheckpoint()
       for (int k = 0; k < wallWidth; k++) walls.push_back(wallHistory->array_atom[i][k]);
     }
   }
-  const auto atomsByTag = gatherByTag(atoms, natoms_, world, comm->me, comm->nprocs);
-  const auto contactsByTag = gatherByTag(contacts, natoms_, world, comm->me, comm->nprocs);
-  const auto wallsByTag = gatherByTag(walls, natoms_, world, comm->me, comm->nprocs);
+  const auto atomsByTag = gatherByTag(atoms, natoms_, world, comm->me);
+  const auto contactsByTag = gatherByTag(contacts, natoms_, world, comm->me);
+  const auto wallsByTag = gatherByTag(walls, natoms_, world, comm->me);
 
   std::string problem;
   if (comm->me == 0) {

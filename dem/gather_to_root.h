@@ -1,6 +1,7 @@
 /* Gather variable-length blocks of doubles from every rank onto rank 0 (MPI_Gather of the counts,
-   then MPI_Gatherv), in rank order. Used by fix fdm/couple and fix fdm/output, which gather their
-   per-particle values to rank 0 and order them by tag there. */
+   then MPI_Gatherv), in rank order. Every gather of the particle side goes through it: fix
+   fdm/couple's particles and sub-grid and spring blocks (Eq. 31 is assembled on rank 0), its
+   checkpoint, and fix fdm/output's records. */
 
 #ifndef FDM_GATHER_TO_ROOT_H
 #define FDM_GATHER_TO_ROOT_H
