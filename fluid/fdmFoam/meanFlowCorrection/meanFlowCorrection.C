@@ -15,6 +15,8 @@ Foam::meanFlowCorrection::meanFlowCorrection
     grid_(grid),
     nu_(nu),
     axis_(-1),
+    uLow_(Zero),
+    uHigh_(Zero),
     lastChange_(0)
 {
     const Vector<bool>& periodic = grid.periodic();
@@ -37,9 +39,9 @@ Foam::meanFlowCorrection::meanFlowCorrection
 
     // Faces in the order xlo, xhi, ylo, yhi, zlo, zhi
     const List<labelList> facePatches = grid.boxFacePatches();
-    lowPatches_ = facePatches[2*wallAxis];
-    highPatches_ = facePatches[2*wallAxis + 1];
-    for (const labelList* face : {&lowPatches_, &highPatches_})
+    const labelList& lowPatches = facePatches[2*wallAxis];
+    const labelList& highPatches = facePatches[2*wallAxis + 1];
+    for (const labelList* face : {&lowPatches, &highPatches})
     {
         if (face->empty())
         {
@@ -54,6 +56,8 @@ Foam::meanFlowCorrection::meanFlowCorrection
         }
     }
     axis_ = wallAxis;
+    uLow_ = wallVelocity(U, lowPatches);
+    uHigh_ = wallVelocity(U, highPatches);
 
     const scalar lo = grid.bounds().min()[axis_];
     const label n = grid.nCells()[axis_];
@@ -118,22 +122,19 @@ void Foam::meanFlowCorrection::correct
     vectorField& u = U.primitiveFieldRef();
     const vectorField& l = lambda.primitiveField();
 
-    // Plane sums of u and lambda over all processors (equal cell volumes)
-    List<vector> uSum(n, Zero), lambdaSum(n, Zero);
+    // Plane sums over all processors (equal cell volumes), in one
+    // reduction: u in [0, n), lambda in [n, 2n)
+    List<vector> sums(2*n, Zero);
     forAll(u, celli)
     {
-        uSum[plane_[celli]] += u[celli];
-        lambdaSum[plane_[celli]] += l[celli];
+        sums[plane_[celli]] += u[celli];
+        sums[n + plane_[celli]] += l[celli];
     }
-    Pstream::listCombineGather(uSum, plusEqOp<vector>());
-    Pstream::listCombineScatter(uSum);
-    Pstream::listCombineGather(lambdaSum, plusEqOp<vector>());
-    Pstream::listCombineScatter(lambdaSum);
+    Pstream::listCombineGather(sums, plusEqOp<vector>());
+    Pstream::listCombineScatter(sums);
 
     const Vector<label>& nCells = grid_.nCells();
     const scalar cellsPerPlane = scalar(nCells.x())*nCells.y()*nCells.z()/n;
-    const vector uLow = wallVelocity(U, lowPatches_);
-    const vector uHigh = wallVelocity(U, highPatches_);
 
     List<vector> shift(n, Zero);
     scalar largest = 0;
@@ -146,15 +147,15 @@ void Foam::meanFlowCorrection::correct
         std::vector<double> source(n);
         for (label j = 0; j < n; ++j)
         {
-            source[j] = lambdaSum[j][d]/cellsPerPlane - gradP0OverRho[d];
+            source[j] = sums[n + j][d]/cellsPerPlane - gradP0OverRho[d];
         }
         const std::vector<double> profile = fdm::channel::solveProfile
         (
-            source, nu_, grid_.delta(), uLow[d], uHigh[d]
+            source, nu_, grid_.delta(), uLow_[d], uHigh_[d]
         );
         for (label j = 0; j < n; ++j)
         {
-            shift[j][d] = profile[j] - uSum[j][d]/cellsPerPlane;
+            shift[j][d] = profile[j] - sums[j][d]/cellsPerPlane;
             largest = max(largest, mag(shift[j][d]));
         }
     }
