@@ -51,33 +51,24 @@ def test_anderson_gives_the_plain_pair_trajectory(pair_shear):
     assert anderson["inner_iterations_mean"] < plain["inner_iterations_mean"]
 
 
-def _cold_start(run_dir, mean_flow, tol_lambda=0.0, tol_velocity=0.0, tol_solve=1e-6, n_max=2000):
-    """One free sphere (a = 1, a/Delta = 3) in a 24^3-cell channel sheared by its top wall, the flow
-    starting from rest: the first step's fluid solves and the sphere's velocities."""
-    from fdm import case
-    delta = 1.0 / 3.0
-    L = 24 * delta
-    box = case.Box((0, 0, 0), (L, L, L), delta, faces=("cyclic", ((0, 0, 0), (1.0, 0, 0)), "cyclic"))
-    case.write_fluid_case(run_dir + "/fluid", box, tol_lambda=tol_lambda, tol_velocity=tol_velocity,
-                          n_max=n_max, first_step=(tol_lambda, n_max), tol_u=tol_solve, tol_p=tol_solve,
-                          n_particles=1, mean_flow_correction=mean_flow)
-    centre = (L / 2 + 0.3 * delta, L / 2 + 0.1 * delta, L / 2 + 0.2 * delta)
-    case.write_dem_input(run_dir + "/dem", box, [centre + (1.0,)], dt=0.01,
-                         pair_style="fdm/subgrid wall ylo 0 0 0 wall yhi 1.0 0 0", runs=("run 1",),
-                         name="in.coldStart")
-    _, parts, steps = case.run_and_read(run_dir)
-    return dict(solves=int(steps["innerIterations"][0]), converged=bool(steps["converged"][0]),
-                velocities=np.array([float(parts[c][0]) for c in ("Ux", "Uy", "Uz", "Wx", "Wy", "Wz")]))
+def _cold_start(work, label, mean_flow, tol_lambda=0.0, tol_velocity=0.0, tol_solve=1e-6):
+    """scripts/benchmarkColdStart.py's scene at CI size: one free sphere (a = 1, a/Delta = 3) in a
+    24^3-cell channel sheared by its top wall, the flow starting from rest; the first step's fluid
+    solves and the sphere's velocities."""
+    import benchmarkColdStart
+    r = benchmarkColdStart.run_one(work, label, "anderson", mean_flow, tol_lambda, tol_velocity, tol_solve,
+                                   cells=24, a_over_delta=3.0, n_max=2000)
+    return dict(solves=r["inner_iterations"], converged=r["converged"], velocities=np.array(r["U"] + r["Omega"]))
 
 
 @pytest.fixture(scope="module")
 def cold_start(tmp_path_factory, env):
     work = str(tmp_path_factory.mktemp("coldStart"))
     return {
-        "tight, corrected": _cold_start(work + "/tight_mf", True, tol_lambda=1e-8, tol_solve=1e-10),
-        "tight, uncorrected": _cold_start(work + "/tight", False, tol_lambda=1e-8, tol_solve=1e-10),
-        "loose, corrected": _cold_start(work + "/loose_mf", True, tol_velocity=1e-4),
-        "loose, uncorrected": _cold_start(work + "/loose", False, tol_velocity=1e-4),
+        "tight, corrected": _cold_start(work, "tight corrected", True, tol_lambda=1e-8, tol_solve=1e-10),
+        "tight, uncorrected": _cold_start(work, "tight uncorrected", False, tol_lambda=1e-8, tol_solve=1e-10),
+        "loose, corrected": _cold_start(work, "loose corrected", True, tol_velocity=1e-4),
+        "loose, uncorrected": _cold_start(work, "loose uncorrected", False, tol_velocity=1e-4),
     }
 
 
