@@ -480,6 +480,7 @@ void PairFdmSubgrid::compute(int eflag, int vflag)
   else evflag = vflag_fdotr = 0;
   computeflag = 1;
   contactsLast_ = 0;
+  wallContactLoads_.assign(3 * walls_.size(), 0.0);
   if (contactStressRequested_) {
     if (atom->nmax > nmaxStress_) {
       nmaxStress_ = atom->nmax;
@@ -632,6 +633,7 @@ void PairFdmSubgrid::wallContactForces()
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];
+        wallContactLoads_[3 * k + d] -= force[d];
       }
       if (contactStressRequested_) {
         const double branch[3] = {-h * n[0], -h * n[1], -h * n[2]};
@@ -642,10 +644,12 @@ void PairFdmSubgrid::wallContactForces()
   }
 }
 
-void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls)
+void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls,
+                                   std::vector<double> *wallIndex)
 {
   pairs.clear();
   walls.clear();
+  if (wallIndex) wallIndex->clear();
   if (!lubricationActive()) return;
   double **x = atom->x;
   const double *radius = atom->radius;
@@ -669,7 +673,8 @@ void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, 
     }
   }
   res::WallBlock wallBlock;
-  for (const Wall &w : walls_) {
+  for (size_t k = 0; k < walls_.size(); k++) {
+    const Wall &w = walls_[k];
     double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};  // normal into the wall (Appendix A.2)
     point[w.axis] = w.side == 0 ? domain->boxlo[w.axis] : domain->boxhi[w.axis];
     normal[w.axis] = w.side == 0 ? -1.0 : 1.0;
@@ -678,6 +683,7 @@ void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, 
       double rhs[6], stressRhs[7];
       res::wallVelocityTerm(wallBlock, w.velocity, rhs, stressRhs);
       walls.push_back(tag[i]);
+      if (wallIndex) wallIndex->push_back(double(k));
       walls.insert(walls.end(), &wallBlock.R[0][0], &wallBlock.R[0][0] + 36);
       walls.insert(walls.end(), rhs, rhs + 6);
       if (withStress) {

@@ -241,6 +241,22 @@ std::vector<double> ParticleVelocitySystem::subgridForces() const
   return std::vector<double>(forces.data(), forces.data() + forces.size());
 }
 
+std::vector<double> ParticleVelocitySystem::wallBlockForces() const
+{
+  std::vector<double> forces(size_t(6) * wallBlocks_, 0.0);
+  for (long b = 0; b < wallBlocks_; b++) {
+    const double *rec = &walls_[size_t(b) * wallRecord_];
+    const int p = int(std::lround(rec[0])) - 1;
+    const double *R = rec + 1, *wallTerm = rec + 37;  // 6 x 6, then R_w[:, 0:3] U_w (6)
+    for (int row = 0; row < 6; row++) {
+      double value = wallTerm[row];
+      for (int k = 0; k < 6; k++) value -= R[6 * row + k] * u_[size_t(6) * p + k];
+      forces[size_t(6) * b + row] = value;
+    }
+  }
+  return forces;
+}
+
 void ParticleVelocitySystem::addSubgridStresslets(std::vector<double> &stresslets) const
 {
   if (!settings_.stresslets)

@@ -98,6 +98,10 @@ class ParticleVelocitySystem {
 
   // After the last solve: F^SG, T^SG = -(R^SG u - wall term) (Eqs. 21, D.6), 6 per particle.
   std::vector<double> subgridForces() const;
+  // After the last solve: the sub-grid force and torque of each wall block on its particle,
+  // R_w[:, 0:3] U_w - R_w u_p (Eq. D.6), 6 per block in the order of the wall records given to
+  // assemble() (their sum over the blocks of a particle is the wall part of subgridForces()).
+  std::vector<double> wallBlockForces() const;
   // After the last solve: adds the sub-grid stresslets S^SG = -rows u (+ wall term) (Eq. 13) to
   // `stresslets`, 7 per particle (S xx xy xz yy yz zz, s). Needs Settings::stresslets.
   void addSubgridStresslets(std::vector<double> &stresslets) const;

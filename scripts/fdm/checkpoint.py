@@ -206,7 +206,7 @@ def truncate(case_dir, step):
     eps = 1e-9 * max(abs(t_step), 1e-300)
     summary = []
     # fdmFoam's records: by DEM step
-    for name in ("steps.dat", "particles.dat"):
+    for name in ("steps.dat", "particles.dat", "walls.dat"):
         path = os.path.join(fluid, "postProcessing", "fdm", name)
         if os.path.isfile(path):
             summary.append("%s: %d lines after step %d removed" % (name, _cut_lines(path, lambda v: v <= step + 0.5),
@@ -243,6 +243,9 @@ def truncate(case_dir, step):
                     if head == b"ITEM: TIMESTEP\n":
                         summary.append("%s: %d frames from step %d on removed" % (rel.lstrip("./"),
                                                                                   _cut_dump(path, step), step))
+                    elif head == b"# fix fdm/coupl":   # fix fdm/couple walls FILE: a line per step
+                        summary.append("%s: %d lines after step %d removed" % (
+                            rel.lstrip("./"), _cut_lines(path, lambda v: v <= step + 0.5), step))
     # checkpoints after this one (an earlier attempt's, or incomplete)
     for directory, prefix in ((os.path.join(fluid, "checkpoint"), "fluid."),
                               (os.path.join(case_dir, "dem", "checkpoint"), "dem.")):
