@@ -8,8 +8,9 @@ each code keeps its two newest.
 
     python3 -m fdm.checkpoint select CASE        the newest step both codes have complete (prints it;
                                                  says on stderr which newer ones were passed over and why)
-    python3 -m fdm.checkpoint truncate CASE STEP cut every record at STEP: fdmFoam's steps.dat and
-                                                 particles.dat and the function objects' records keep
+    python3 -m fdm.checkpoint truncate CASE STEP cut every record at STEP: fdmFoam's steps.dat,
+                                                 particles.dat, walls.dat, fix fdm/couple's walls
+                                                 file and the function objects' records keep
                                                  the steps up to STEP, the DEM's dumps the frames before
                                                  STEP (the resumed run writes STEP's frame again), and
                                                  time directories and checkpoints after STEP go
