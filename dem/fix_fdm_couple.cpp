@@ -44,7 +44,7 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), pairBlocks_(0),
-  wallBlocks_(0), contacts_(0), checkpointEvery_(0), checkpointSeconds_(0), resumed_(false)
+  wallBlocks_(0), contacts_(0), wallOut_(nullptr), checkpointEvery_(0), checkpointSeconds_(0), resumed_(false)
 {
   if (igroup != 0) error->all(FLERR, "fix fdm/couple must be applied to group all (every particle is in the fluid)");
   time_integrate = 1;
@@ -119,6 +119,10 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       checkpointEvery_ = force->inumeric(FLERR, value(1));
       if (checkpointEvery_ < 0) error->all(FLERR, "fix fdm/couple: checkpoint N needs N >= 0 steps (0: none)");
       i++;
+    } else if (key == "walls") {
+      wallFile_ = value(1);
+      if (wallFile_.empty()) error->all(FLERR, "fix fdm/couple: walls needs a file name");
+      i++;
     } else if (key == "tolerance") {
       tolerance_ = force->numeric(FLERR, value(1));
       if (!(tolerance_ > 0 && tolerance_ < 1))
@@ -152,6 +156,7 @@ FixFdmCouple::~FixFdmCouple()
 {
   session_.detach(this);
   memory->destroy(perAtom_);
+  if (wallOut_) fclose(wallOut_);
 }
 
 int FixFdmCouple::setmask()
@@ -166,6 +171,9 @@ void FixFdmCouple::init()
   atomsAtInit_ = int(atom->natoms);
   pair_ = dynamic_cast<PairFdmSubgrid *>(force->pair_match("fdm/subgrid", 1));
   if (pair_) pair_->requestContactStress(stresslets_);
+  if (!wallFile_.empty() && (!pair_ || pair_->walls().empty()))
+    error->all(FLERR, ("fix fdm/couple: walls " + wallFile_ + " needs pair_style fdm/subgrid with its walls "
+                       "(wall FACE ux uy uz): there are no walls to write the loads of").c_str());
   if (force->newton_pair) error->all(FLERR, "fix fdm/couple requires newton off");
   if (std::strcmp(update->unit_style, "si") != 0)
     error->all(FLERR, (std::string("fix fdm/couple requires units si (the fluid solver works in SI), not units ") +
@@ -467,10 +475,10 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
 {
   // Every rank builds the sub-grid blocks of its own pairs and wall gaps from its neighbour list;
   // rank 0 collects them and assembles Eq. (31) once for the step (paper section 4.4.2).
-  std::vector<double> pairs, walls, allPairs, allWalls;
+  std::vector<double> pairs, walls, allPairs, allWalls, wallIndex;
   long contacts = 0;
   if (pair_) {
-    pair_->collectBlocks(stresslets_, pairs, walls);
+    pair_->collectBlocks(stresslets_, pairs, walls, wallFile_.empty() ? nullptr : &wallIndex);
     contacts = pair_->contactsLast();
   }
   allPairs = fdm::gatherToRoot(pairs, world);
@@ -483,15 +491,28 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
   int multistepFlag = adamsBashforth_ && havePlan_ && haveVelocities_ && planPositions_.size() == size_t(3) * natoms_;
   MPI_Bcast(&multistepFlag, 1, MPI_INT, 0, world);
   const bool multistep = multistepFlag != 0;
+  springWallBlockWall_.clear();
   if (pair_ && pair_->implicitContact() && move_) {
     std::vector<double> springPairs, springWalls;
-    pair_->collectSpringBlocks(multistep ? 1.5 : 1.0, update->dt, springPairs, springWalls);
+    std::vector<double> springWallIndex;
+    pair_->collectSpringBlocks(multistep ? 1.5 : 1.0, update->dt, springPairs, springWalls,
+                               wallFile_.empty() ? nullptr : &springWallIndex);
     springs.pairs = fdm::gatherToRoot(springPairs, world);
     springs.walls = fdm::gatherToRoot(springWalls, world);
+    if (!wallFile_.empty()) springWallBlockWall_ = fdm::gatherToRoot(springWallIndex, world);
     if (multistep) {
       springs.gamma = 1.0 / 3.0;
       springs.previous = currentVelocity_;
     }
+  }
+  if (!wallFile_.empty()) {
+    // the wall of each block, gathered in the same rank order as the blocks; the contact loads summed
+    wallBlockWall_ = fdm::gatherToRoot(wallIndex, world);
+    const std::vector<double> &local = pair_->wallContactLoads();
+    std::vector<double> loads(3 * pair_->walls().size(), 0.0);
+    for (size_t k = 0; k < loads.size() && k < local.size(); k++) loads[k] = local[k];
+    wallContact_.assign(loads.size(), 0.0);
+    MPI_Reduce(loads.data(), wallContact_.data(), int(loads.size()), MPI_DOUBLE, MPI_SUM, 0, world);
   }
   MPI_Reduce(&contacts, &contacts_, 1, MPI_LONG, MPI_SUM, 0, world);
   if (comm->me != 0) return;
@@ -600,7 +621,8 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   subgrid_ = system_->subgridForces();
   // the implicit part of the contact forces (Eq. C2) and of their stresslet (Eq. 52)
   std::vector<double> springStress(size_t(6) * natoms_, 0.0);
-  springs_ = system_->springForces(stresslets_ ? &springStress : nullptr);
+  springs_ = system_->springForces(stresslets_ ? &springStress : nullptr,
+                                   springWallBlockWall_.empty() ? nullptr : &springWallForces_);
   if (!stresslets_) return;
   std::vector<double> subgrid(size_t(7) * natoms_, 0.0);  // S^SG, s^SG: 7 per particle
   system_->addSubgridStresslets(subgrid);
@@ -713,6 +735,7 @@ void FixFdmCouple::final_integrate()
     }
   }
 
+  if (!wallFile_.empty() && comm->me == 0) writeWallLoads();
   if (move_ && comm->me == 0) {
     t0 = MPI_Wtime();
     planNextMove(particles);
@@ -807,6 +830,65 @@ void FixFdmCouple::scatter()
     }
   }
   fillPerAtomArray();
+}
+
+void FixFdmCouple::writeWallLoads()
+{
+  // rank 0, after the last inner iteration: per wall the force of the particles on it, sub-grid
+  // lubrication (minus each wall block's force on its particle, Eq. D.6) and contact (minus the
+  // wall contact forces of this step's force evaluation and of the implicit springs). A resumed run appends (fdmRun --resume
+  // cut the file at the checkpoint, fdm/checkpoint.py).
+  const std::vector<PairFdmSubgrid::Wall> &walls = pair_->walls();
+  static const char *faceNames[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
+  if (!wallOut_) {
+    const bool append = !session_.resumeFile().empty();
+    wallOut_ = fopen(wallFile_.c_str(), append ? "a" : "w");
+    if (!wallOut_) fail("walls: cannot open " + wallFile_ + " for writing");
+    if (!append) {
+      fprintf(wallOut_, "# fix fdm/couple walls: force of the particles on each wall [N]: sub-grid lubrication "
+                        "(Eq. D.6) and contact; timestep %.17g\n# step", update->dt);
+      for (const PairFdmSubgrid::Wall &w : walls)
+        for (const char *part : {"subgrid", "contact"})
+          for (const char *c : {"X", "Y", "Z"}) fprintf(wallOut_, " %s:%s%s", faceNames[2 * w.axis + w.side], part, c);
+      fprintf(wallOut_, "\n");
+    }
+  }
+  std::vector<double> subgrid(3 * walls.size(), 0.0);
+  if (system_ && !wallBlockWall_.empty()) {
+    const std::vector<double> blocks = system_->wallBlockForces();
+    if (blocks.size() != 6 * wallBlockWall_.size())
+      fail("walls: " + std::to_string(blocks.size() / 6) + " wall blocks in Eq. (31) but " +
+           std::to_string(wallBlockWall_.size()) + " wall indices");
+    for (size_t b = 0; b < wallBlockWall_.size(); b++) {
+      const size_t k = size_t(std::lround(wallBlockWall_[b]));
+      for (int d = 0; d < 3; d++) subgrid[3 * k + d] -= blocks[6 * b + d];
+    }
+  }
+  // contact: the forces of the step's force evaluation, plus the implicit springs' increment over
+  // the step (Eq. C2), each spring block's share on its particle
+  std::vector<double> contact(3 * walls.size(), 0.0);
+  for (size_t k = 0; k < contact.size() && k < wallContact_.size(); k++) contact[k] = wallContact_[k];
+  if (!springWallBlockWall_.empty()) {
+    if (springWallForces_.size() != 6 * springWallBlockWall_.size())
+      fail("walls: " + std::to_string(springWallForces_.size() / 6) + " implicit wall springs in Eq. (31) but " +
+           std::to_string(springWallBlockWall_.size()) + " wall indices");
+    for (size_t b = 0; b < springWallBlockWall_.size(); b++) {
+      const size_t k = size_t(std::lround(springWallBlockWall_[b]));
+      for (int d = 0; d < 3; d++) contact[3 * k + d] -= springWallForces_[6 * b + d];
+    }
+  }
+  std::ostringstream line;
+  line.precision(12);
+  line << update->ntimestep;
+  for (size_t k = 0; k < walls.size(); k++) {
+    for (int d = 0; d < 3; d++) line << ' ' << subgrid[3 * k + d];
+    for (int d = 0; d < 3; d++) line << ' ' << contact[3 * k + d];
+  }
+  line << '\n';
+  const std::string text = line.str();
+  if (fwrite(text.data(), 1, text.size(), wallOut_) != text.size() || fflush(wallOut_) != 0)
+    fail("walls: could not write step " + std::to_string((long long) update->ntimestep) + " to " + wallFile_ +
+         " (disk full or not writable?)");
 }
 
 void FixFdmCouple::fillPerAtomArray()

@@ -4,7 +4,7 @@
      fix ID all fdm/couple [transport socket|file] [host H] [port P] [portfile F] [directory D]
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
                            [stresslets yes|no] [solver cg|ldlt] [tolerance t] [integrator ab2|euler]
-                           [gap_update log|none] [checkpoint N]
+                           [gap_update log|none] [checkpoint N] [walls FILE]
      fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
@@ -20,7 +20,10 @@
    exchange seconds, linear-solver iterations, sub-grid pair blocks, wall blocks, contacts] of the
    last step; per-atom array [F^FDM, T^FDM, F^SG, T^SG] (12 columns), and with stresslets yes
    [S^h (6), s^h, S^c (6), S^SG (6), s^SG] after them (32 columns; S^SG, s^SG: the sub-grid part of
-   S^h, s^h). fix fdm/output (fix_fdm_output.h) writes them to binary records and ParaView files. */
+   S^h, s^h). fix fdm/output (fix_fdm_output.h) writes them to binary records and ParaView files.
+   walls FILE: rank 0 writes every step the force of the particles on each wall of pair_style
+   fdm/subgrid, split into sub-grid lubrication (Eq. D.6) and contact (a text line per step; the
+   particle side of the momentum balance of a sheared suspension, docs/dem.md, docs/profiles.md). */
 
 #ifndef FDM_FIX_FDM_COUPLE_H
 #define FDM_FIX_FDM_COUPLE_H
@@ -82,6 +85,7 @@ class FixFdmCouple : public Fix {
   void planNextMove(const std::vector<Particle> &particles);
   void scatter();
   void fillPerAtomArray();
+  void writeWallLoads();
   void allAgree(const std::string &problemOnRank0);
   void fail(const std::string &message);
   void printTiming(const char *what, const Timing &t, double wall, int runs) const;
@@ -128,6 +132,14 @@ class FixFdmCouple : public Fix {
   std::vector<double> springs_;    // 6N: implicit part of the contact forces of the last step (Eq. C2), by tag
   std::vector<double> stress_;     // 20N: S^h (6), s^h, S^c (6), S^SG (6), s^SG of the last step, by tag
   long solverIterations_, pairBlocks_, wallBlocks_, contacts_;
+
+  // walls FILE: the particles' loads on the walls (rank 0)
+  std::string wallFile_;
+  FILE *wallOut_;
+  std::vector<double> wallBlockWall_;  // rank 0: the wall (index in pair_->walls()) of each gathered wall block
+  std::vector<double> wallContact_;    // rank 0: 3 per wall, the force of the contacts on the wall
+  std::vector<double> springWallBlockWall_;  // rank 0: the wall of each gathered implicit wall-spring block
+  std::vector<double> springWallForces_;     // rank 0: 6 per implicit wall-spring block, its force on the particle
 
   long long checkpointEvery_;      // checkpoint N: every N steps and at the end of each run (0: never)
   double checkpointSeconds_;       // wall time spent writing checkpoints (rank 0's)

@@ -505,6 +505,7 @@ void PairFdmSubgrid::compute(int eflag, int vflag)
   computeflag = 1;
   contactsLast_ = 0;
   contacts_.clear();
+  wallContactLoads_.assign(3 * walls_.size(), 0.0);
   if (contactStressRequested_) {
     if (atom->nmax > nmaxStress_) {
       nmaxStress_ = atom->nmax;
@@ -666,6 +667,7 @@ void PairFdmSubgrid::wallContactForces()
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];
+        wallContactLoads_[3 * k + d] -= force[d];
       }
       const double branch[3] = {-h * n[0], -h * n[1], -h * n[2]};
       if (contactStressRequested_) addContactStress(i, force, branch, 1.0);
@@ -678,7 +680,7 @@ void PairFdmSubgrid::wallContactForces()
 }
 
 void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<double> &pairs,
-                                         std::vector<double> &walls) const
+                                         std::vector<double> &walls, std::vector<double> *wallIndex) const
 {
   // Eqs. (C1)-(C3) of docs/contact.md: the springs at the end of the step, for the contacts the last
   // compute found (the neighbour lists and local indices have not changed since). A sliding
@@ -686,6 +688,7 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
   // tangential force stays the explicit Coulomb force of the compute.
   pairs.clear();
   walls.clear();
+  if (wallIndex) wallIndex->clear();
   if (!implicitContact()) return;
   const int *tag = atom->tag;
   double R[144], term[6];
@@ -705,14 +708,17 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
       walls.insert(walls.end(), R, R + 36);
       walls.insert(walls.end(), term, term + 6);
       walls.insert(walls.end(), c.branch, c.branch + 3);
+      if (wallIndex) wallIndex->push_back(double(-1 - c.j));
     }
   }
 }
 
-void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls)
+void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls,
+                                   std::vector<double> *wallIndex)
 {
   pairs.clear();
   walls.clear();
+  if (wallIndex) wallIndex->clear();
   if (!lubricationActive()) return;
   double **x = atom->x;
   const double *radius = atom->radius;
@@ -736,7 +742,8 @@ void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, 
     }
   }
   res::WallBlock wallBlock;
-  for (const Wall &w : walls_) {
+  for (size_t k = 0; k < walls_.size(); k++) {
+    const Wall &w = walls_[k];
     double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};  // normal into the wall (Appendix A.2)
     point[w.axis] = w.side == 0 ? domain->boxlo[w.axis] : domain->boxhi[w.axis];
     normal[w.axis] = w.side == 0 ? -1.0 : 1.0;
@@ -745,6 +752,7 @@ void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, 
       double rhs[6], stressRhs[7];
       res::wallVelocityTerm(wallBlock, w.velocity, rhs, stressRhs);
       walls.push_back(tag[i]);
+      if (wallIndex) wallIndex->push_back(double(k));
       walls.insert(walls.end(), &wallBlock.R[0][0], &wallBlock.R[0][0] + 36);
       walls.insert(walls.end(), rhs, rhs + 6);
       if (withStress) {

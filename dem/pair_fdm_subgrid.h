@@ -54,13 +54,17 @@ class PairFdmSubgrid : public Pair {
   };
 
   // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0, in
-  // the records of fdm::subgrid (particle_velocity_system.h), with their stress rows if withStress.
-  void collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls);
+  // the records of fdm::subgrid (particle_velocity_system.h), with their stress rows if withStress;
+  // wallIndex (if given): for each wall block, the index of its wall in walls() (the records do not say).
+  void collectBlocks(bool withStress, std::vector<double> &pairs, std::vector<double> &walls,
+                     std::vector<double> *wallIndex = nullptr);
 
   // The implicit contact springs of the last compute (records of fdm::springs, particle_velocity_system.h):
   // R_c = c1 dt B^T K B (Eq. C3 of docs/contact.md) with c1 the weight of U_{n+1} in the next
   // position update (3/2 ab2, 1 euler). Each contact once (the side of the lower tag keeps it).
-  void collectSpringBlocks(double c1, double dt, std::vector<double> &pairs, std::vector<double> &walls) const;
+  // wallIndex (optional): the wall (index in walls()) of each wall spring block, in the same order
+  void collectSpringBlocks(double c1, double dt, std::vector<double> &pairs, std::vector<double> &walls,
+                           std::vector<double> *wallIndex = nullptr) const;
   bool implicitContact() const { return contactActive() && implicit_; }
 
   bool lubricationActive() const { return lubrication_ && model_; }
@@ -77,6 +81,10 @@ class PairFdmSubgrid : public Pair {
     static const double none[6] = {0, 0, 0, 0, 0, 0};
     return contactStress_ && i < nmaxStress_ ? contactStress_[i] : none;
   }
+  // The force this rank's particle-wall contacts exert on each wall in the last compute (minus the
+  // contact force on the particles; 3 per wall, in the order of walls()), for fix fdm/couple's wall
+  // loads (the momentum balance of a sheared suspension, docs/profiles.md).
+  const std::vector<double> &wallContactLoads() const { return wallContactLoads_; }
   // Contacts (pair and wall) found by this rank in the last compute.
   long contactsLast() const { return contactsLast_; }
   // The time-step limits of the contact springs, dt k/zeta below 1 (ab2) or 2 (euler), docs/contact.md
@@ -121,6 +129,7 @@ class PairFdmSubgrid : public Pair {
   int nmaxStress_;
   double **contactStress_;
   long contactsLast_;
+  std::vector<double> wallContactLoads_;  // 3 per wall: force of the contacts on the wall (this rank)
   bool reported_;
   double checkedTimeStep_;     // the time step last checked (checked again if it changes)
   // the contacts of the last compute, for the implicit spring blocks (local index j, or -1 - wall)

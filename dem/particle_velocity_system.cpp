@@ -299,7 +299,8 @@ std::vector<double> ParticleVelocitySystem::subgridForces() const
   return std::vector<double>(forces.data(), forces.data() + forces.size());
 }
 
-std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *stresslets) const
+std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *stresslets,
+                                                         std::vector<double> *wallBlockForces) const
 {
   // Eq. (C2): -R_c (u - gamma U_n) + dt B^T K U_w per contact; the stresslet of Eq. (52) of that force
   std::vector<double> out(size_t(6) * n_, 0.0);
@@ -332,6 +333,7 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     addStress(p[0], f, branch, weight);
     addStress(p[1], f, branch, 1.0 - weight);
   }
+  if (wallBlockForces) wallBlockForces->clear();
   for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord) {
     const double *rec = &springWalls_[b];
     const int p = int(std::lround(rec[0])) - 1;
@@ -342,9 +344,26 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
       for (int j = 0; j < 6; j++) f[i] -= R[6 * i + j] * velocity(6 * p + j);
       out[size_t(6) * p + i] += f[i];
     }
+    if (wallBlockForces) wallBlockForces->insert(wallBlockForces->end(), f, f + 6);
     addStress(p, f, branch, 1.0);
   }
   return out;
+}
+
+std::vector<double> ParticleVelocitySystem::wallBlockForces() const
+{
+  std::vector<double> forces(size_t(6) * wallBlocks_, 0.0);
+  for (long b = 0; b < wallBlocks_; b++) {
+    const double *rec = &walls_[size_t(b) * wallRecord_];
+    const int p = int(std::lround(rec[0])) - 1;
+    const double *R = rec + 1, *wallTerm = rec + 37;  // 6 x 6, then R_w[:, 0:3] U_w (6)
+    for (int row = 0; row < 6; row++) {
+      double value = wallTerm[row];
+      for (int k = 0; k < 6; k++) value -= R[6 * row + k] * u_[size_t(6) * p + k];
+      forces[size_t(6) * b + row] = value;
+    }
+  }
+  return forces;
 }
 
 void ParticleVelocitySystem::addSubgridStresslets(std::vector<double> &stresslets) const

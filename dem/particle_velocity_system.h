@@ -119,13 +119,19 @@ class ParticleVelocitySystem {
 
   // After the last solve: F^SG, T^SG = -(R^SG u - wall term) (Eqs. 21, D.6), 6 per particle.
   std::vector<double> subgridForces() const;
+  // After the last solve: the sub-grid force and torque of each wall block on its particle,
+  // R_w[:, 0:3] U_w - R_w u_p (Eq. D.6), 6 per block in the order of the wall records given to
+  // assemble() (their sum over the blocks of a particle is the wall part of subgridForces()).
+  std::vector<double> wallBlockForces() const;
   // After the last solve: adds the sub-grid stresslets S^SG = -rows u (+ wall term) (Eq. 13) to
   // `stresslets`, 7 per particle (S xx xy xz yy yz zz, s). Needs Settings::stresslets.
   void addSubgridStresslets(std::vector<double> &stresslets) const;
   // After the last solve: the implicit part of the contact forces, -R_c (u - gamma U_n) + wall term
   // (Eq. C2), 6 per particle (F, T; 0 without springs), and its contact stresslet (Eq. 52, 6 per
-  // particle: xx xy xz yy yz zz) added to `stresslets` if not null.
-  std::vector<double> springForces(std::vector<double> *stresslets = nullptr) const;
+  // particle: xx xy xz yy yz zz) added to `stresslets` if not null; `wallBlockForces` (if not null)
+  // receives 6 per implicit wall spring, its force and torque on its particle, in block order.
+  std::vector<double> springForces(std::vector<double> *stresslets = nullptr,
+                                   std::vector<double> *wallBlockForces = nullptr) const;
   long springBlocks() const { return long(springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord); }
 
  private:

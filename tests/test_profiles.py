@@ -438,3 +438,90 @@ def test_bad_input():
         P.Channel.centred((4, 4, 4)).core_bounds(2.0)
     with pytest.raises(ValueError):
         R.fit_maron_pierce([0.1, 0.2], [1, 2], [0.1, 0.1])
+
+
+# ---- the momentum balance (fdm.rheology.stress_balance, fdm.output.read_wall_loads) ----------------
+
+def _write_wall_records(run, steps, dt, fluid_forces, subgrid, contact, area=(40.0, 40.0)):
+    """fdmFoam's walls.dat and fix fdm/couple's walls file by hand: forces (T, 2, 3) on yLow/ylo and
+    yHigh/yhi; the fluid pressure force is (0, 7, 0) on every wall (not in the shear stress)."""
+    import os
+    os.makedirs(run / "fluid" / "postProcessing" / "fdm")
+    os.makedirs(run / "dem")
+    with open(run / "fluid" / "postProcessing" / "fdm" / "walls.dat", "w") as f:
+        f.write("# fdmFoam: force of the fluid on each wall patch [N]; areas [m2]: yLow %g yHigh %g\n" % area)
+        f.write("# step time " + " ".join("%s:%s%s" % (w, p, c) for w in ("yLow", "yHigh")
+                                          for p in ("viscous", "pressure") for c in "XYZ") + "\n")
+        for k, st in enumerate(steps):
+            f.write("%d %.17g %s\n" % (st, st * dt, " ".join("%.17g %.17g %.17g 0 7 0" % tuple(fluid_forces[k, w]) for w in (0, 1))))
+    with open(run / "dem" / "walls.dat", "w") as f:
+        f.write("# fix fdm/couple walls: force of the particles on each wall [N]: sub-grid lubrication (Eq. D.6) "
+                "and contact; timestep %r\n# step" % dt)
+        f.write("".join(" %s:%s%s" % (w, p, c) for w in ("ylo", "yhi") for p in ("subgrid", "contact") for c in "XYZ"))
+        f.write("\n")
+        for k, st in enumerate(steps):
+            f.write("%d %s\n" % (st, " ".join("%.17g %.17g %.17g %.17g %.17g %.17g" % (*subgrid[k, w], *contact[k, w]) for w in (0, 1))))
+
+
+def test_wall_stress_signs_parts_and_balance(tmp_path):
+    # Walls y = 0 (low) and y = 8 (high) of area 40; the suspension drags the high wall back (-x) and
+    # the low one forward (+x): tau_lo = F_lo,x / A, tau_hi = -F_hi,x / A (n out of the suspension).
+    from fdm import output as O
+    rng = np.random.default_rng(5)
+    n = 64
+    steps = np.arange(1, n + 1)
+    fluid = np.zeros((n, 2, 3))
+    sub = np.zeros((n, 2, 3))
+    con = np.zeros((n, 2, 3))
+    fluid[:, 0, 0], fluid[:, 1, 0] = 80.0, -84.0           # 2.0 and 2.1
+    sub[:, 0, 0], sub[:, 1, 0] = 20.0, -16.0               # 0.5 and 0.4
+    con[:, 0, 0], con[:, 1, 0] = 4.0 + rng.normal(0, 0.4, n), -4.0  # 0.1 (+ noise) and 0.1
+    con[:, :, 1] = 50.0                                     # normal loads: not shear stress
+    _write_wall_records(tmp_path, steps, 0.05, fluid, sub, con)
+    loads = O.read_wall_loads(str(tmp_path))
+    assert loads.faces == ("ylo", "yhi") and np.allclose(loads.areas, 40.0) and loads.particles
+    assert np.array_equal(loads.steps, steps) and np.allclose(loads.times, 0.05 * steps)
+    assert np.allclose(loads.fluid_pressure[:, :, 1], 7.0)
+    channel = P.Channel((0, 0, 0), (10, 8, 4))
+    tau = R.wall_shear_stresses(loads, channel)
+    assert np.allclose(tau["fluid"], [2.0, 2.1]) and np.allclose(tau["subgrid"], [0.5, 0.4])
+    assert np.allclose(tau["contact"][:, 1], 0.1) and np.allclose(tau["contact"][:, 0], con[:, 0, 0] / 40)
+    assert np.allclose(tau["total"], tau["fluid"] + tau["subgrid"] + tau["contact"])
+    # a core stress of 2.5 = eta gamma_core + Sigma^p_12 with gamma_core = 1, eta = 1, Sigma^p_12 = 1.5
+    t = np.arange(20) * 0.5
+    sigma = np.zeros((20, 6))
+    sigma[:, P.component(0, 1)] = 1.5
+    series = P.CoreSeries(times=t, phi=np.full(20, 0.3), gamma_dot=np.ones(20), sigma_h=sigma,
+                          sigma_c=np.zeros((20, 6)), n_particles=np.full(20, 10), channel=channel, h_layer=1.0)
+    rh = R.shear_rheology(series, eta=1.0, start_time=1.0)
+    b = R.stress_balance(rh, loads, channel, strain_rate=1.0)
+    sel = loads.times >= 1.0
+    wall = np.mean(tau["total"][sel].mean(axis=1))
+    assert b.n_steps == int(np.sum(sel)) and b.start_time == 1.0
+    assert b.core.value == pytest.approx(2.5) and b.wall.value == pytest.approx(wall, rel=1e-12)
+    assert b.rel_error == pytest.approx(abs(2.5 - wall) / wall, rel=1e-12)
+    assert b.wall_fluid.value == pytest.approx(2.05) and b.wall_subgrid.value == pytest.approx(0.45)
+    assert b.wall_lo.value == pytest.approx(np.mean(tau["total"][sel, 0]))
+    assert b.wall_asymmetry == pytest.approx(abs(b.wall_lo.value - b.wall_hi.value) / wall)
+    assert 0 < b.wall.error < 0.1 and b.core.error == 0.0
+    assert b.rel_error_err == pytest.approx(b.wall.error / wall)
+    d = b.as_dict()
+    assert d["stress_balance_rel_error"] == b.rel_error and d["stress_wall_contact"] == b.wall_contact.value
+    # too few steps in the window, and unknown walls, are errors that say so
+    with pytest.raises(ValueError, match="steps with wall loads"):
+        R.stress_balance(rh, loads, channel, start_time=3.0 - 1e-12 + 0.05 * 60)
+    with pytest.raises(KeyError, match="no wall 'zlo'"):
+        R.wall_shear_stresses(loads, P.Channel((0, 0, 0), (10, 8, 4), wall_axis=2))
+
+
+def test_gap_shear_stress_is_the_box_average():
+    # eta (U_hi - U_lo)/L_y + sum_p (S^H + S^c)_12 / V: two spheres with given stresslets
+    channel = P.Channel((0, 0, 0), (10, 8, 5))
+    sh = np.zeros((2, 6))
+    sc = np.zeros((2, 6))
+    sh[:, P.component(0, 1)] = [30.0, 10.0]
+    sc[0, P.component(0, 1)] = -4.0
+    sh[:, 0] = 99.0                               # a normal component: not in the shear stress
+    s = P.Snapshot([[2, 4, 2], [7, 3, 3]], [1.0, 1.4], stresslet_h=sh, stresslet_c=sc)
+    assert R.gap_shear_stress(s, channel, eta=2.0, wall_shear_rate=0.5) == pytest.approx(1.0 + 36.0 / 400.0)
+    assert R.relative_difference(1.1, 1.0) == pytest.approx(0.1) and math.isnan(R.relative_difference(1.0, 0.0))

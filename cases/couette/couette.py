@@ -149,7 +149,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                "run             %d upto" % steps])   # upto: a resumed run ends at the same step
     # a checkpoint every 10 snapshots and at the end: fdmRun --resume continues a killed run (docs/coupling.md)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
-                         fix_options="stresslets yes checkpoint %d" % (10 * dump_every), runs=runs, name="in.couette")
+                         fix_options="stresslets yes checkpoint %d walls walls.dat" % (10 * dump_every), runs=runs, name="in.couette")
     return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
                 wall_velocity=U, dt=dt, dump_every=dump_every, write_every=write_every)
 
@@ -188,6 +188,19 @@ def analyse(run_dir: str, scene: dict, pack: packing.Packing, wall_seconds: floa
     else:
         raise ValueError("couette: %d particle snapshots are too few for time averages (8 at least): run longer "
                          "or lower --dump-every" % len(snapshots))
+    # the momentum balance (docs/profiles.md "Stress balance"): the core stress of Eq. 51 against the
+    # walls' shear stress (fluid traction + sub-grid lubrication + contact), both over the steady part;
+    # and at every snapshot the gap-averaged stress against the mean of the two walls (exact)
+    loads = output.read_wall_loads(run_dir)
+    balance = rheology.stress_balance(r, loads, channel, SHEAR_RATE)
+    tau = rheology.wall_shear_stresses(loads, channel)["total"].mean(axis=1)
+    step_of = {int(st): k for k, st in enumerate(loads.steps)}
+    gap_errors = []
+    for s in snapshots:
+        k = step_of.get(int(round(s.time / (SHEAR_RATE * scene["dt"]))))
+        if k is not None:
+            gap = rheology.gap_shear_stress(s, channel, ETA, 2 * scene["wall_velocity"] / box[1])
+            gap_errors.append(rheology.relative_difference(gap, float(tau[k])))
     avg = profiles.average_profiles(snapshots, channel, start_time=r.start_time)
     fine = profiles.average_profiles(snapshots, channel, y=channel.planes(0.02), start_time=r.start_time, errors=False)
     pair_gap, wall_gap = minimum_gaps(snapshots, box)
@@ -214,6 +227,9 @@ def analyse(run_dir: str, scene: dict, pack: packing.Packing, wall_seconds: floa
         min_pair_gap=pair_gap, min_wall_gap=wall_gap,
         mean_particle_velocity=np.mean([s.velocities.mean(axis=0) for s in snapshots], axis=0).tolist(),
         snapshots=len(snapshots))
+    res.update(balance.as_dict())
+    res.update(stress_gap_rel_error_max=float(np.max(gap_errors)) if gap_errors else float("nan"),
+               stress_gap_snapshots=len(gap_errors))
     return res, [channel, avg, fine, snapshots]
 
 
@@ -315,6 +331,16 @@ def main(argv: list[str] | None = None) -> dict:
             "inner_iterations_max unconverged_steps min_pair_gap min_wall_gap").split()
     for k in keys:
         print("%-30s %s" % (k, results[k]))
+    print("stress balance (Eq. 51 core against the walls, from strain %g, %d steps):"
+          % (results["stress_balance_from_strain"], results["stress_balance_steps"]))
+    print("  core  eta gamma_core + Sigma^h_12 + Sigma^c_12 = %.4g +- %.2g" % (results["stress_core"],
+                                                                           results["stress_core_err"]))
+    print("  walls %.4g +- %.2g (low %.4g, high %.4g): fluid %.4g + sub-grid %.3g + contact %.3g"
+          % tuple(results[k] for k in ("stress_wall", "stress_wall_err", "stress_wall_lo", "stress_wall_hi",
+                                       "stress_wall_fluid", "stress_wall_subgrid", "stress_wall_contact")))
+    print("  stress_balance_rel_error = %.4g +- %.2g; gap-averaged stress against the walls at the %d snapshots: "
+          "at most %.2g" % (results["stress_balance_rel_error"], results["stress_balance_rel_error_err"],
+                            results["stress_gap_snapshots"], results["stress_gap_rel_error_max"]))
     print("wrote %s and %s" % (args.out, figure))
     if not args.keep:
         fluid = os.path.join(run_dir, "fluid")

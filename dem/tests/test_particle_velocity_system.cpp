@@ -240,6 +240,36 @@ TEST(ParticleVelocitySystem, SubgridForceIsMinusRTimesUPlusTheWallTerm)
   }
 }
 
+TEST(ParticleVelocitySystem, WallBlockForcesAreEachBlocksShare)
+{
+  // Each wall block's force on its particle, R_w[:, 0:3] U_w - R_w u_p (Eq. D.6), by hand; without
+  // pair blocks their sum per particle is subgridForces() (fix fdm/couple sums them per wall for the
+  // momentum balance of a sheared suspension).
+  for (bool stresslets : {false, true}) {
+    Scene s = randomScene(17, 6, 0, 9, stresslets);
+    ParticleVelocitySystem system(s.settings);
+    system.assemble(s.particles, s.pairs, s.walls);
+    system.setVolumes(s.Vu, s.Ju);
+    const std::vector<double> u = system.solve(s.fluid);
+    const std::vector<double> blocks = system.wallBlockForces();
+    ASSERT_EQ(blocks.size(), size_t(6 * 9));
+    const size_t record = subgrid::wallRecord + (stresslets ? subgrid::wallStressRecord : 0);
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(6 * s.n()), byHand(6 * 9);
+    for (int b = 0; b < 9; b++) {
+      const double *rec = &s.walls[b * record];
+      const int p = int(rec[0]) - 1;
+      for (int r = 0; r < 6; r++) {
+        double f = rec[37 + r];
+        for (int c = 0; c < 6; c++) f -= rec[1 + 6 * r + c] * u[6 * p + c];
+        byHand(6 * b + r) = f;
+        sum(6 * p + r) += blocks[6 * b + r];
+      }
+    }
+    expectClose(blocks, byHand, 1e-14, "wall blocks");
+    expectClose(system.subgridForces(), sum, 1e-12, "sum of the wall blocks");
+  }
+}
+
 TEST(ParticleVelocitySystem, StressletRowsAreAppliedToTheirParticles)
 {
   Scene s = randomScene(5, 5, 6, 3, true);

@@ -4,6 +4,8 @@ import shutil
 import subprocess
 import time
 
+import numpy as np
+
 from . import PROJECT_DIR
 
 HEADER = """FoamFile
@@ -233,6 +235,31 @@ boundaryField
 %s
 }
 """ % "\n".join(p_bc))
+
+
+def write_initial_velocity(case_dir, box, velocity):
+    """0/U of the fluid case in case_dir with a nonuniform internal field: velocity(centres) -> (n, 3)
+    at the (n, 3) cell centres, in blockMesh's cell order (x fastest, then y, then z); the boundary
+    conditions write_fluid_case wrote are kept."""
+    nx, ny, nz = box.n
+    d = box.delta
+    i, j, k = np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij")
+    order = (i + nx * (j + ny * k)).reshape(-1)
+    centres = np.empty((nx * ny * nz, 3))
+    centres[order] = np.column_stack([box.lo[0] + (i.reshape(-1) + 0.5) * d, box.lo[1] + (j.reshape(-1) + 0.5) * d,
+                                      box.lo[2] + (k.reshape(-1) + 0.5) * d])
+    u = np.asarray(velocity(centres), dtype=float)
+    if u.shape != centres.shape or not np.all(np.isfinite(u)):
+        raise ValueError("write_initial_velocity: velocity() must give finite (%d, 3) values" % len(centres))
+    path = os.path.join(case_dir, "0", "U")
+    with open(path) as f:
+        text = f.read()
+    field = "internalField   nonuniform List<vector>\n%d\n(\n%s\n);" % (
+        len(u), "\n".join("(%.17g %.17g %.17g)" % tuple(v) for v in u))
+    if "internalField   uniform (0 0 0);" not in text:
+        raise ValueError("write_initial_velocity: %s is not the 0/U of write_fluid_case" % path)
+    with open(path, "w") as f:
+        f.write(text.replace("internalField   uniform (0 0 0);", field))
 
 
 def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):

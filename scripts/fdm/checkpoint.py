@@ -8,8 +8,9 @@ each code keeps its two newest.
 
     python3 -m fdm.checkpoint select CASE        the newest step both codes have complete (prints it;
                                                  says on stderr which newer ones were passed over and why)
-    python3 -m fdm.checkpoint truncate CASE STEP cut every record at STEP: fdmFoam's steps.dat and
-                                                 particles.dat and the function objects' records keep
+    python3 -m fdm.checkpoint truncate CASE STEP cut every record at STEP: fdmFoam's steps.dat,
+                                                 particles.dat, walls.dat, fix fdm/couple's walls
+                                                 file and the function objects' records keep
                                                  the steps up to STEP, the DEM's dumps the frames before
                                                  STEP (the resumed run writes STEP's frame again), and
                                                  time directories and checkpoints after STEP go
@@ -206,7 +207,7 @@ def truncate(case_dir, step):
     eps = 1e-9 * max(abs(t_step), 1e-300)
     summary = []
     # fdmFoam's records: by DEM step
-    for name in ("steps.dat", "particles.dat"):
+    for name in ("steps.dat", "particles.dat", "walls.dat"):
         path = os.path.join(fluid, "postProcessing", "fdm", name)
         if os.path.isfile(path):
             summary.append("%s: %d lines after step %d removed" % (name, _cut_lines(path, lambda v: v <= step + 0.5),
@@ -243,6 +244,9 @@ def truncate(case_dir, step):
                     if head == b"ITEM: TIMESTEP\n":
                         summary.append("%s: %d frames from step %d on removed" % (rel.lstrip("./"),
                                                                                   _cut_dump(path, step), step))
+                    elif head == b"# fix fdm/coupl":   # fix fdm/couple walls FILE: a line per step
+                        summary.append("%s: %d lines after step %d removed" % (
+                            rel.lstrip("./"), _cut_lines(path, lambda v: v <= step + 0.5), step))
     # checkpoints after this one (an earlier attempt's, or incomplete)
     for directory, prefix in ((os.path.join(fluid, "checkpoint"), "fluid."),
                               (os.path.join(case_dir, "dem", "checkpoint"), "dem.")):

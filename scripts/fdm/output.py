@@ -1,9 +1,12 @@
 """Reading the outputs of coupled runs: fdmFoam's per-step and per-particle records
 (postProcessing/fdm/*.dat), the binary particle records and ParaView files of fix fdm/output,
 LIGGGHTS text dumps (older runs) and the time breakdowns of the logs."""
+from __future__ import annotations
+
 import io
 import os
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,6 +44,116 @@ def steps(fluid_case):
 
 def particles(fluid_case):
     return _read(os.path.join(fluid_case, "postProcessing", "fdm", "particles.dat"), PARTICLE_COLUMNS)
+
+
+# ------------------------------------------------------------------------------------------------
+# Wall loads: the force of the fluid (fdmFoam, postProcessing/fdm/walls.dat) and of the particles
+# (fix fdm/couple ... walls FILE) on each wall, per step -- the momentum balance of a sheared
+# suspension (fdm.rheology.stress_balance, docs/profiles.md)
+# ------------------------------------------------------------------------------------------------
+
+_AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class WallLoads:
+    """Per step (T steps common to both records) and per wall (W walls, in the order of `faces`,
+    e.g. ("ylo", "yhi")), the force on the wall [N] as (T, W, 3) arrays: `fluid_viscous`
+    (-rho_f nu sum snGrad(U)|Sf| over the patch), `fluid_pressure` (rho_f sum p Sf, the solver's
+    pressure level), `subgrid` (the particles' sub-grid lubrication, Eq. D.6) and `contact` (the
+    particles' wall contacts); `areas` (W,) of the patches; `steps` (T,) DEM steps, `times` (T,)
+    [s]. `particles` False if there was no particle record (subgrid and contact then zero)."""
+
+    steps: np.ndarray
+    times: np.ndarray
+    faces: tuple
+    areas: np.ndarray
+    fluid_viscous: np.ndarray
+    fluid_pressure: np.ndarray
+    subgrid: np.ndarray
+    contact: np.ndarray
+    particles: bool
+
+    @property
+    def total(self) -> np.ndarray:
+        """Force of the suspension on each wall without the pressure: viscous + sub-grid + contact
+        (T, W, 3); the tangential components are the walls' shear loads."""
+        return self.fluid_viscous + self.subgrid + self.contact
+
+    def wall(self, face: str) -> int:
+        if face not in self.faces:
+            raise KeyError("no wall %r in the wall loads (walls: %s)" % (face, " ".join(self.faces)))
+        return self.faces.index(face)
+
+
+def _header_lines(path: str, count: int) -> list:
+    lines = []
+    with open(path) as f:
+        for line in f:
+            if not line.startswith("#"):
+                break
+            lines.append(line[1:].split())
+            if len(lines) == count:
+                break
+    return lines
+
+
+def _patch_face(patch: str) -> str:
+    """fdmFoam's patch name of a box face (fdm.case: xLow, yHigh, ...) as LIGGGHTS's (xlo, yhi)."""
+    if len(patch) > 1 and patch[0] in _AXES and patch[1:] in ("Low", "High"):
+        return patch[0] + ("lo" if patch[1:] == "Low" else "hi")
+    return patch
+
+
+def read_wall_loads(run_dir: str, dem_file: str | None = "walls.dat") -> WallLoads:
+    """The wall loads of a coupled run (run_dir with fluid/ and dem/): fdmFoam's
+    fluid/postProcessing/fdm/walls.dat and, unless dem_file is None, the particle side
+    dem/<dem_file> of `fix fdm/couple ... walls FILE`; joined on their common steps. The fluid
+    patches are matched to the particle code's faces by name (fdm.case names the patch of the
+    face ylo yLow). A last, incomplete line (a killed run) is dropped with a warning."""
+    fluid_path = os.path.join(run_dir, "fluid", "postProcessing", "fdm", "walls.dat")
+    if not os.path.isfile(fluid_path):
+        raise FileNotFoundError("%s not found: did this fdmFoam (with wall records) run?" % fluid_path)
+    head = _header_lines(fluid_path, 2)
+    words = head[0][head[0].index("[m2]:") + 1:] if head and "[m2]:" in head[0] else []
+    patches = [_patch_face(w) for w in words[0::2]]
+    areas = np.array([float(w) for w in words[1::2]])
+    if not patches:
+        raise ValueError("%s: no patch areas in its header" % fluid_path)
+    fluid = _read(fluid_path, ["step", "time"] + ["%s%d" % (p, k) for p in patches for k in range(6)])
+    f_steps = fluid["step"].astype(np.int64)
+    fl = np.stack([np.column_stack([fluid["%s%d" % (p, k)] for k in range(6)]) for p in patches], axis=1)
+    if dem_file is None:
+        faces = tuple(patches)
+        zeros = np.zeros((len(f_steps), len(faces), 3))
+        return WallLoads(f_steps, fluid["time"], faces, areas, fl[:, :, 0:3], fl[:, :, 3:6], zeros, zeros.copy(),
+                         False)
+    dem_path = os.path.join(run_dir, "dem", dem_file)
+    if not os.path.isfile(dem_path):
+        raise FileNotFoundError("%s not found: give fix fdm/couple 'walls %s' (docs/dem.md)" % (dem_path, dem_file))
+    head = _header_lines(dem_path, 2)
+    if len(head) < 2 or head[1][0] != "step":
+        raise ValueError("%s is not a wall-loads file of fix fdm/couple (no '# step ...' header)" % dem_path)
+    columns = head[1]
+    dem_faces = []
+    for c in columns[1:]:
+        face = c.split(":")[0]
+        if face not in dem_faces:
+            dem_faces.append(face)
+    dem = _read(dem_path, columns)
+    d_steps = dem["step"].astype(np.int64)
+    faces = tuple(f for f in patches if f in dem_faces)
+    if not faces:
+        raise ValueError("the fluid's wall patches (%s) and the particle code's walls (%s) have no face in common"
+                         % (" ".join(patches), " ".join(dem_faces)))
+    common, fi, di = np.intersect1d(f_steps, d_steps, return_indices=True)
+    keep = [patches.index(f) for f in faces]
+
+    def part(name: str) -> np.ndarray:
+        return np.stack([np.column_stack([dem["%s:%s%s" % (f, name, c)][di] for c in "XYZ"]) for f in faces], axis=1)
+
+    return WallLoads(common, fluid["time"][fi], faces, areas[keep], fl[fi][:, keep, 0:3], fl[fi][:, keep, 3:6],
+                     part("subgrid"), part("contact"), True)
 
 
 # ------------------------------------------------------------------------------------------------

@@ -30,6 +30,21 @@ averaging over the snapshots. The steady part starts at the latest start found b
 gamma_dot_core, Sigma^p_12, Sigma^p_11 - Sigma^p_22, Sigma^p_22 - Sigma^p_33, Sigma^c_11,
 Sigma^c_22, Sigma^c_33), unless start_time is given.
 
+The momentum balance (the built-in check of a Couette run, docs/profiles.md "Stress balance"). In
+steady simple shear without inertia the time-averaged shear stress is uniform across the gap, so
+the core stress Sigma_12 of Eq. 51 equals the shear stress the suspension exerts on each wall:
+
+    tau_w = -F_w,1 (n_w . e2) / A_w,   F_w = fluid traction + sub-grid lubrication + contact
+
+with F_w the force on wall w per step (fdm.output.read_wall_loads: fdmFoam's viscous force on the
+patch, and the particles' sub-grid wall force (Eq. D.6) and wall contacts from fix fdm/couple
+walls), n_w the wall's normal out of the suspension (-e2 at the low wall, +e2 at the high one), A_w
+its area. stress_balance time-averages tau_lo, tau_hi, their mean and its parts over the steady part
+(block averaging over the steps) and reports |Sigma_12 - tau|/tau. Instantaneously and exactly (the
+divergence theorem over the whole gap, Stokes flow, force-free particles): the mean of the two walls
+equals the gap-averaged stress eta (U_hi - U_lo)/L_y + sum_p (S^H_p + S^c_p)_12 / V
+(gap_shear_stress), the check of the records themselves.
+
 Maron-Pierce (Eq. 55): eta_s = alpha / (1 - phi/phi_m)^2 fitted by weighted least squares
 (scipy.optimize.curve_fit with sigma = the error bars of eta_s, absolute_sigma=True: the
 parameter covariance is that of the given error bars, not rescaled by chi^2/dof); the starting
@@ -45,7 +60,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import curve_fit
 
 from . import timeseries
-from .profiles import CoreSeries, component
+from .profiles import Channel, CoreSeries, Snapshot, component
 
 
 @dataclass(frozen=True)
@@ -120,6 +135,110 @@ def shear_rheology(series: CoreSeries, eta: float = 1.0, start_time: float | Non
                      ratio(series.sigma_c[:, c33], total12)),
         sigma_h=series.sigma_h[sl].mean(axis=0), sigma_c=series.sigma_c[sl].mean(axis=0),
         start_time=float(t[start]), steady=bool(steady), n_samples=len(t) - start)
+
+
+# ---- the momentum balance: core stress against the walls' --------------------------------------
+
+def wall_shear_stresses(loads, channel: Channel) -> dict[str, NDArray]:
+    """Per step the shear stress the suspension exerts on the low and the high wall of the channel,
+    tau_w = -F_w,1 (n_w . e2)/A_w (module docstring), and its parts: a dict of (T, 2) arrays
+    (column 0 the low wall, 1 the high one) "total", "fluid", "subgrid", "contact". loads: an
+    fdm.output.WallLoads (forces on the walls per step, faces named like "ylo", "yhi")."""
+    axis = "xyz"[channel.wall_axis]
+    lo, hi = loads.wall(axis + "lo"), loads.wall(axis + "hi")
+    f1 = channel.flow_axis
+    # n_w . e2: -1 at the low wall (the suspension lies above it), +1 at the high one
+    sign = np.array([1.0, -1.0])
+    areas = np.array([loads.areas[lo], loads.areas[hi]])
+    if np.any(areas <= 0):
+        raise ValueError("wall areas must be positive, got %s" % areas)
+
+    def tau(force: NDArray) -> NDArray:
+        return sign * force[:, [lo, hi], f1] / areas
+
+    parts = dict(fluid=tau(loads.fluid_viscous), subgrid=tau(loads.subgrid), contact=tau(loads.contact))
+    parts["total"] = parts["fluid"] + parts["subgrid"] + parts["contact"]
+    return parts
+
+
+def gap_shear_stress(snapshot: Snapshot, channel: Channel, eta: float, wall_shear_rate: float) -> float:
+    """The shear stress averaged over the whole gap at one instant: eta (U_hi - U_lo)/L_y (the fluid's
+    mean strain rate, exact with no-slip walls) + sum_p (S^H_p + S^c_p)_12 / V (Eqs. 51-53 over the
+    box). wall_shear_rate = (U_hi - U_lo)/L_y of the walls' flow components."""
+    c = component(channel.flow_axis, channel.wall_axis)
+    total = float(np.sum(snapshot.stresslet_h[:, c]) + np.sum(snapshot.stresslet_c[:, c]))
+    return eta * wall_shear_rate + total / channel.volume
+
+
+@dataclass(frozen=True)
+class StressBalance:
+    """The momentum balance of one run (module docstring). core: Sigma_12 of Eq. 51 (the
+    ShearRheology's sigma_12); wall: the mean of tau_lo and tau_hi; wall_lo, wall_hi; parts (mean of
+    both walls): wall_fluid, wall_subgrid, wall_contact. rel_error = |core - wall|/|wall| and its
+    error (core and wall errors combined as independent: the core is sampled at the snapshots, the
+    walls every step); wall_asymmetry = |tau_lo - tau_hi|/|wall| (the net force on the walls: zero
+    at convergence); n_steps averaged from start_time (strain)."""
+
+    core: Estimate
+    wall: Estimate
+    wall_lo: Estimate
+    wall_hi: Estimate
+    wall_fluid: Estimate
+    wall_subgrid: Estimate
+    wall_contact: Estimate
+    rel_error: float
+    rel_error_err: float
+    wall_asymmetry: float
+    start_time: float
+    n_steps: int
+
+    def as_dict(self) -> dict:
+        """The numbers for results.json: stress_balance_rel_error and its parts (stresses in the
+        units of eta gamma_dot)."""
+        out = dict(stress_balance_rel_error=self.rel_error, stress_balance_rel_error_err=self.rel_error_err,
+                   stress_core=self.core.value, stress_core_err=self.core.error,
+                   stress_wall=self.wall.value, stress_wall_err=self.wall.error,
+                   stress_wall_asymmetry=self.wall_asymmetry, stress_balance_steps=self.n_steps,
+                   stress_balance_from_strain=self.start_time)
+        for name in ("wall_lo", "wall_hi", "wall_fluid", "wall_subgrid", "wall_contact"):
+            e = getattr(self, name)
+            out["stress_" + name] = e.value
+            out["stress_" + name + "_err"] = e.error
+        return out
+
+
+def relative_difference(core: float, wall: float) -> float:
+    """|core - wall| / |wall| (nan if wall = 0)."""
+    return abs(core - wall) / abs(wall) if wall != 0 else float("nan")
+
+
+def stress_balance(rheology: ShearRheology, loads, channel: Channel, strain_rate: float = 1.0,
+                   start_time: float | None = None) -> StressBalance:
+    """Core stress against the walls' shear stress, both time-averaged over the steady part: from
+    start_time (strain; default the rheology's start) on, the wall loads of every step with
+    time x strain_rate >= start_time (block-averaged: the steps are correlated)."""
+    start = rheology.start_time if start_time is None else start_time
+    tau = wall_shear_stresses(loads, channel)
+    strain = np.asarray(loads.times, dtype=float) * strain_rate
+    sl = strain >= start - 1e-9 * max(1.0, abs(start))
+    n = int(np.sum(sl))
+    if n < 2 * timeseries.MIN_BLOCKS:
+        raise ValueError("stress balance: %d steps with wall loads from strain %g on; %d at least"
+                         % (n, start, 2 * timeseries.MIN_BLOCKS))
+
+    def mean(x: NDArray) -> Estimate:
+        return Estimate.from_average(timeseries.block_average(x[sl]))
+
+    wall = mean(tau["total"].mean(axis=1))
+    core = rheology.sigma_12
+    rel = relative_difference(core.value, wall.value)
+    rel_err = float(np.hypot(core.error, wall.error) / abs(wall.value)) if wall.value != 0 else float("nan")
+    lo, hi = mean(tau["total"][:, 0]), mean(tau["total"][:, 1])
+    return StressBalance(core=core, wall=wall, wall_lo=lo, wall_hi=hi,
+                         wall_fluid=mean(tau["fluid"].mean(axis=1)), wall_subgrid=mean(tau["subgrid"].mean(axis=1)),
+                         wall_contact=mean(tau["contact"].mean(axis=1)), rel_error=rel, rel_error_err=rel_err,
+                         wall_asymmetry=abs(lo.value - hi.value) / abs(wall.value) if wall.value != 0 else float("nan"),
+                         start_time=float(start), n_steps=n)
 
 
 # ---- Maron-Pierce ------------------------------------------------------------------------------
