@@ -6,7 +6,8 @@ Every run is couette.py with the same packing (same box, phi_bulk and seed: the 
 depend on dt or a1/Delta) and its own springs from the docs/contact.md recipe (k_t depends on dt).
 A run whose results file exists is not run again, so the study can be stopped and continued.
 
-  convergence.py                      dt in {0.04, 0.02, 0.01} at a1/Delta = 3, and dt 0.02 at 4
+  convergence.py                      dt in {0.04, 0.02, 0.01} at a1/Delta = 3, dt 0.02 at 4, and
+                                      tolLambda 1e-2 and 3e-3 (the case's 1e-3) at dt 0.02, a1/Delta 3
   convergence.py --strain 4 --quick   two runs only (dt 0.04 and 0.02 at a1/Delta = 3)
 
 Writes <workdir>/<run>.json per run and --out (default docs/benchmarks_couetteConvergence.json) with
@@ -19,6 +20,7 @@ import subprocess
 import sys
 from typing import Dict, List, Tuple
 
+TOL_LAMBDA = 1e-3   # the case's default
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 
@@ -29,19 +31,19 @@ KEYS = ("phi_bulk", "phi_core", "gamma_core_over_gamma0", "eta_s", "eta_s_err", 
         "springs")
 
 
-def run_one(a_over_delta: int, dt: float, args: argparse.Namespace) -> Dict:
+def run_one(a_over_delta: int, dt: float, tol_lambda: float, args: argparse.Namespace) -> Dict:
     """One Couette run (or its results file if it exists): the keys of KEYS."""
-    name = "ad%d_dt%g" % (a_over_delta, dt)
+    name = "ad%d_dt%g" % (a_over_delta, dt) + ("" if tol_lambda == TOL_LAMBDA else "_tol%g" % tol_lambda)
     out = os.path.join(args.workdir, name + ".json")
     if not os.path.exists(out):
         cmd = [sys.executable, os.path.join(HERE, "couette.py"), "--phi", str(args.phi), "--size", *map(str, args.size),
                "--a-over-delta", str(a_over_delta), "--dt", str(dt), "--strain", str(args.strain),
-               "--seed", str(args.seed), "--workdir", os.path.join(args.workdir, name), "--out", out, "--overwrite"]
+               "--seed", str(args.seed), "--tol-lambda", str(tol_lambda), "--workdir", os.path.join(args.workdir, name), "--out", out, "--overwrite"]
         print("running:", " ".join(cmd), flush=True)
         subprocess.run(cmd, check=True)
     with open(out) as f:
         r = json.load(f)
-    return {k: r.get(k) for k in KEYS} | {"a_over_delta": a_over_delta, "run": name}
+    return {k: r.get(k) for k in KEYS} | {"a_over_delta": a_over_delta, "tol_lambda": tol_lambda, "run": name}
 
 
 def plot(runs: List[Dict], path: str) -> None:
@@ -50,13 +52,13 @@ def plot(runs: List[Dict], path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 3, figsize=(12, 3.6))
-    for ad in sorted({r["a_over_delta"] for r in runs}):
-        rs = sorted((r for r in runs if r["a_over_delta"] == ad), key=lambda r: r["dt"])
+    for ad, tol in sorted({(r["a_over_delta"], r["tol_lambda"]) for r in runs}):
+        rs = sorted((r for r in runs if r["a_over_delta"] == ad and r["tol_lambda"] == tol), key=lambda r: r["dt"])
+        label = "a1/Δ = %d, tolLambda %g" % (ad, tol)
         dts = [r["dt"] for r in rs]
-        ax[0].errorbar(dts, [r["eta_s"] for r in rs], [r["eta_s_err"] for r in rs], marker="o", capsize=3,
-                       label="a1/Δ = %d" % ad)
-        ax[1].plot(dts, [r["stress_balance_rel_error"] * 100 for r in rs], marker="o", label="a1/Δ = %d" % ad)
-        ax[2].plot(dts, [r["core_seconds_per_strain_unit"] for r in rs], marker="o", label="a1/Δ = %d" % ad)
+        ax[0].errorbar(dts, [r["eta_s"] for r in rs], [r["eta_s_err"] for r in rs], marker="o", capsize=3, label=label)
+        ax[1].plot(dts, [r["stress_balance_rel_error"] * 100 for r in rs], marker="o", label=label)
+        ax[2].plot(dts, [r["core_seconds_per_strain_unit"] for r in rs], marker="o", label=label)
     for a, ylabel in zip(ax, ("η_s (core)", "stress balance error [%]", "core-seconds per strain unit")):
         a.set_xscale("log")
         a.set_xlabel("Δt γ̇0")
@@ -78,10 +80,10 @@ def main(argv=None) -> Dict:
     p.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_couetteConvergence.json"))
     args = p.parse_args(argv)
     os.makedirs(args.workdir, exist_ok=True)
-    grid: List[Tuple[int, float]] = [(3, 0.04), (3, 0.02)]
+    grid: List[Tuple[int, float, float]] = [(3, 0.04, TOL_LAMBDA), (3, 0.02, TOL_LAMBDA)]
     if not args.quick:
-        grid += [(3, 0.01), (4, 0.02)]
-    runs = [run_one(ad, dt, args) for ad, dt in grid]
+        grid += [(3, 0.01, TOL_LAMBDA), (4, 0.02, TOL_LAMBDA), (3, 0.02, 1e-2), (3, 0.02, 3e-3)]
+    runs = [run_one(ad, dt, tol, args) for ad, dt, tol in grid]
     summary = dict(phi=args.phi, size=list(args.size), strain=args.strain, seed=args.seed,
                    command="cases/couette/convergence.py " + " ".join(argv if argv is not None else sys.argv[1:]),
                    runs=runs)
@@ -89,10 +91,10 @@ def main(argv=None) -> Dict:
         json.dump(summary, f, indent=1)
     figure = os.path.splitext(args.out)[0] + ".png"
     plot(runs, figure)
-    print("%-10s %8s %14s %8s %8s %10s %10s %8s" % ("run", "phi_core", "eta_s", "N2_hat", "balance", "solves/st",
+    print("%-16s %8s %14s %8s %8s %10s %10s %8s" % ("run", "phi_core", "eta_s", "N2_hat", "balance", "solves/st",
                                                  "core-s/str", "min gap"))
     for r in runs:
-        print("%-10s %8.4f %7.3f ± %4.2f %8.3f %7.1f%% %10.1f %10.0f %8.1e" % (
+        print("%-16s %8.4f %7.3f ± %4.2f %8.3f %7.1f%% %10.1f %10.0f %8.1e" % (
             r["run"], r["phi_core"], r["eta_s"], r["eta_s_err"], r["N2_hat"], 100 * r["stress_balance_rel_error"],
             r["inner_iterations_mean"], r["core_seconds_per_strain_unit"], r["min_pair_gap"]))
     print("wrote %s and %s" % (args.out, figure))

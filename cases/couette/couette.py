@@ -14,10 +14,11 @@ The contact springs follow the rules of docs/contact.md ("A recipe"), computed a
                                                      from the paper's Maron-Pierce fit (Eq. 55:
                                                      alpha = 0.803, phi_m = 0.59)
   k_n   = 2 F_max / h_r                              a contact under F_max sits at h = h_r/2 (recipe step 2)
-  k_t   = min(k_n, 0.5 zeta_t / dt)                  the tangential spring within half its ab2 limit (step 4)
+  k_t   = k_n                                        the springs are implicit (contact_integration implicit,
+                                                     the default): they set no limit on dt (step 4)
 with zeta_n, zeta_t the normal and slip resistances of a free a1-a1 pair at the gap h_r/2 (Stokes drag
-plus the sub-grid block at this a1/Delta, fdmResistance); the stable time steps zeta_n/k_n and
-zeta_t/k_t (ab2) are printed, and a dt above half of them is warned about.
+plus the sub-grid block at this a1/Delta, fdmResistance); the time steps zeta_n/k_n and zeta_t/k_t
+that would bound explicit springs (ab2) are printed for reference.
 
   couette.py                         the small scene (about 40 spheres, 10 x 12 x 8 a1, a1/Delta = 3,
                                      3 strain units at dt = 0.02): a few minutes
@@ -51,7 +52,6 @@ SHEAR_RATE = 1.0
 ROUGHNESS = 5e-3 * A1        # h_r (section 6)
 FRICTION = 0.5               # mu_s (section 6)
 MARON_PIERCE = (0.803, 0.59)  # alpha, phi_m of the paper's fit (Eq. 55, Fig. 21)
-SPRING_SAFETY = 0.5           # docs/contact.md recipe step 4
 PAIR_CUTOFF = 0.65            # pair_style fdm/subgrid default cut-off (mesh cells)
 
 # Table 8: phi_bulk -> (phi_core, gamma_core/gamma_0, (Lx, Ly, Lz)/a1, N_P, dt)
@@ -83,7 +83,8 @@ class Springs:
     def describe(self, dt: float) -> str:
         return ("contact springs (docs/contact.md recipe): design load F_max = %.4g N, kn = 2 F_max/h_r = %.4g N/m, "
                 "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a1-a1 pair at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
-                "stable dt (ab2): normal %.4g, tangential %.4g; dt = %g is %.2f of the smaller"
+                "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential; implicit springs (the "
+                "default) have no such limit, dt = %g is %.2f of the smaller"
                 % (self.design_load, self.kn, self.kt, self.mu_s, self.h_r / A1, self.zeta_n, self.zeta_t,
                    self.dt_limit_normal, self.dt_limit_tangential, dt,
                    dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
@@ -119,7 +120,7 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
     design_load = 6 * math.pi * ETA * A2 ** 2 * SHEAR_RATE * relative_viscosity
     zeta_n, zeta_t = pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta)
     kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
-    kt = min(kn, SPRING_SAFETY * zeta_t / dt) if kt is None else kt
+    kt = kn if kt is None else kt      # implicit springs: no stability bound on k_t dt / zeta_t
     return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
 
 
@@ -283,13 +284,6 @@ def main(argv: list[str] | None = None) -> dict:
     print("packing:", pack.summary())
     springs = choose_springs(pack.phi, dt, delta, args.kn, args.kt)
     print(springs.describe(dt))
-    limit = min(springs.dt_limit_normal, springs.dt_limit_tangential)
-    if dt > limit:
-        print("WARNING: dt = %g is beyond the contact stability limit %.4g (ab2, docs/contact.md 3c): expect limit "
-              "cycles, overlaps and contacts that look plausible but are wrong" % (dt, limit))
-    elif dt > SPRING_SAFETY * limit:
-        print("note: dt = %g is above half the contact stability limit %.4g (the recipe's safety factor): the "
-              "gaps and loads of a suspension vary" % (dt, limit))
 
     name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (pack.phi if n_particles is None else phi, *args.size,
                                                   args.a_over_delta, dt, args.seed,
