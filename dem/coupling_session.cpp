@@ -145,6 +145,7 @@ void CouplingSession::connectAndHandshake(LAMMPS *lmp)
         rhoFluid_ = reply.rhoFluid;
         meshSize_ = reply.delta;
         viscosity_ = reply.viscosity;
+        for (int d = 0; d < 3; d++) gradP0_[d] = reply.gradP0[d];
         for (int face = 0; face < 6; face++) {
           faces_[face][0] = reply.faces[face].kind;
           for (int d = 0; d < 3; d++) faces_[face][1 + d] = reply.faces[face].velocity[d];
@@ -163,6 +164,7 @@ void CouplingSession::connectAndHandshake(LAMMPS *lmp)
   MPI_Bcast(&rhoFluid_, 1, MPI_DOUBLE, 0, lmp->world);
   MPI_Bcast(&meshSize_, 1, MPI_DOUBLE, 0, lmp->world);
   MPI_Bcast(&viscosity_, 1, MPI_DOUBLE, 0, lmp->world);
+  MPI_Bcast(gradP0_, 3, MPI_DOUBLE, 0, lmp->world);
   MPI_Bcast(&faces_[0][0], 24, MPI_DOUBLE, 0, lmp->world);
   start_ = MPI_Wtime();
 }

@@ -65,6 +65,8 @@ class CouplingSession {
   double rhoFluid() const { return rhoFluid_; }
   double meshSize() const { return meshSize_; }
   double viscosity() const { return viscosity_; }
+  // The fluid's imposed mean pressure gradient [Pa/m] (Eq. 42; 0 without a fluid)
+  const double *gradP0() const { return gradP0_; }
   // Box face 0..5 (xlo xhi ylo yhi zlo zhi): kind and wall velocity.
   void fluidFace(int face, int &kind, double velocity[3]) const;
   static const char *faceKindName(int kind);
@@ -99,6 +101,7 @@ class CouplingSession {
   bool connected_;                                       // every rank: handshake done
   int particles_;
   double alphaLambda_, rhoFluid_, meshSize_, viscosity_;
+  double gradP0_[3] = {0, 0, 0};
   double faces_[6][4];                                   // kind, wall velocity
   double start_;                                         // MPI_Wtime of the handshake
   int runs_;

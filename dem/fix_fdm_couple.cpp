@@ -530,6 +530,8 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
     l.mass = q.mass;
     l.density = q.density;
   }
+  if (move_ && session_.hasFluid() && domain->xperiodic && domain->yperiodic && domain->zperiodic)
+    checkPeriodicBalance(particles);
   try {
     if (!system_) {
       fdm::ParticleVelocitySystem::Settings settings;
@@ -830,6 +832,47 @@ void FixFdmCouple::scatter()
     }
   }
   fillPerAtomArray();
+}
+
+void FixFdmCouple::checkPeriodicBalance(const std::vector<Particle> &particles)
+{
+  // rank 0. In a box periodic in every direction the steady Stokes flow exists only if the loads
+  // on the free particles (the forces LIGGGHTS holds, whose contact parts cancel in pairs, plus the
+  // buoyant weights of Eq. 31) balance the fluid's imposed pressure gradient: their sum is
+  // V0 gradP0 (Eq. 43). Otherwise the mean flow grows without bound (2e12 m/s within the first
+  // step of a force-free sphere under gradP0 = 0.01 Pa/m).
+  const double pi = 3.14159265358979323846;
+  const double *gradP0 = session_.gradP0();
+  // only under an imposed gradient: the unit tests' stand-in fluids drive free particles in periodic
+  // boxes by forces alone (a real fluid's mean flow would then grow too; docs/errors.md)
+  if (gradP0[0] == 0 && gradP0[1] == 0 && gradP0[2] == 0) return;
+  const double volume = domain->xprd * domain->yprd * domain->zprd;
+  double sum[3] = {0, 0, 0}, scale = 0;
+  for (const Particle &q : particles) {
+    const double buoyantMass = q.mass - session_.rhoFluid() * 4.0 / 3.0 * pi * q.radius * q.radius * q.radius;
+    for (int d = 0; d < 3; d++) {
+      const double load = q.f[d] + buoyantMass * gravity_[d];
+      sum[d] += load;
+      scale += std::fabs(load);
+    }
+  }
+  double imposed[3], mismatch = 0;
+  for (int d = 0; d < 3; d++) {
+    imposed[d] = volume * gradP0[d];
+    scale += std::fabs(imposed[d]);
+    mismatch = std::max(mismatch, std::fabs(sum[d] - imposed[d]));
+  }
+  if (mismatch <= 1e-6 * scale || scale == 0) return;
+  char text[600];
+  snprintf(text, sizeof text,
+           "in a box periodic in every direction the loads on the free particles (forces beside contacts, "
+           "buoyant weights) sum to (%g %g %g) N but the fluid's imposed pressure gradient gradP0 = (%g %g %g) "
+           "Pa/m needs V0 gradP0 = (%g %g %g) N (Eq. 43; V0 = %g m3) at step " BIGINT_FORMAT
+           ": no steady Stokes flow exists. Set gradP0 in the fluid's constant/fdmProperties, give the particles "
+           "that external force (fix addforce), hold them (move no), or bound the flow with walls",
+           sum[0], sum[1], sum[2], gradP0[0], gradP0[1], gradP0[2], imposed[0], imposed[1], imposed[2], volume,
+           update->ntimestep);
+  fail(text);
 }
 
 void FixFdmCouple::writeWallLoads()

@@ -86,6 +86,7 @@ class FixFdmCouple : public Fix {
   void scatter();
   void fillPerAtomArray();
   void writeWallLoads();
+  void checkPeriodicBalance(const std::vector<Particle> &particles);
   void allAgree(const std::string &problemOnRank0);
   void fail(const std::string &message);
   void printTiming(const char *what, const Timing &t, double wall, int runs) const;

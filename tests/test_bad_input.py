@@ -64,6 +64,24 @@ def test_particle_crossing_a_wall(tmp_path, env):
     assert wall < 30
 
 
+def test_pressure_gradient_in_a_fully_periodic_box_with_free_particles(tmp_path, env):
+    """gradP0 in a box periodic in every direction, the sphere force-free: no steady Stokes flow
+    exists (Eq. 43; the mean flow grew to 2e12 m/s within the first step before this check).
+    fix fdm/couple stops before the first fluid solve, naming the loads, gradP0 and the remedies;
+    the held sphere of the reference run (test_reference_run_succeeds) carries the force and passes."""
+    root = make_case(tmp_path, fix_options="", runs=("run 3",))
+    status, out, wall = run_fdm(root, env)
+    assert status != 0
+    text = logs(root)
+    assert re.search(r"in a box periodic in every direction the loads on the free particles .* sum to \(0 0 0\) N "
+                     r"but the fluid's imposed pressure gradient gradP0 = \(-0.01 0 0\) Pa/m needs "
+                     r"V0 gradP0 = \(-0.64 0 0\) N", text), text[-2000:]
+    assert "constant/fdmProperties" in text and "fix addforce" in text and "move no" in text
+    steps = os.path.join(root, "fluid", "postProcessing", "fdm", "steps.dat")
+    assert not os.path.exists(steps) or all(line.startswith("#") for line in open(steps))
+    assert wall < 30
+
+
 def test_overlapping_particles(tmp_path, env):
     root = make_case(tmp_path, spheres=[(2.0, 2.0, 2.0, 0.5), (2.8, 2.0, 2.0, 0.5)])
     status, out, wall = run_fdm(root, env)

@@ -174,7 +174,9 @@ Message FluidHello::toMessage() const
 {
     using namespace layout;
     Message m = makeMessage(MessageType::Hello, 0, 0, 1, helloFluidWidth,
-                            "role=fluid version=" + std::to_string(version) + " resume=" + std::to_string(resumeStep));
+                            "role=fluid version=" + std::to_string(version) + " resume=" + std::to_string(resumeStep) +
+                                " gradP0x=" + allDigits(gradP0[0]) + " gradP0y=" + allDigits(gradP0[1]) +
+                                " gradP0z=" + allDigits(gradP0[2]));
     double* r = &m.data[0];
     r[hfNParticles] = double(nParticlesExpected);
     r[hfAlphaLambda] = alphaLambda;
@@ -203,6 +205,10 @@ FluidHello FluidHello::fromMessage(const Message& m)
     expectVersion(m, "Hello of the fluid solver");
     FluidHello h;
     h.resumeStep = optionalCount(m, "resume", 0);
+    for (int d = 0; d < 3; ++d) {
+        const std::string key = std::string("gradP0") + "xyz"[d];
+        if (m.text.find(key + "=") != std::string::npos) h.gradP0[d] = m.textNumber(key);
+    }
     const double* r = &m.data[0];
     h.nParticlesExpected = std::llround(r[hfNParticles]);
     h.alphaLambda = r[hfAlphaLambda];

@@ -31,6 +31,7 @@ Usage
 #include "pisoControl.H"
 #include "OFstream.H"
 #include "OStringStream.H"
+#include "emptyFvPatch.H"
 #include "uniformCartesianMesh.H"
 #include "particleForcing.H"
 #include "fluidCoupling.H"
@@ -93,7 +94,8 @@ int main(int argc, char *argv[])
     (
         grid, U, nParticlesExpected, alphaLambda, rho.value(),
         rho.value()*nu.value(),     // eta
-        label(resumed.step)
+        label(resumed.step),
+        gradP0.value()
     );
 
     #include "createOutput.H"
@@ -121,6 +123,20 @@ int main(int argc, char *argv[])
     // The function objects of system/controlDict. fdmDEM drives time, so
     // instead of runTime.run() the loop calls what it would: start() before
     // the first step, execute() after each step, end() after the last.
+    // A box periodic in every direction (no wall patch) has a steady Stokes
+    // flow under gradP0 only if the particles carry its force, V0 gradP0
+    // (Eq. 43; held particles, or an external force): checked every step
+    bool fullyPeriodic = true;
+    forAll(mesh.boundary(), patchi)
+    {
+        const fvPatch& patch = mesh.boundary()[patchi];
+        if (!patch.coupled() && !isA<emptyFvPatch>(patch))
+        {
+            fullyPeriodic = false;
+        }
+    }
+    const scalar boxVolume = gSum(mesh.V());
+
     runTime.functionObjects().start();
 
     Info<< nl << "Starting time loop (driven by fdmDEM)" << nl << endl;
@@ -248,6 +264,30 @@ int main(int argc, char *argv[])
                 t0 = wallClock();
                 anderson.accelerate(state, U, lambda, p);
                 stepFluidTime += wallClock() - t0;
+            }
+        }
+
+        if (converged && fullyPeriodic && mag(gradP0.value()) > 0)
+        {
+            // Eq. (43) at a converged step, before anything of it is written
+            // (fix fdm/couple checks the particles' forces before the step;
+            // this catches what it cannot see)
+            const vector lambdaForce =
+                -rho.value()*gSum(lambda.primitiveField()*mesh.V());
+            const vector imposed = boxVolume*gradP0.value();
+            if (mag(lambdaForce + imposed) > 0.1*mag(imposed))
+            {
+                OStringStream msg;
+                msg << "constant/fdmProperties: gradP0 " << gradP0.value()
+                    << " Pa/m in a box periodic in every direction (no wall"
+                    << " patch) has no steady Stokes flow unless the particles"
+                    << " carry its force, V0 gradP0 = " << imposed
+                    << " N (Eq. 43); at time step " << coupling.step()
+                    << " the lambda force on the liquid is " << lambdaForce
+                    << " N. Hold the particles (fix fdm/couple ... move no),"
+                    << " give them that external force (fix addforce), or"
+                    << " bound the flow with walls";
+                coupling.fatal(msg.str());
             }
         }
 

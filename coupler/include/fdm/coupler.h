@@ -188,6 +188,8 @@ struct FluidHello {
     double viscosity = 0;                      // eta = rho_f nu [Pa s]
     BoxFace faces[layout::nFaces];             // xlo, xhi, ylo, yhi, zlo, zhi
     long long resumeStep = 0;                  // the checkpoint step the fluid resumes from (0: fresh)
+    double gradP0[3] = {0, 0, 0};              // imposed mean pressure gradient [Pa/m] (Eq. 42;
+                                               // optional text entries, 0 when absent)
 
     Message toMessage() const;
     static FluidHello fromMessage(const Message& m);

@@ -237,7 +237,8 @@ void Foam::fluidCoupling::handshake
     scalar alphaLambda,
     scalar rhoFluid,
     scalar eta,
-    label resumeStep
+    label resumeStep,
+    const vector& gradP0
 )
 {
     namespace layout = cpl::layout;
@@ -346,6 +347,10 @@ void Foam::fluidCoupling::handshake
                 }
                 reply.viscosity = eta;
                 reply.resumeStep = resumeStep;
+                for (direction d = 0; d < 3; ++d)
+                {
+                    reply.gradP0[d] = gradP0[d];
+                }
                 for (label f = 0; f < label(layout::nFaces); ++f)
                 {
                     reply.faces[f] = faces[f];
