@@ -33,6 +33,7 @@ import argparse
 import json
 import math
 import os
+import re
 import shutil
 import sys
 import time
@@ -234,6 +235,72 @@ def analyse(run_dir: str, scene: dict, pack: packing.Packing, wall_seconds: floa
     return res, [channel, avg, fine, snapshots]
 
 
+def table8_row(phi: float) -> dict:
+    """The paper's Table 8 row of phi_bulk."""
+    return dict(zip(("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi]))
+
+
+def report(run_dir: str, scene: dict, pack: packing.Packing, wall: float, ranks: int, h_layer: float, out: str,
+           extra: dict) -> dict:
+    """analyse() the run, write `out` (results.json, with `extra`) and the profile figure beside it,
+    print the summary; returns the results."""
+    results, (channel, avg, fine, _) = analyse(run_dir, scene, pack, wall, ranks, h_layer)
+    results.update(extra)
+    figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_couette.png")
+    if out.endswith(".json") and os.path.basename(out) != "results.json":
+        figure = out[:-len(".json")] + ".png"
+    profiles.plot_profiles(figure, channel, avg, fine)
+    results["figure"] = os.path.basename(figure)
+    with open(out, "w") as f:
+        json.dump(results, f, indent=1)
+    keys = ("phi_bulk phi_core gamma_core_over_gamma0 eta_s eta_s_err N1_hat N2_hat Sigma_c_hat strain_units "
+            "steady_from_strain n_particles cells dt wall_seconds core_seconds_per_strain_unit inner_iterations_mean "
+            "inner_iterations_max unconverged_steps min_pair_gap min_wall_gap").split()
+    for k in keys:
+        print("%-30s %s" % (k, results[k]))
+    print("stress balance (Eq. 51 core against the walls, from strain %g, %d steps):"
+          % (results["stress_balance_from_strain"], results["stress_balance_steps"]))
+    print("  core  eta gamma_core + Sigma^h_12 + Sigma^c_12 = %.4g +- %.2g" % (results["stress_core"],
+                                                                           results["stress_core_err"]))
+    print("  walls %.4g +- %.2g (low %.4g, high %.4g): fluid %.4g + sub-grid %.3g + contact %.3g"
+          % tuple(results[k] for k in ("stress_wall", "stress_wall_err", "stress_wall_lo", "stress_wall_hi",
+                                       "stress_wall_fluid", "stress_wall_subgrid", "stress_wall_contact")))
+    print("  stress_balance_rel_error = %.4g +- %.2g; gap-averaged stress against the walls at the %d snapshots: "
+          "at most %.2g" % (results["stress_balance_rel_error"], results["stress_balance_rel_error_err"],
+                            results["stress_gap_snapshots"], results["stress_gap_rel_error_max"]))
+    print("wrote %s and %s" % (out, figure))
+    return results
+
+
+def read_run(run_dir: str) -> tuple[dict, packing.Packing, dict]:
+    """(scene, packing, springs) of a run folder written by write_case, from its own files (the
+    packing data, blockMeshDict, the LIGGGHTS input): what --analyse needs to analyse a run that
+    was resumed, stopped or is still going."""
+    pack = packing.read_data(os.path.join(run_dir, "dem", "packing.data"), walls=(1,))
+    with open(os.path.join(run_dir, "fluid", "system", "blockMeshDict")) as f:
+        mesh = [int(v) for v in re.search(r"hex \([\d ]+\) \((\d+) (\d+) (\d+)\)", f.read()).groups()]
+    with open(os.path.join(run_dir, "dem", "in.couette")) as f:
+        dem = f.read()
+    dt = float(re.search(r"^timestep\s+(\S+)", dem, re.M).group(1))
+    steps = int(re.search(r"^run\s+(\d+)", dem, re.M).group(1))
+    contact = re.search(r"fdm/subgrid contact (\S+) (\S+) (\S+) (\S+)", dem)
+    springs = dict(zip(("kn", "kt", "mu_s", "h_r"), (float(v) for v in contact.groups()))) if contact else {}
+    box = [float(v) for v in pack.box]
+    scene = dict(box=box, cells=mesh[0] * mesh[1] * mesh[2], mesh=mesh, steps=steps,
+                 wall_velocity=SHEAR_RATE * box[1] / 2, dt=dt)
+    return scene, pack, springs
+
+
+def run_seconds(run_dir: str) -> tuple[float, int]:
+    """(wall seconds, ranks) of a run from its step records (the sum over sessions of a resumed run:
+    fluid solve + particle work + exchange of every step), ranks: fluid processor folders (or 1)
+    plus one particle rank."""
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    seconds = float(np.sum(steps["fluidSeconds"]) + np.sum(steps["particleSeconds"]) + np.sum(steps["exchangeSeconds"]))
+    fluid_ranks = len([d for d in os.listdir(os.path.join(run_dir, "fluid")) if d.startswith("processor")]) or 1
+    return seconds, fluid_ranks + 1
+
+
 def main(argv: list[str] | None = None) -> dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--phi", type=float, default=0.3, help="phi_bulk, the volume fraction of the spheres in the box")
@@ -259,8 +326,22 @@ def main(argv: list[str] | None = None) -> dict:
                    help="the paper's Table 8 scene for phi_bulk = PHI (box, N_P, dt): written, not run")
     p.add_argument("--run", action="store_true", help="with --table8: run it too")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
+    p.add_argument("--analyse", metavar="RUN_DIR", default=None,
+                   help="analyse this run folder as it stands (a resumed, stopped or running run) and write --out")
     case.add_run_options(p, HERE, tol_lambda=1e-3)
     args = p.parse_args(argv)
+
+    if args.analyse:
+        # a run folder as it stands (finished, stopped or still going): its own files say the scene
+        scene, pack, springs_used = read_run(args.analyse)
+        wall, ranks = run_seconds(args.analyse)
+        name = os.path.basename(os.path.normpath(args.analyse))
+        table8 = None
+        if name.startswith("table8_"):
+            table8 = table8_row(min(TABLE8, key=lambda k: abs(k - pack.phi)))
+        return report(args.analyse, scene, pack, wall, ranks, args.h_layer, args.out,
+                      dict(case="couette", run=name, run_dir=os.path.abspath(args.analyse), springs=springs_used,
+                           steps_planned=scene["steps"], table8=table8))
 
     n_particles = None
     phi = args.phi
@@ -308,34 +389,11 @@ def main(argv: list[str] | None = None) -> dict:
         return dict(run_dir=run_dir, **scene)
 
     wall = case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
-    results, (channel, avg, fine, _) = analyse(run_dir, scene, pack, wall, args.np_fluid + args.np_dem,
-                                               args.h_layer)
-    results.update(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration, tol_lambda=args.tol_lambda,
-                   n_max=args.n_max,
-                   a_over_delta=args.a_over_delta, seed=args.seed, springs=asdict(springs),
-                   table8=None if args.table8 is None else dict(zip(
-                       ("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi])))
-    figure = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_couette.png")
-    profiles.plot_profiles(figure, channel, avg, fine)
-    results["figure"] = os.path.basename(figure)
-    with open(args.out, "w") as f:
-        json.dump(results, f, indent=1)
-    keys = ("phi_bulk phi_core gamma_core_over_gamma0 eta_s eta_s_err N1_hat N2_hat Sigma_c_hat strain_units "
-            "steady_from_strain n_particles cells dt wall_seconds core_seconds_per_strain_unit inner_iterations_mean "
-            "inner_iterations_max unconverged_steps min_pair_gap min_wall_gap").split()
-    for k in keys:
-        print("%-30s %s" % (k, results[k]))
-    print("stress balance (Eq. 51 core against the walls, from strain %g, %d steps):"
-          % (results["stress_balance_from_strain"], results["stress_balance_steps"]))
-    print("  core  eta gamma_core + Sigma^h_12 + Sigma^c_12 = %.4g +- %.2g" % (results["stress_core"],
-                                                                           results["stress_core_err"]))
-    print("  walls %.4g +- %.2g (low %.4g, high %.4g): fluid %.4g + sub-grid %.3g + contact %.3g"
-          % tuple(results[k] for k in ("stress_wall", "stress_wall_err", "stress_wall_lo", "stress_wall_hi",
-                                       "stress_wall_fluid", "stress_wall_subgrid", "stress_wall_contact")))
-    print("  stress_balance_rel_error = %.4g +- %.2g; gap-averaged stress against the walls at the %d snapshots: "
-          "at most %.2g" % (results["stress_balance_rel_error"], results["stress_balance_rel_error_err"],
-                            results["stress_gap_snapshots"], results["stress_gap_rel_error_max"]))
-    print("wrote %s and %s" % (args.out, figure))
+    results = report(run_dir, scene, pack, wall, args.np_fluid + args.np_dem, args.h_layer, args.out,
+                     dict(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration,
+                          tol_lambda=args.tol_lambda, n_max=args.n_max, a_over_delta=args.a_over_delta,
+                          seed=args.seed, springs=asdict(springs),
+                          table8=None if args.table8 is None else table8_row(phi)))
     if not args.keep:
         fluid = os.path.join(run_dir, "fluid")
         shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
