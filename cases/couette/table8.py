@@ -1,0 +1,213 @@
+#!/usr/bin/env python3
+"""The paper's Table 8 and Fig. 21 (section 6.1) from one command: each phi_bulk's scene written,
+run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq. 55).
+
+  table8.py                                 phi_bulk 0.27, 0.37, 0.47 (25 strain units at dt 0.02)
+  table8.py --phis 0.27 0.32 0.37 0.42 0.47 0.52 0.54   all seven rows
+  table8.py --analyse-only                  the runs as they stand (partial runs reported with the
+                                            strain they reached), nothing run
+  table8.py --sessions-hours 2.5            stop launching runs after this long (a run in progress is
+                                            checkpointed every strain unit; the next call resumes it)
+
+Each run is `couette.py --table8 PHI` (the paper's box and particle count, this project's time step
+and a1/Delta), in <workdir>/table8_phi..., run with fdmRun; a call finds each folder again: a
+finished run is analysed, one with a checkpoint is resumed (`fdmRun --resume`), one without is
+started again. Killing this script (or the session ending) loses at most one checkpoint interval.
+
+Writes --out (default docs/table8.json): per phi_bulk the paper's row, this project's phi_core,
+gamma_core/gamma_0, eta_s, N1_hat, N2_hat, Sigma_c_hat with error bars, the stress balance, the strain
+reached and the cost; the Maron-Pierce fit with its uncertainty against the paper's alpha = 0.803,
+phi_m = 0.59 (with 3 or more analysed runs); and the figure beside it (Fig. 21 with error bars).
+"""
+import argparse
+import glob
+import json
+import os
+import subprocess
+import sys
+import time
+from typing import Dict, List, Optional
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PROJECT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(PROJECT, "scripts"))
+
+from fdm import checkpoint, output, rheology  # noqa: E402
+
+PAPER_FIT = dict(alpha=0.803, phi_m=0.59)   # paper section 6.1, Eq. (55)
+MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
+
+
+def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int) -> Optional[str]:
+    """The run folder couette.py --table8 wrote for this row, if any."""
+    pattern = os.path.join(workdir, "table8_phi%g_*_ad%g_dt%g_seed%d" % (phi, a_over_delta, dt, seed))
+    found = sorted(d for d in glob.glob(pattern) if os.path.isdir(d))
+    return found[0] if found else None
+
+
+def steps_planned(run_dir: str) -> int:
+    with open(os.path.join(run_dir, "dem", "in.couette")) as f:
+        for line in f:
+            words = line.split()
+            if words[:1] == ["run"]:
+                return int(words[1])
+    raise ValueError("%s/dem/in.couette has no run command" % run_dir)
+
+
+def steps_done(run_dir: str) -> int:
+    path = os.path.join(run_dir, "fluid", "postProcessing", "fdm", "steps.dat")
+    if not os.path.exists(path):
+        return 0
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    return int(steps["step"][-1]) if len(steps["step"]) else 0
+
+
+def running_elsewhere(run_dir: str) -> bool:
+    """Whether another process (an fdmRun started by hand, another table8.py) is running this
+    folder: a process whose command line names it."""
+    target = os.path.realpath(run_dir)
+    name = os.path.basename(target)
+    for cmdline in glob.glob("/proc/[0-9]*/cmdline"):
+        if cmdline == "/proc/%d/cmdline" % os.getpid():
+            continue
+        try:
+            with open(cmdline, "rb") as f:
+                words = f.read().decode(errors="replace").split("\0")
+        except OSError:
+            continue
+        if any(w and (os.path.basename(os.path.normpath(w)) == name or w.startswith(target + "/")) for w in words[1:]):
+            return True
+    return False
+
+
+def run_row(phi: float, args: argparse.Namespace) -> str:
+    """Write, start or resume the run of one phi_bulk until it finishes; returns its folder. A run
+    that another process is running is waited for, never started a second time."""
+    run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed)
+    if run_dir is not None and running_elsewhere(run_dir):
+        print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
+        while running_elsewhere(run_dir):
+            time.sleep(60)
+    if run_dir is None:
+        subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(args.dt),
+                        "--strain", str(args.strain), "--a-over-delta", str(args.a_over_delta),
+                        "--seed", str(args.seed), "--workdir", args.workdir], check=True)
+        run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed)
+    if steps_done(run_dir) >= steps_planned(run_dir):
+        return run_dir
+    fdmrun = [os.path.join(PROJECT, "scripts", "fdmRun"), "-f", str(args.np_fluid)]
+    try:
+        checkpoint.select(run_dir)
+        cmd = fdmrun + ["--resume", run_dir]
+    except checkpoint.CheckpointError:
+        cmd = fdmrun + (["--overwrite"] if steps_done(run_dir) else []) + [run_dir]
+    log = run_dir + ".log"
+    print("table8: phi_bulk %g: %s (log %s)" % (phi, " ".join(cmd), log), flush=True)
+    with open(log, "a") as f:
+        subprocess.run(cmd, check=True, stdout=f, stderr=subprocess.STDOUT)
+    return run_dir
+
+
+def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) -> Dict:
+    """couette.py --analyse of the run as it stands, with the paper's row."""
+    row: Dict = dict(phi_bulk_table8=phi, run_dir=run_dir)
+    if run_dir is None:
+        return row | dict(status="not started")
+    done, planned = steps_done(run_dir), steps_planned(run_dir)
+    row.update(steps_done=done, steps_planned=planned, strain_reached=done * args.dt)
+    if done * args.dt < MIN_STRAIN_TO_REPORT:
+        return row | dict(status="started")
+    out = run_dir + ".results.json"
+    subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--analyse", run_dir, "--out", out], check=True,
+                   stdout=subprocess.DEVNULL)
+    with open(out) as f:
+        r = json.load(f)
+    keep = ("phi_bulk phi_core phi_core_err gamma_core_over_gamma0 gamma_core_err eta_s eta_s_err N1_hat N1_hat_err "
+            "N2_hat N2_hat_err Sigma_c_hat Sigma_c_hat_err steady_from_strain steady_detected strain_units "
+            "stress_balance_rel_error stress_balance_rel_error_err stress_gap_rel_error_max n_particles cells dt "
+            "wall_seconds core_seconds_per_strain_unit inner_iterations_mean unconverged_steps min_pair_gap "
+            "min_wall_gap table8 springs").split()
+    row.update({k: r.get(k) for k in keep})
+    row["status"] = "finished" if done >= planned else "partial"
+    row["strain_averaged"] = r["strain_units"] - r["steady_from_strain"]
+    return row
+
+
+def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
+    """The Maron-Pierce fit (3 or more analysed rows) and Fig. 21."""
+    done = [r for r in rows if "eta_s" in r]
+    summary: Dict = dict(rows=rows, paper_fit=PAPER_FIT, a_over_delta=args.a_over_delta, dt=args.dt,
+                         strain=args.strain, seed=args.seed)
+    fit = None
+    if len(done) >= 3:
+        fit = rheology.fit_maron_pierce([r["phi_core"] for r in done], [r["eta_s"] for r in done],
+                                        [r["eta_s_err"] for r in done])
+        summary["fit"] = dict(alpha=fit.alpha, alpha_error=fit.alpha_error, phi_m=fit.phi_m,
+                              phi_m_error=fit.phi_m_error, chi2=fit.chi2, dof=fit.dof)
+    if done:
+        figure = os.path.splitext(args.out)[0] + ".png"
+        rheology.plot_viscosity(figure, [r["phi_core"] for r in done], [r["eta_s"] for r in done],
+                                [r["eta_s_err"] for r in done], fit=fit,
+                                phi_core_error=[r.get("phi_core_err") or 0.0 for r in done],
+                                label="this project (a1/Δ = %g, Δt = %g)" % (args.a_over_delta, args.dt),
+                                title="Fig. 21: η_s(φ_core); paper: α = 0.803, φ_m = 0.59")
+        summary["figure"] = os.path.basename(figure)
+    return summary
+
+
+def print_table(summary: Dict) -> None:
+    print("%-6s %-9s %-16s %-16s %-14s %-14s %-14s %-9s %-8s %s" % (
+        "phi_b", "status", "phi_core (paper)", "g_core (paper)", "eta_s", "N1_hat", "N2_hat", "balance", "strain",
+        "core-s/strain"))
+    for r in summary["rows"]:
+        if "eta_s" not in r:
+            print("%-6g %-9s (strain %.2f)" % (r["phi_bulk_table8"], r["status"], r.get("strain_reached", 0)))
+            continue
+        t = r["table8"] or {}
+        print("%-6g %-9s %.3f (%.3f)    %.3f (%.3f)    %.2f ± %.2f    %+.3f ± %.3f %+.3f ± %.3f %5.1f %%  %-8.1f %.0f" % (
+            r["phi_bulk_table8"], r["status"], r["phi_core"], t.get("phi_core", float("nan")),
+            r["gamma_core_over_gamma0"], t.get("gamma_core_over_gamma0", float("nan")), r["eta_s"], r["eta_s_err"],
+            r["N1_hat"], r["N1_hat_err"], r["N2_hat"], r["N2_hat_err"], 100 * r["stress_balance_rel_error"],
+            r["strain_units"], r["core_seconds_per_strain_unit"]))
+    if "fit" in summary:
+        f = summary["fit"]
+        print("Maron-Pierce fit: alpha = %.3f ± %.3f, phi_m = %.3f ± %.3f (chi2 %.2f for %d dof); paper 0.803, 0.59"
+              % (f["alpha"], f["alpha_error"], f["phi_m"], f["phi_m_error"], f["chi2"], f["dof"]))
+
+
+def main(argv: Optional[List[str]] = None) -> Dict:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--phis", type=float, nargs="+", default=[0.27, 0.37, 0.47], help="Table 8 rows (phi_bulk)")
+    p.add_argument("--strain", type=float, default=25.0, help="strain units per run (transient + averaging)")
+    p.add_argument("--dt", type=float, default=0.02, help="time step in units of 1/gamma_dot_0")
+    p.add_argument("--a-over-delta", type=float, default=3.0)
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--np-fluid", type=int, default=1, help="MPI ranks of fdmFoam per run")
+    p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
+    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "table8.json"))
+    p.add_argument("--analyse-only", action="store_true", help="report the runs as they stand; run nothing")
+    p.add_argument("--session-hours", type=float, default=None,
+                   help="launch no further run after this many hours (the run in progress finishes)")
+    args = p.parse_args(argv)
+    os.makedirs(args.workdir, exist_ok=True)
+    start = time.time()
+    for phi in args.phis:
+        if args.analyse_only:
+            break
+        if args.session_hours is not None and time.time() - start > 3600 * args.session_hours:
+            print("table8: --session-hours reached; the next call continues", flush=True)
+            break
+        run_row(phi, args)
+    rows = [analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed), args)
+            for phi in args.phis]
+    summary = summarise(rows, args)
+    summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    with open(args.out, "w") as f:
+        json.dump(summary, f, indent=1)
+    print_table(summary)
+    print("wrote %s" % args.out)
+    return summary
+
+
+if __name__ == "__main__":
+    main()
