@@ -14,11 +14,14 @@ The contact springs follow the rules of docs/contact.md ("A recipe"), computed a
                                                      from the paper's Maron-Pierce fit (Eq. 55:
                                                      alpha = 0.803, phi_m = 0.59)
   k_n   = 2 F_max / h_r                              a contact under F_max sits at h = h_r/2 (recipe step 2)
-  k_t   = k_n                                        the springs are implicit (contact_integration implicit,
-                                                     the default): they set no limit on dt (step 4)
+  k_t   = min(k_n, 0.5 zeta_t / dt)                  the tangential spring within half its explicit ab2
+                                                     limit: the implicit tangential springs are not stable
+                                                     at k_t dt/zeta_t of 100 or more in a suspension
+                                                     (docs/benchmarks.md, "Stability map": k_t = k_n
+                                                     blew up phi 0.47 at dt 0.02 within 10 steps)
 with zeta_n, zeta_t the normal and slip resistances of a free a1-a1 pair at the gap h_r/2 (Stokes drag
 plus the sub-grid block at this a1/Delta, fdmResistance); the time steps zeta_n/k_n and zeta_t/k_t
-that would bound explicit springs (ab2) are printed for reference.
+that would bound explicit springs (ab2) are printed.
 
   couette.py                         the small scene (about 40 spheres, 10 x 12 x 8 a1, a1/Delta = 3,
                                      3 strain units at dt = 0.02): a few minutes
@@ -47,6 +50,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdm import case, output, packing, profiles, rheology, theory  # noqa: E402
 
 A1 = 1.0
+TANGENTIAL_SAFETY = 0.5       # k_t dt / zeta_t of the rule (docs/contact.md recipe step 4)
 A2 = packing.A2_OVER_A1 * A1
 ETA = 1.0
 SHEAR_RATE = 1.0
@@ -84,8 +88,8 @@ class Springs:
     def describe(self, dt: float) -> str:
         return ("contact springs (docs/contact.md recipe): design load F_max = %.4g N, kn = 2 F_max/h_r = %.4g N/m, "
                 "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a1-a1 pair at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
-                "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential; implicit springs (the "
-                "default) have no such limit, dt = %g is %.2f of the smaller"
+                "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential (the springs are implicit; "
+                "k_t is kept at half its limit), dt = %g is %.2f of the smaller"
                 % (self.design_load, self.kn, self.kt, self.mu_s, self.h_r / A1, self.zeta_n, self.zeta_t,
                    self.dt_limit_normal, self.dt_limit_tangential, dt,
                    dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
@@ -121,7 +125,9 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
     design_load = 6 * math.pi * ETA * A2 ** 2 * SHEAR_RATE * relative_viscosity
     zeta_n, zeta_t = pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta)
     kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
-    kt = kn if kt is None else kt      # implicit springs: no stability bound on k_t dt / zeta_t
+    # k_t dt/zeta_t <= 0.5: stiffer implicit tangential springs blew up dense suspensions (growth x10
+    # per step at k_t dt/zeta_t ~ 300-400, docs/benchmarks.md "Stability map")
+    kt = min(kn, TANGENTIAL_SAFETY * zeta_t / dt) if kt is None else kt
     return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
 
 
