@@ -91,7 +91,7 @@ def run_row(phi: float, args: argparse.Namespace) -> str:
     if run_dir is None:
         subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(args.dt),
                         "--strain", str(args.strain), "--a-over-delta", str(args.a_over_delta),
-                        "--seed", str(args.seed), "--workdir", args.workdir], check=True)
+                        "--seed", str(args.seed), "--n-max", str(args.n_max), "--workdir", args.workdir], check=True)
         run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed)
     if steps_done(run_dir) >= steps_planned(run_dir):
         return run_dir
@@ -183,6 +183,8 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--np-fluid", type=int, default=1, help="MPI ranks of fdmFoam per run")
+    p.add_argument("--n-max", type=int, default=50, help="fdmFoam's innerIterations nMax for scenes written now "
+                   "(the dense rows stop at 50 in most steps: docs/benchmarks.md, 'Stability map')")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(PROJECT, "docs", "table8.json"))
     p.add_argument("--analyse-only", action="store_true", help="report the runs as they stand; run nothing")
