@@ -311,3 +311,20 @@ def test_paraview_files_at_the_fluid_write_times(tiny_run):
         if vtk is not None:
             assert vtk[:3] == (0, r["n_particles"], r["n_particles"]) and "S_hydro" in vtk[3]
     assert checked == 2
+
+
+def test_analyse_a_run_folder_as_it_stands(couette, tiny_run, tmp_path):
+    # couette --analyse RUN_DIR (what table8.py uses for resumed and running runs): the scene from
+    # the folder's own files gives the run's own results; the run time from the step records
+    out = str(tmp_path / "again.json")
+    again = couette.main(["--analyse", tiny_run["run_dir"], "--out", out])
+    for key in ("phi_bulk", "phi_core", "gamma_core_over_gamma0", "eta_s", "eta_s_err", "N1_hat", "N2_hat",
+                "stress_balance_rel_error", "stress_gap_rel_error_max", "min_pair_gap", "cells", "dt",
+                "strain_units", "unconverged_steps"):
+        assert again[key] == tiny_run[key], key
+    assert again["Sigma_c_hat"] == tiny_run["Sigma_c_hat"]
+    assert again["springs"]["kn"] == pytest.approx(tiny_run["springs"]["kn"], rel=1e-12)
+    assert again["steps_planned"] == 20
+    # the step records' seconds (solve, particles, exchange) are the run's wall time less start-up
+    assert 0.3 * tiny_run["wall_seconds"] < again["wall_seconds"] <= tiny_run["wall_seconds"]
+    assert os.path.exists(out) and os.path.exists(str(tmp_path / "again.png"))
