@@ -310,6 +310,22 @@ def test_time_step_beyond_contact_stability_at_the_contact_gap(tmp_path, env):
     assert m and 0.01 < float(m.group(1)) < 0.1, dem[-3000:]
 
 
+def test_stiff_implicit_tangential_spring_is_warned(tmp_path, env):
+    """Implicit springs with k_t = 1e6 N/m at dt = 1 s: dt k_t/zeta_t far beyond the 41 that sheared
+    suspensions held (they blew up at 320 and 400): a warning with the ratio and the k_t that
+    cases/couette uses; the run goes on."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 1e6 0.5 0.01",
+                     runs=("run 1",))
+    status, out, wall = run_fdm(root, env)
+    assert status == 0, out
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    m = re.search(r"WARNING: pair_style fdm/subgrid: time step 1 s gives the tangential spring of two spheres "
+                  r"dt k_t/zeta_t = (\S+) at the contact gap h_r: sheared suspensions .* k_t = (\S+) N/m "
+                  r"\(0.5 zeta_t/dt\)", dem)
+    assert m and float(m.group(1)) > 50, dem[-3000:]
+    assert float(m.group(2)) == pytest.approx(0.5e6 / float(m.group(1)), rel=1e-3)
+
+
 def test_particles_too_small_for_the_mesh(tmp_path, env):
     """a/Delta = 1: below the range of the cut-off sub-grid model (a/Delta >= 2), reported."""
     root = make_case(tmp_path, pair_style="fdm/subgrid", runs=("run 1",))
