@@ -481,6 +481,7 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
     pair_->collectBlocks(stresslets_, pairs, walls, wallFile_.empty() ? nullptr : &wallIndex);
     contacts = pair_->contactsLast();
   }
+  checkOverlaps();
   allPairs = fdm::gatherToRoot(pairs, world);
   allWalls = fdm::gatherToRoot(walls, world);
   // implicit contact springs (docs/contact.md 2b): c1 the weight of U_{n+1} in the next position
@@ -832,6 +833,34 @@ void FixFdmCouple::scatter()
     }
   }
   fillPerAtomArray();
+}
+
+void FixFdmCouple::checkOverlaps()
+{
+  // Every rank (collective). Two spheres overlapping by more than the fluid accepts of a sphere
+  // pressed into a wall (maxOverlap of the smaller radius, fdmFoam's 0.05) are beyond what the
+  // contact springs allow for any load they were chosen for: the run is no longer a suspension of
+  // rigid spheres (measured: 0.08-0.21 a1 in dense scenes at large steps, docs/benchmarks.md
+  // "Stability map"), so it stops rather than record it.
+  const double maxOverlap = 0.05;
+  if (!pair_ || !session_.hasFluid()) return;
+  const PairFdmSubgrid::Overlap &mine = pair_->deepestOverlap();
+  struct {
+    double depth;
+    int rank;
+  } local = {mine.depth, comm->me}, worst;
+  MPI_Allreduce(&local, &worst, 1, MPI_DOUBLE_INT, MPI_MAXLOC, world);
+  if (!(worst.depth > maxOverlap)) return;
+  double info[3] = {mine.gap, double(mine.tagI), double(mine.tagJ)};
+  MPI_Bcast(info, 3, MPI_DOUBLE, worst.rank, world);
+  char text[500];
+  snprintf(text, sizeof text,
+           "particles %ld and %ld overlap by %g m (%g of the smaller radius) at step " BIGINT_FORMAT
+           ", more than the %g the fluid accepts: the contact springs did not hold them (a time step too large "
+           "for this packing, or springs too soft for its loads: docs/benchmarks.md, 'Stability map', "
+           "docs/contact.md, 'A recipe')",
+           std::lround(info[1]), std::lround(info[2]), -info[0], worst.depth, update->ntimestep, maxOverlap);
+  allAgree(comm->me == 0 ? std::string(text) : std::string());
 }
 
 void FixFdmCouple::checkPeriodicBalance(const std::vector<Particle> &particles)

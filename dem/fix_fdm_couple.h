@@ -87,6 +87,7 @@ class FixFdmCouple : public Fix {
   void fillPerAtomArray();
   void writeWallLoads();
   void checkPeriodicBalance(const std::vector<Particle> &particles);
+  void checkOverlaps();
   void allAgree(const std::string &problemOnRank0);
   void fail(const std::string &message);
   void printTiming(const char *what, const Timing &t, double wall, int runs) const;

@@ -523,6 +523,7 @@ void PairFdmSubgrid::compute(int eflag, int vflag)
   contactsLast_ = 0;
   contacts_.clear();
   wallContactLoads_.assign(3 * walls_.size(), 0.0);
+  deepest_ = Overlap();
   if (contactStressRequested_) {
     if (atom->nmax > nmaxStress_) {
       nmaxStress_ = atom->nmax;
@@ -618,6 +619,13 @@ void PairFdmSubgrid::contactForces()
       // rigid motion of the pair does not slip the contact points (docs/contact.md 2, Eq. C1)
       const double halfGap = 0.5 * (r - radius[i] - radius[j]);
       const double leverI = radius[i] + halfGap, leverJ = radius[j] + halfGap;
+      const double depth = -2 * halfGap / std::min(radius[i], radius[j]);
+      if (depth > deepest_.depth) {
+        deepest_.depth = depth;
+        deepest_.gap = 2 * halfGap;
+        deepest_.tagI = atom->tag[i];
+        deepest_.tagJ = atom->tag[j];
+      }
       // relative velocity of the contact points: v_i - v_j - (l_i w_i + l_j w_j) x n
       double w[3], vr[3];
       for (int d = 0; d < 3; d++) w[d] = leverI * omega[i][d] + leverJ * omega[j][d];

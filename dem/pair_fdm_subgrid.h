@@ -87,6 +87,13 @@ class PairFdmSubgrid : public Pair {
   const std::vector<double> &wallContactLoads() const { return wallContactLoads_; }
   // Contacts (pair and wall) found by this rank in the last compute.
   long contactsLast() const { return contactsLast_; }
+  // The deepest overlap of two spheres this rank's last compute found: depth = -gap/min(a_i, a_j)
+  // (negative: no overlap), the gap [m] and the two tags
+  struct Overlap {
+    double depth = -1e300, gap = 0;
+    long tagI = 0, tagJ = 0;
+  };
+  const Overlap &deepestOverlap() const { return deepest_; }
   // The time-step limits of the contact springs, dt k/zeta below 1 (ab2) or 2 (euler), docs/contact.md
   // section 3c; called by fix fdm/couple, which knows the time step and its integrator.
   void checkTimeStep(double dt, bool adamsBashforth);
@@ -129,6 +136,7 @@ class PairFdmSubgrid : public Pair {
   int nmaxStress_;
   double **contactStress_;
   long contactsLast_;
+  Overlap deepest_;
   std::vector<double> wallContactLoads_;  // 3 per wall: force of the contacts on the wall (this rank)
   bool reported_;
   double checkedTimeStep_;     // the time step last checked (checked again if it changes)

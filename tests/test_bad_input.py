@@ -326,6 +326,25 @@ def test_stiff_implicit_tangential_spring_is_warned(tmp_path, env):
     assert float(m.group(2)) == pytest.approx(0.5e6 / float(m.group(1)), rel=1e-3)
 
 
+def test_spheres_pressed_through_each_other_stop_the_run(tmp_path, env):
+    """Two free spheres pushed together (1 N each) against a spring far too soft for the load
+    (k_n = 1 N/m) and no lubrication: once they overlap by more than 0.05 of a radius (what the fluid
+    accepts of a sphere in a wall) the run stops naming both and the overlap, instead of going on
+    with interpenetrating spheres (dense scenes reached 0.2 a1: docs/benchmarks.md 'Stability map')."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, fix_options="",
+                     pair_style="fdm/subgrid lubrication no contact 1 0 0 0.01",
+                     fdm_edit=lambda text: text.replace("(-0.01 0 0)", "(0 0 0)"),
+                     runs=("variable push atom 1-2*(id-1)", "fix push all addforce v_push 0 0", "run 20"))
+    status, out, wall = run_fdm(root, env)
+    assert status != 0
+    text = logs(root)
+    m = re.search(r"particles 1 and 2 overlap by (\S+) m \((\S+) of the smaller radius\) at step (\d+), more than "
+                  r"the 0.05 the fluid accepts", text)
+    assert m, text[-3000:]
+    assert 0.05 < float(m.group(2)) < 1 and float(m.group(1)) == pytest.approx(float(m.group(2)), rel=1e-6)
+    assert wall < 60
+
+
 def test_particles_too_small_for_the_mesh(tmp_path, env):
     """a/Delta = 1: below the range of the cut-off sub-grid model (a/Delta >= 2), reported."""
     root = make_case(tmp_path, pair_style="fdm/subgrid", runs=("run 1",))
