@@ -280,6 +280,14 @@ PAIR = [(1.5, 2.0, 2.0, 1.0), (3.55, 2.0, 2.0, 1.0)]
 PAIR_BOX = case.Box((0, 0, 0), (6, 4, 4), 0.5)
 
 
+def pair_scene_log(tmp_path, env, pair_style):
+    """fdmDEM's log of one step of the two spheres PAIR with this pair style, which must run."""
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style=pair_style, runs=("run 1",))
+    status, out, wall = run_fdm(root, env)
+    assert status == 0, out
+    return open(os.path.join(root, "log.dem"), errors="replace").read()
+
+
 def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
     """Explicit springs, kn = 1e6 N/m, dt = 1 s: beyond dt k/zeta < 1 (ab2) even with the largest resistance a contact
     can have: an error at the start, with the limit and how it was computed; both codes stop."""
@@ -300,11 +308,7 @@ def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
 def test_time_step_beyond_contact_stability_at_the_contact_gap(tmp_path, env):
     """Explicit springs, kn = 1e4 N/m, dt = 1 s: beyond the limit at h_r (~0.05 s), within it for contacts pressed
     deeper (~50 s at zero gap): a warning, and the run goes on."""
-    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e4 0 0.5 0.01 contact_integration explicit",
-                     runs=("run 1",))
-    status, out, wall = run_fdm(root, env)
-    assert status == 0, out
-    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    dem = pair_scene_log(tmp_path, env, "fdm/subgrid contact 1e4 0 0.5 0.01 contact_integration explicit")
     m = re.search(r"WARNING: pair_style fdm/subgrid: time step 1 s is beyond the stability limit (\S+) s of the normal "
                   r"spring of two spheres .* at the contact gap h_r = 0.01 m", dem)
     assert m and 0.01 < float(m.group(1)) < 0.1, dem[-3000:]
@@ -314,11 +318,7 @@ def test_stiff_implicit_tangential_spring_is_warned(tmp_path, env):
     """Implicit springs with k_t = 1e6 N/m at dt = 1 s: dt k_t/zeta_t far beyond the 41 that sheared
     suspensions held (they blew up at 320 and 400): a warning with the ratio and the k_t that
     cases/couette uses; the run goes on."""
-    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 1e6 0.5 0.01",
-                     runs=("run 1",))
-    status, out, wall = run_fdm(root, env)
-    assert status == 0, out
-    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    dem = pair_scene_log(tmp_path, env, "fdm/subgrid contact 1e6 1e6 0.5 0.01")
     m = re.search(r"WARNING: pair_style fdm/subgrid: time step 1 s gives the tangential spring of two spheres "
                   r"dt k_t/zeta_t = (\S+) at the contact gap h_r: sheared suspensions .* k_t = (\S+) N/m "
                   r"\(0.5 zeta_t/dt\)", dem)
@@ -359,11 +359,7 @@ def test_particles_too_small_for_the_mesh(tmp_path, env):
 def test_time_step_beyond_explicit_limit_with_implicit_springs(tmp_path, env):
     """The same kn = 1e6 N/m, dt = 1 s with the implicit springs (the default): no error, a note of
     how far beyond the explicit springs' limit the step is, and the run goes on."""
-    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 0 0.5 0.01",
-                     runs=("run 1",))
-    status, out, wall = run_fdm(root, env)
-    assert status == 0, out
-    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    dem = pair_scene_log(tmp_path, env, "fdm/subgrid contact 1e6 0 0.5 0.01")
     m = re.search(r"pair fdm/subgrid: time step 1 s is (\S+) times the explicit springs' stability limit (\S+) s \(the "
                   r"normal spring of two spheres at the contact gap h_r\): stable with the implicit springs", dem)
     assert m and float(m.group(1)) > 1000 and 1e-4 < float(m.group(2)) < 1e-3, dem[-3000:]
