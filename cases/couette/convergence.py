@@ -31,11 +31,18 @@ KEYS = ("phi_bulk", "phi_core", "gamma_core_over_gamma0", "eta_s", "eta_s_err", 
         "springs")
 
 
-def run_one(a_over_delta: int, dt: float, tol_lambda: float, args: argparse.Namespace) -> Dict:
-    """One Couette run (or its results file if it exists): the keys of KEYS."""
-    name = "ad%d_dt%g" % (a_over_delta, dt) + ("" if tol_lambda == TOL_LAMBDA else "_tol%g" % tol_lambda)
+def run_name(a_over_delta: int, dt: float, tol_lambda: float) -> str:
+    return "ad%d_dt%g" % (a_over_delta, dt) + ("" if tol_lambda == TOL_LAMBDA else "_tol%g" % tol_lambda)
+
+
+def run_one(a_over_delta: int, dt: float, tol_lambda: float, args: argparse.Namespace, run: bool = True) -> Dict | None:
+    """One Couette run (or its results file if it exists): the keys of KEYS; None if it has no
+    results file and run is False."""
+    name = run_name(a_over_delta, dt, tol_lambda)
     out = os.path.join(args.workdir, name + ".json")
     if not os.path.exists(out):
+        if not run:
+            return None
         cmd = [sys.executable, os.path.join(HERE, "couette.py"), "--phi", str(args.phi), "--size", *map(str, args.size),
                "--a-over-delta", str(a_over_delta), "--dt", str(dt), "--strain", str(args.strain),
                "--seed", str(args.seed), "--tol-lambda", str(tol_lambda), "--workdir", os.path.join(args.workdir, name), "--out", out, "--overwrite"]
@@ -76,6 +83,9 @@ def main(argv=None) -> Dict:
     p.add_argument("--strain", type=float, default=12.0)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--quick", action="store_true", help="dt 0.04 and 0.02 at a1/Delta = 3 only")
+    p.add_argument("--runs", nargs="+", metavar="AD:DT[:TOL]", default=None,
+                   help="run only these of the grid (e.g. 3:0.02 4:0.02 3:0.02:0.01), so that two processes can "
+                   "share the grid; the summary holds every run of the grid whose results exist")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs", "convergence"))
     p.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_couetteConvergence.json"))
     args = p.parse_args(argv)
@@ -83,7 +93,15 @@ def main(argv=None) -> Dict:
     grid: List[Tuple[int, float, float]] = [(3, 0.04, TOL_LAMBDA), (3, 0.02, TOL_LAMBDA)]
     if not args.quick:
         grid += [(3, 0.01, TOL_LAMBDA), (4, 0.02, TOL_LAMBDA), (3, 0.02, 1e-2), (3, 0.02, 3e-3)]
-    runs = [run_one(ad, dt, tol, args) for ad, dt, tol in grid]
+    if args.runs:
+        chosen = []
+        for spec in args.runs:
+            fields = [float(v) for v in spec.split(":")]
+            chosen.append((int(fields[0]), fields[1], fields[2] if len(fields) > 2 else TOL_LAMBDA))
+        for ad, dt, tol in chosen:
+            run_one(ad, dt, tol, args)
+        grid += [c for c in chosen if c not in grid]
+    runs = [r for r in (run_one(ad, dt, tol, args, run=not args.runs) for ad, dt, tol in grid) if r is not None]
     summary = dict(phi=args.phi, size=list(args.size), strain=args.strain, seed=args.seed,
                    command="cases/couette/convergence.py " + " ".join(argv if argv is not None else sys.argv[1:]),
                    runs=runs)
