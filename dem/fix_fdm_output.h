@@ -7,7 +7,7 @@
      position wrapped into the box, radius, U, Omega, the fluid's and the sub-grid force and torque,
      LIGGGHTS's own force and torque, and with fix fdm/couple ... stresslets yes the stresslets:
      fluid part, sub-grid part, contact) appended to the binary FILE (particle_records.h; read by
-     scripts/fdm/output.py read_particle_records), flushed after each block.
+     scripts/fdmsubgrid/output.py read_particle_records), flushed after each block.
    vtk M DIR: every M steps (the fluid's writeInterval), and at the last step of every run, the
      particles as DIR/particles_<step>.vtp (VTK XML PolyData) and the series DIR/particles.pvd.
    append yes: continue the files of a previous run (a resumed run): the blocks and VTK entries

@@ -15,7 +15,7 @@
      <the doubles of every array, in the order of the lines>
      end FDM-DEM-CHECKPOINT\n
    It is written to FILE.tmp, flushed to disk and renamed to FILE: a kill during the write leaves
-   FILE.tmp and the previous checkpoints untouched. scripts/fdm/checkpoint.py reads the same layout. */
+   FILE.tmp and the previous checkpoints untouched. scripts/fdmsubgrid/checkpoint.py reads the same layout. */
 
 #ifndef FDM_PARTICLE_CHECKPOINT_H
 #define FDM_PARTICLE_CHECKPOINT_H

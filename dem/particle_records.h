@@ -1,6 +1,6 @@
 /* Per-particle records of long suspension runs, and the ParaView files of the particles: plain C++,
    no LIGGGHTS, no MPI (fix fdm/output gathers the particles and calls these on rank 0; docs/dem.md,
-   "fix fdm/output"; the Python reader is scripts/fdm/output.py, read_particle_records).
+   "fix fdm/output"; the Python reader is scripts/fdmsubgrid/output.py, read_particle_records).
 
    The records file (binary, native byte order, declared in the header):
 

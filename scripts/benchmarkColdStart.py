@@ -15,7 +15,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from fdm import case, output  # noqa: E402
+from fdmsubgrid import case, output  # noqa: E402
 
 # (label, acceleration, mean-flow correction, tolLambda, tolVelocity, tol_u = tol_p)
 RUNS = [

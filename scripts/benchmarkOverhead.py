@@ -5,7 +5,7 @@ mesh, fvSolution and fvSchemes, and the cost of a whole fdmFoam time step in ico
 The scene: a cubic box of --cells^3 cells (a1/Delta = --a-over-delta, a1 = 1, nu = 1), periodic in
 x and z, walls at -U and +U (U = 1) in y, so the shear rate is 2U/L; fdmFoam gets --particles
 bidisperse spheres (a2 = 1.4 a1, equal volumes, a random non-overlapping packing from
-fdm.packing.channel_packing) with `pair_style fdm/subgrid` (lubrication, frictional contact, both
+fdmsubgrid.packing.channel_packing) with `pair_style fdm/subgrid` (lubrication, frictional contact, both
 walls) and, for comparison, one sphere a1 at the centre. icoFoam (Debian's /usr/bin/icoFoam,
 OpenFOAM v1912) runs on the same polyMesh with fdmFoam's fvSolution and fvSchemes plus only what it
 needs (ddt Euler, div(phi,U) Gauss linear) and deltaT = alpha_lambda = Delta^2/nu, the pseudo-time
@@ -50,7 +50,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from fdm import case, output, packing  # noqa: E402
+from fdmsubgrid import case, output, packing  # noqa: E402
 
 A1, NU, U_WALL = 1.0, 1.0, 1.0
 # frictional contact as in the suspension cases (kn, kt, mu_s, h_r), docs/contact.md

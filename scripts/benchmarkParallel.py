@@ -30,7 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 
-from fdm import case, decomposition, output  # noqa: E402
+from fdmsubgrid import case, decomposition, output  # noqa: E402
 
 DELTA = 0.2
 RADIUS = 1.0   # a/Delta = 5, the paper's resolution

@@ -9,17 +9,14 @@ Markdown table for docs/benchmarks.md. Runs `--jobs` configurations side by side
 """
 import argparse
 import concurrent.futures
-import importlib.util
 import json
 import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
-spec = importlib.util.spec_from_file_location(
-    "periodicArray", os.path.join(PROJECT, "cases", "periodicArray", "periodicArray.py"))
-periodic_array = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(periodic_array)
+sys.path.insert(0, HERE)
+from fdmsubgrid import periodicarray as periodic_array  # noqa: E402
 
 
 def main():

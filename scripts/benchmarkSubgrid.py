@@ -11,7 +11,7 @@
                 (a) a pair at xi = 1e-5 (a2/a1 = 1 and 1.4), held (move no) and pushed together
                     (normal load kn (h_r - gap) plus a tangential couple: it stays near xi = 1e-5
                     and turns);
-                (b) a random packing (fdm.packing) of 150 bidisperse spheres at phi = 0.5 between
+                (b) a random packing (fdmsubgrid.packing) of 150 bidisperse spheres at phi = 0.5 between
                     two walls in shear (boundary p f p, walls at -U and +U, shear rate 1/s).
   timing      (c) 1000 bidisperse spheres (a1 = 1, a2 = 1.4, equal volumes) at phi = 0.45 in a
               periodic box on the matching mesh (Delta = a1/5, box rounded to whole cells), DEM
@@ -58,7 +58,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from fdm import case, demonly, output, packing  # noqa: E402
+from fdmsubgrid import case, demonly, output, packing  # noqa: E402
 
 SOLVERS = [("cg", 1e-10), ("cg", 1e-6), ("ldlt", None)]
 ASSEMBLY = ("cg", 0.9)            # warm-started CG stops at once: what remains is the assembly

@@ -11,7 +11,7 @@ import warnings
 
 import pytest
 
-from fdm import case, output
+from fdmsubgrid import case, output
 
 PROJECT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FDMRUN = os.path.join(PROJECT, "scripts", "fdmRun")

@@ -9,7 +9,7 @@ import re
 
 import pytest
 
-from fdm import case
+from fdmsubgrid import case
 
 from test_bad_input import make_case, run_fdm, logs
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from conftest import load_case_module
-from fdm import case, output, packing, profiles
+from fdmsubgrid import case, output, packing, profiles
 
 TINY = ["--phi", "0.25", "--size", "7", "11", "7", "--a-over-delta", "3", "--dt", "0.02", "--strain", "0.4",
         "--dump-every", "0.02", "--seed", "3"]
@@ -328,3 +328,35 @@ def test_analyse_a_run_folder_as_it_stands(couette, tiny_run, tmp_path):
     # the step records' seconds (solve, particles, exchange) are the run's wall time less start-up
     assert 0.3 * tiny_run["wall_seconds"] < again["wall_seconds"] <= tiny_run["wall_seconds"]
     assert os.path.exists(out) and os.path.exists(str(tmp_path / "again.png"))
+
+
+def test_fdmProfiles_command_on_a_run_folder(tiny_run, tmp_path, env):
+    # the command-line tool of the package (scripts/fdmProfiles, on the PATH of etc/bashrc) reads the
+    # folder's own files and gives the case's own numbers; --from-strain moves the averaging window
+    import json
+    import subprocess
+    out = tmp_path / "p.json"
+    proc = subprocess.run(["fdmProfiles", tiny_run["run_dir"], "--out", str(out)], env=env, text=True,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    assert proc.returncode == 0, proc.stdout[-2000:]
+    assert "stress_balance_rel_error" in proc.stdout and "eta_s" in proc.stdout
+    again = json.loads(out.read_text())
+    for key in ("phi_bulk", "phi_core", "eta_s", "eta_s_err", "N2_hat", "steady_from_strain", "strain_units"):
+        assert again[key] == tiny_run[key], key
+    assert (tmp_path / "p.png").stat().st_size > 1000
+    late = tmp_path / "late.json"
+    proc = subprocess.run(["fdmProfiles", tiny_run["run_dir"], "--out", str(late), "--from-strain", "0.26", "--core", "4"],
+                          env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    assert proc.returncode == 0, proc.stdout[-2000:]
+    late = json.loads(late.read_text())
+    assert late["steady_from_strain"] == pytest.approx(0.26, abs=0.01) and late["h_layer"] == 4
+    assert late["samples_averaged"] == 8 < again["samples_averaged"]
+    # a window too short for a time average: said, with the strain the run reached
+    proc = subprocess.run(["fdmProfiles", tiny_run["run_dir"], "--out", str(tmp_path / "x.json"), "--from-strain", "0.35"],
+                          env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    assert proc.returncode == 2 and "from strain 0.35 on there are" in proc.stdout and "Traceback" not in proc.stdout
+    # a folder that is not a run: the file it lacks is named, nothing is written
+    proc = subprocess.run(["fdmProfiles", str(tmp_path)], env=env, text=True, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT)
+    assert proc.returncode == 2 and "packing.data" in proc.stdout, proc.stdout
+    assert not (tmp_path / "profiles.json").exists()

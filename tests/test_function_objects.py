@@ -3,7 +3,7 @@ coupled run, and on a finished case with fdmFoam -postProcess."""
 import os
 import subprocess
 
-from fdm import case
+from fdmsubgrid import case
 
 PROJECT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

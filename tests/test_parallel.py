@@ -1,5 +1,5 @@
 """Parallel runs give the serial answers: the fluid on N MPI ranks (fdmRun -f N, the mesh split by
-scripts/fdm/decomposition.py for any N the mesh allows) and the particles on N ranks (fdmRun -d N).
+scripts/fdmsubgrid/decomposition.py for any N the mesh allows) and the particles on N ranks (fdmRun -d N).
 
 The scene: six spheres (a/Delta = 2) in a shear cell of 16 x 12 x 12 cells, periodic in x and z,
 walls moving at -/+0.5 in y, with sub-grid lubrication (two close pairs, one sphere near a wall),
@@ -15,7 +15,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from fdm import case, decomposition
+from fdmsubgrid import case, decomposition
 
 DELTA = 0.25
 BOX = case.Box((0, 0, 0), (4.0, 3.0, 3.0), DELTA, faces=("cyclic", ((-0.5, 0, 0), (0.5, 0, 0)), "cyclic"))

@@ -1,4 +1,4 @@
-"""fdm.profiles, fdm.timeseries, fdm.rheology (paper 6.1, 6.2): exact profiles of hand-computed
+"""fdmsubgrid.profiles, fdmsubgrid.timeseries, fdmsubgrid.rheology (paper 6.1, 6.2): exact profiles of hand-computed
 configurations, block-averaging errors, the transient rule, the Maron-Pierce fit. Pure Python, no
 solver; a few seconds."""
 import math
@@ -8,9 +8,9 @@ import pytest
 from scipy.integrate import quad
 from scipy.signal import lfilter
 
-from fdm import profiles as P
-from fdm import rheology as R
-from fdm import timeseries as T
+from fdmsubgrid import profiles as P
+from fdmsubgrid import rheology as R
+from fdmsubgrid import timeseries as T
 
 
 def cap(a, h):
@@ -440,7 +440,7 @@ def test_bad_input():
         R.fit_maron_pierce([0.1, 0.2], [1, 2], [0.1, 0.1])
 
 
-# ---- the momentum balance (fdm.rheology.stress_balance, fdm.output.read_wall_loads) ----------------
+# ---- the momentum balance (fdmsubgrid.rheology.stress_balance, fdmsubgrid.output.read_wall_loads) ----------------
 
 def _write_wall_records(run, steps, dt, fluid_forces, subgrid, contact, area=(40.0, 40.0)):
     """fdmFoam's walls.dat and fix fdm/couple's walls file by hand: forces (T, 2, 3) on yLow/ylo and
@@ -466,7 +466,7 @@ def _write_wall_records(run, steps, dt, fluid_forces, subgrid, contact, area=(40
 def test_wall_stress_signs_parts_and_balance(tmp_path):
     # Walls y = 0 (low) and y = 8 (high) of area 40; the suspension drags the high wall back (-x) and
     # the low one forward (+x): tau_lo = F_lo,x / A, tau_hi = -F_hi,x / A (n out of the suspension).
-    from fdm import output as O
+    from fdmsubgrid import output as O
     rng = np.random.default_rng(5)
     n = 64
     steps = np.arange(1, n + 1)

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from conftest import FULL, PROJECT
-from fdm import case, output
+from fdmsubgrid import case, output
 
 STEPS = 50
 EVERY = 5
@@ -194,7 +194,7 @@ def test_truncated_checkpoint_falls_back_to_the_previous_one(tmp_path, env, refe
     records_once(root)
     assert_same_trajectory(root, reference)
     # the reason is said
-    r = subprocess.run(["python3", "-m", "fdm.checkpoint", "select", root], env=dict(
+    r = subprocess.run(["python3", "-m", "fdmsubgrid.checkpoint", "select", root], env=dict(
         env, PYTHONPATH=os.path.join(PROJECT, "scripts")), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
     assert r.returncode == 0
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import load_case_module
-from fdm import case, output
+from fdmsubgrid import case, output
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +23,7 @@ def wall_squeeze():
 
 def test_pair_squeeze_unequal_spheres(tmp_path, env, pair_squeeze):
     # a2/a1 = 1.4: the closing velocity under equal and opposite forces, against Jeffrey & Onishi
-    from fdm import theory
+    from fdmsubgrid import theory
     xis = [1e-2, 1e-3, 1e-4]
     ref = [theory.pair_squeeze_velocity(1.0, 1.4, xi) for xi in xis]
     on = pair_squeeze.run_pair(str(tmp_path), 1.4, xis, True, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-4)
@@ -36,7 +36,7 @@ def test_pair_squeeze_unequal_spheres(tmp_path, env, pair_squeeze):
 
 
 def test_wall_squeeze(tmp_path, env, wall_squeeze):
-    from fdm import theory
+    from fdmsubgrid import theory
     epss = [1e-2, 1e-3]
     ref = [theory.wall_squeeze_velocity(1.0, e) for e in epss]
     on = wall_squeeze.run_wall(str(tmp_path), epss, True, a_over_delta=4.0, L_over_a=8.0, H_over_a=10.0,

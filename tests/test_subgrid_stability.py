@@ -6,7 +6,7 @@ same R^SG, a weaker diagonal than with the fluid, so a harder system), DEM only,
 * a pair at the smallest gap the resistance functions resolve, xi = 1e-5 (below it they are frozen,
   paper 4.2), equal and unequal (a2/a1 = 1.4) spheres, held in place and free (a normal load that
   balances the contact spring at that gap plus a tangential couple that turns the pair), 1000 steps;
-* a random packing (fdm.packing, overlap relaxation: ~1.7 pairs per sphere at gaps ~1.5e-4 a1) of
+* a random packing (fdmsubgrid.packing, overlap relaxation: ~1.7 pairs per sphere at gaps ~1.5e-4 a1) of
   100 bidisperse spheres at phi = 0.5 sheared between two walls, 500 steps.
 
 Checked: every step done, no NaN/inf, speeds bounded, no overlap beyond the roughness height, and
@@ -19,7 +19,7 @@ import os
 import numpy as np
 import pytest
 
-from fdm import case, demonly, output, packing
+from fdmsubgrid import case, demonly, output, packing
 
 ETA, DELTA, HR, KN = 1.0, 0.2, 5e-3, 1e4
 CONTACT = (KN, KN, 0.5, HR)

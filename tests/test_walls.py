@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from fdm import case, output
+from fdmsubgrid import case, output
 
 
 def run_shear(tmp_path, faces_y, wall_speed):

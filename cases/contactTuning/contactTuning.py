@@ -45,7 +45,8 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
-from fdm import theory  # noqa: E402
+from fdmsubgrid import theory  # noqa: E402
+from fdmsubgrid.demonly import environment, fdmdem  # noqa: E402
 
 PI = math.pi
 # the scene: every length in units of a = 1 m, eta = 1 Pa s (the velocity scale F/(6 pi eta a))
@@ -58,24 +59,6 @@ MIN_GAP = 1e-5                   # the resistance functions are frozen below thi
 # ---------------------------------------------------------------------------------------------
 # running fdmDEM
 # ---------------------------------------------------------------------------------------------
-
-def _environment():
-    env = dict(os.environ)
-    lib = os.path.join(PROJECT, ".cache", "build", "lib")
-    if lib not in env.get("LD_LIBRARY_PATH", "").split(":"):
-        env["LD_LIBRARY_PATH"] = lib + (":" + env["LD_LIBRARY_PATH"] if env.get("LD_LIBRARY_PATH") else "")
-    if os.geteuid() == 0:
-        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    return env
-
-
-def fdmdem():
-    exe = shutil.which("fdmDEM") or os.path.join(PROJECT, ".cache", "build", "bin", "fdmDEM")
-    if not os.path.isfile(exe):
-        raise FileNotFoundError("fdmDEM not built: run ./Allwmake")
-    return exe
-
 
 def _value(v):
     return "%.17g" % v if isinstance(v, float) else str(v)
@@ -106,7 +89,7 @@ def run_scene(scene, variables, workdir, name=None, timeout=900):
         f.write(" ".join(cmd) + "\n")
     t0 = time.time()
     proc = subprocess.run(cmd, cwd=run_dir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                          errors="replace", timeout=timeout, env=_environment())
+                          errors="replace", timeout=timeout, env=environment())
     seconds = time.time() - t0
     with open(os.path.join(run_dir, "log"), "w") as f:
         f.write(proc.stdout)
@@ -195,20 +178,8 @@ class Resistance:
         tangential forces f at the contact points (with their torques) make the contact points slip
         at f/zeta_t; the spheres translate and rotate (Stokes drag, 8 pi eta a^3, plus the sub-grid
         pair block of `fdmResistance matrix`). 12/7 pi eta a without lubrication."""
-        a, eta = self.a, self.eta
-        M = np.diag([6 * PI * eta * a] * 3 + [8 * PI * eta * a ** 3] * 3 + [6 * PI * eta * a] * 3
-                    + [8 * PI * eta * a ** 3] * 3)
-        if lubrication:
-            out = self._call(("matrix", round(gap, 15)), "matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % (2 * a + gap), 0, 0,
-                             "--a1", a, "--a2", a, "--delta", self.delta, "--eta", eta, "--cutoff", self.cutoff)
-            M = M + np.array(out["R"])
-        n = np.array([-1.0, 0.0, 0.0])     # from sphere 2 to sphere 1 (the pair style's n for i = 1)
-        t = np.array([0.0, 1.0, 0.0])
-        lever = a + 0.5 * gap                # the contact point in the middle of the gap (docs/contact.md 2)
-        load = np.concatenate([t, np.cross(-lever * n, t), -t, np.cross(lever * n, -t)])
-        u = np.linalg.solve(M, load)
-        slip = u[0:3] - u[6:9] - np.cross(lever * u[3:6] + lever * u[9:12], n)
-        return 1.0 / float(slip @ t)
+        return theory.pair_mode_resistances(self.a, self.a, gap, self.delta, self.eta, self.cutoff,
+                                            subgrid=lubrication, contact_in_mid_gap=True)[1]
 
     def table(self, kind, lubrication, points=40, jobs=2):
         """zeta(gap) for the gap-history predictions: sampled on log-spaced gaps, interpolated in

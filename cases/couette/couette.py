@@ -4,7 +4,7 @@
 Walls y = 0 and y = L_y move at -U and +U along x (nominal shear rate gamma_dot_0 = 2U/L_y = 1),
 x and z are periodic. The suspension: spheres of radii a1 = 1 and a2 = 1.4 a1 in equal volumes
 (phi_1 = phi_2 = phi_bulk/2), placed at random without overlap and clear of the walls
-(fdm.packing.channel_packing), frictional contact with h_r = 5e-3 a1 and mu_s = 0.5 (pairs and
+(fdmsubgrid.packing.channel_packing), frictional contact with h_r = 5e-3 a1 and mu_s = 0.5 (pairs and
 walls), sub-grid lubrication for pairs and walls, stresslets on. Units: a1 = 1 m, eta = 1 Pa s,
 gamma_dot_0 = 1 1/s (time = strain).
 
@@ -33,21 +33,17 @@ Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png her
 """
 
 import argparse
-import json
 import math
 import os
-import re
 import shutil
 import sys
-import time
-import dataclasses
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdm import case, output, packing, profiles, rheology, theory  # noqa: E402
+from fdmsubgrid import case, output, packing, shear, theory  # noqa: E402
 
 A1 = 1.0
 TANGENTIAL_SAFETY = 0.5       # k_t dt / zeta_t of the rule (docs/contact.md recipe step 4)
@@ -57,7 +53,6 @@ SHEAR_RATE = 1.0
 ROUGHNESS = 5e-3 * A1        # h_r (section 6)
 FRICTION = 0.5               # mu_s (section 6)
 MARON_PIERCE = (0.803, 0.59)  # alpha, phi_m of the paper's fit (Eq. 55, Fig. 21)
-PAIR_CUTOFF = 0.65            # pair_style fdm/subgrid default cut-off (mesh cells)
 
 # Table 8: phi_bulk -> (phi_core, gamma_core/gamma_0, (Lx, Ly, Lz)/a1, N_P, dt)
 TABLE8 = {
@@ -95,35 +90,12 @@ class Springs:
                    dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
 
 
-def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta: float = ETA,
-                          cutoff: float = PAIR_CUTOFF) -> tuple[float, float]:
-    """(zeta_n, zeta_t) of two free spheres at surface gap `gap`: the force per unit closing speed
-    under equal and opposite loads along the line of centres, and per unit slip speed of the contact
-    points under equal and opposite tangential loads there (with their torques); the resistance is
-    the isolated Stokes drag (6 pi eta a, 8 pi eta a^3) plus the sub-grid pair block of fdmResistance
-    (Eq. 21), as in Eq. (31) without the fluid's resolved part (docs/contact.md, 3c)."""
-    out = theory.resistance("matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % (a_i + a_j + gap), 0, 0, "--a1", a_i,
-                            "--a2", a_j, "--delta", "%.17g" % delta, "--eta", eta, "--cutoff", cutoff)
-    drag = [6 * math.pi * eta * a_i] * 3 + [8 * math.pi * eta * a_i ** 3] * 3 \
-        + [6 * math.pi * eta * a_j] * 3 + [8 * math.pi * eta * a_j ** 3] * 3
-    resistance = np.diag(drag) + np.array(out["R"])
-    d = np.array([1.0, 0.0, 0.0])       # from sphere i to sphere j
-    t = np.array([0.0, 1.0, 0.0])
-    zero = np.zeros(3)
-    u = np.linalg.solve(resistance, np.concatenate([-d, zero, d, zero]))   # pulled apart
-    zeta_n = 1.0 / float((u[6:9] - u[0:3]) @ d)
-    u = np.linalg.solve(resistance, np.concatenate([t, np.cross(a_i * d, t), -t, np.cross(-a_j * d, -t)]))
-    slip = u[0:3] + np.cross(u[3:6], a_i * d) - u[6:9] - np.cross(u[9:12], -a_j * d)
-    zeta_t = 1.0 / float(slip @ t)
-    return zeta_n, zeta_t
-
-
 def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None) -> Springs:
     """The springs by the rule of the module docstring (docs/contact.md), unless given."""
     alpha, phi_m = MARON_PIERCE
     relative_viscosity = alpha / (1.0 - min(phi, 0.9 * phi_m) / phi_m) ** 2
     design_load = 6 * math.pi * ETA * A2 ** 2 * SHEAR_RATE * relative_viscosity
-    zeta_n, zeta_t = pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta)
+    zeta_n, zeta_t = theory.pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta, ETA)
     kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
     # k_t dt/zeta_t <= 0.5: stiffer implicit tangential springs blew up dense suspensions (growth x10
     # per step at k_t dt/zeta_t ~ 300-400, docs/benchmarks.md "Stability map")
@@ -162,149 +134,9 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                 wall_velocity=U, dt=dt, dump_every=dump_every, write_every=write_every)
 
 
-def minimum_gaps(snapshots: list[profiles.Snapshot], box: np.ndarray) -> tuple[float, float]:
-    """Smallest surface gap between spheres and between a sphere and a wall over the snapshots."""
-    pair, wall = math.inf, math.inf
-    for s in snapshots:
-        pair = min(pair, _pair_gap(s, box))
-        wall = min(wall, float(np.min(np.minimum(s.positions[:, 1] - s.radii, box[1] - s.positions[:, 1] - s.radii))))
-    return pair, wall
-
-
-def _pair_gap(s: profiles.Snapshot, box: np.ndarray) -> float:
-    i, j, d = packing.neighbour_pairs(s.positions, box, 2 * float(s.radii.max()) + 0.5, walls=(1,))
-    return float(np.min(d - s.radii[i] - s.radii[j])) if len(i) else math.inf
-
-
-def analyse(run_dir: str, scene: dict, pack: packing.Packing, wall_seconds: float, ranks: int,
-            h_layer: float) -> tuple[dict, list]:
-    """results of one run: the profiles and rheology (fdm.profiles, fdm.rheology), the inner
-    iterations, the gaps."""
-    fluid = os.path.join(run_dir, "fluid")
-    steps = output.steps(fluid)
-    snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"), SHEAR_RATE)
-    box = np.array(scene["box"])
-    channel = profiles.Channel((0, 0, 0), tuple(box))
-    phi_integral = [profiles.bulk_volume_fraction(s, channel) for s in snapshots]
-    series = profiles.core_series(snapshots, channel, h_layer=h_layer)
-    if len(snapshots) >= 16:
-        r = rheology.shear_rheology(series, eta=ETA)    # the steady part from MSER-m (docs/profiles.md)
-    elif len(snapshots) >= 8:  # too few snapshots for the transient rule: the last 8 or more, flagged
-        r = rheology.shear_rheology(series, eta=ETA, start_time=float(series.times[min(len(snapshots) // 2,
-                                                                                          len(snapshots) - 8)]))
-        r = dataclasses.replace(r, steady=False)
-    else:
-        raise ValueError("couette: %d particle snapshots are too few for time averages (8 at least): run longer "
-                         "or lower --dump-every" % len(snapshots))
-    # the momentum balance (docs/profiles.md "Stress balance"): the core stress of Eq. 51 against the
-    # walls' shear stress (fluid traction + sub-grid lubrication + contact), both over the steady part;
-    # and at every snapshot the gap-averaged stress against the mean of the two walls (exact)
-    loads = output.read_wall_loads(run_dir)
-    balance = rheology.stress_balance(r, loads, channel, SHEAR_RATE)
-    tau = rheology.wall_shear_stresses(loads, channel)["total"].mean(axis=1)
-    step_of = {int(st): k for k, st in enumerate(loads.steps)}
-    gap_errors = []
-    for s in snapshots:
-        k = step_of.get(int(round(s.time / (SHEAR_RATE * scene["dt"]))))
-        if k is not None:
-            gap = rheology.gap_shear_stress(s, channel, ETA, 2 * scene["wall_velocity"] / box[1])
-            gap_errors.append(rheology.relative_difference(gap, float(tau[k])))
-    avg = profiles.average_profiles(snapshots, channel, start_time=r.start_time)
-    fine = profiles.average_profiles(snapshots, channel, y=channel.planes(0.02), start_time=r.start_time, errors=False)
-    pair_gap, wall_gap = minimum_gaps(snapshots, box)
-    strain = float(steps["time"][-1] * SHEAR_RATE)
-    inner = steps["innerIterations"]
-
-    def est(e: rheology.Estimate) -> float:
-        return float(e.value)
-
-    res = dict(
-        phi_bulk=pack.phi, phi_bulk_integral_max_error=float(np.max(np.abs(np.array(phi_integral) - pack.phi))),
-        phi_core=est(r.phi_core), phi_core_err=r.phi_core.error,
-        gamma_core_over_gamma0=est(r.gamma_dot_core) / SHEAR_RATE, gamma_core_err=r.gamma_dot_core.error,
-        eta_s=est(r.eta_s), eta_s_err=r.eta_s.error, eta_s_n_eff=r.eta_s.n_eff,
-        N1_hat=est(r.n1_hat), N1_hat_err=r.n1_hat.error, N2_hat=est(r.n2_hat), N2_hat_err=r.n2_hat.error,
-        Sigma_c_hat=[est(e) for e in r.sigma_c_hat], Sigma_c_hat_err=[e.error for e in r.sigma_c_hat],
-        strain_units=strain, steady_from_strain=r.start_time, steady_detected=r.steady, samples_averaged=r.n_samples,
-        h_layer=h_layer, n_particles=pack.n, n_a1=int(np.sum(pack.types == 1)), n_a2=int(np.sum(pack.types == 2)),
-        cells=scene["cells"], mesh=scene["mesh"], box=scene["box"], dt=scene["dt"], steps=int(len(inner)),
-        wall_seconds=wall_seconds, ranks=ranks,
-        core_seconds_per_strain_unit=wall_seconds * ranks / strain,
-        inner_iterations_mean=float(inner.mean()), inner_iterations_max=int(inner.max()),
-        unconverged_steps=int(np.sum(steps["converged"] == 0)),
-        min_pair_gap=pair_gap, min_wall_gap=wall_gap,
-        mean_particle_velocity=np.mean([s.velocities.mean(axis=0) for s in snapshots], axis=0).tolist(),
-        snapshots=len(snapshots))
-    res.update(balance.as_dict())
-    res.update(stress_gap_rel_error_max=float(np.max(gap_errors)) if gap_errors else float("nan"),
-               stress_gap_snapshots=len(gap_errors))
-    return res, [channel, avg, fine, snapshots]
-
-
 def table8_row(phi: float) -> dict:
     """The paper's Table 8 row of phi_bulk."""
     return dict(zip(("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi]))
-
-
-def report(run_dir: str, scene: dict, pack: packing.Packing, wall: float, ranks: int, h_layer: float, out: str,
-           extra: dict) -> dict:
-    """analyse() the run, write `out` (results.json, with `extra`) and the profile figure beside it,
-    print the summary; returns the results."""
-    results, (channel, avg, fine, _) = analyse(run_dir, scene, pack, wall, ranks, h_layer)
-    results.update(extra)
-    figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_couette.png")
-    if out.endswith(".json") and os.path.basename(out) != "results.json":
-        figure = out[:-len(".json")] + ".png"
-    profiles.plot_profiles(figure, channel, avg, fine)
-    results["figure"] = os.path.basename(figure)
-    with open(out, "w") as f:
-        json.dump(results, f, indent=1)
-    keys = ("phi_bulk phi_core gamma_core_over_gamma0 eta_s eta_s_err N1_hat N2_hat Sigma_c_hat strain_units "
-            "steady_from_strain n_particles cells dt wall_seconds core_seconds_per_strain_unit inner_iterations_mean "
-            "inner_iterations_max unconverged_steps min_pair_gap min_wall_gap").split()
-    for k in keys:
-        print("%-30s %s" % (k, results[k]))
-    print("stress balance (Eq. 51 core against the walls, from strain %g, %d steps):"
-          % (results["stress_balance_from_strain"], results["stress_balance_steps"]))
-    print("  core  eta gamma_core + Sigma^h_12 + Sigma^c_12 = %.4g +- %.2g" % (results["stress_core"],
-                                                                           results["stress_core_err"]))
-    print("  walls %.4g +- %.2g (low %.4g, high %.4g): fluid %.4g + sub-grid %.3g + contact %.3g"
-          % tuple(results[k] for k in ("stress_wall", "stress_wall_err", "stress_wall_lo", "stress_wall_hi",
-                                       "stress_wall_fluid", "stress_wall_subgrid", "stress_wall_contact")))
-    print("  stress_balance_rel_error = %.4g +- %.2g; gap-averaged stress against the walls at the %d snapshots: "
-          "at most %.2g" % (results["stress_balance_rel_error"], results["stress_balance_rel_error_err"],
-                            results["stress_gap_snapshots"], results["stress_gap_rel_error_max"]))
-    print("wrote %s and %s" % (out, figure))
-    return results
-
-
-def read_run(run_dir: str) -> tuple[dict, packing.Packing, dict]:
-    """(scene, packing, springs) of a run folder written by write_case, from its own files (the
-    packing data, blockMeshDict, the LIGGGHTS input): what --analyse needs to analyse a run that
-    was resumed, stopped or is still going."""
-    pack = packing.read_data(os.path.join(run_dir, "dem", "packing.data"), walls=(1,))
-    with open(os.path.join(run_dir, "fluid", "system", "blockMeshDict")) as f:
-        mesh = [int(v) for v in re.search(r"hex \([\d ]+\) \((\d+) (\d+) (\d+)\)", f.read()).groups()]
-    with open(os.path.join(run_dir, "dem", "in.couette")) as f:
-        dem = f.read()
-    dt = float(re.search(r"^timestep\s+(\S+)", dem, re.M).group(1))
-    steps = int(re.search(r"^run\s+(\d+)", dem, re.M).group(1))
-    contact = re.search(r"fdm/subgrid contact (\S+) (\S+) (\S+) (\S+)", dem)
-    springs = dict(zip(("kn", "kt", "mu_s", "h_r"), (float(v) for v in contact.groups()))) if contact else {}
-    box = [float(v) for v in pack.box]
-    scene = dict(box=box, cells=mesh[0] * mesh[1] * mesh[2], mesh=mesh, steps=steps,
-                 wall_velocity=SHEAR_RATE * box[1] / 2, dt=dt)
-    return scene, pack, springs
-
-
-def run_seconds(run_dir: str) -> tuple[float, int]:
-    """(wall seconds, ranks) of a run from its step records (the sum over sessions of a resumed run:
-    fluid solve + particle work + exchange of every step), ranks: fluid processor folders (or 1)
-    plus one particle rank."""
-    steps = output.steps(os.path.join(run_dir, "fluid"))
-    seconds = float(np.sum(steps["fluidSeconds"]) + np.sum(steps["particleSeconds"]) + np.sum(steps["exchangeSeconds"]))
-    fluid_ranks = len([d for d in os.listdir(os.path.join(run_dir, "fluid")) if d.startswith("processor")]) or 1
-    return seconds, fluid_ranks + 1
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -339,15 +171,14 @@ def main(argv: list[str] | None = None) -> dict:
 
     if args.analyse:
         # a run folder as it stands (finished, stopped or still going): its own files say the scene
-        scene, pack, springs_used = read_run(args.analyse)
-        wall, ranks = run_seconds(args.analyse)
+        # (the same as fdmProfiles RUN_DIR --out OUT, with the case's keys)
+        run = shear.read_run(args.analyse)
         name = os.path.basename(os.path.normpath(args.analyse))
         table8 = None
         if name.startswith("table8_"):
-            table8 = table8_row(min(TABLE8, key=lambda k: abs(k - pack.phi)))
-        return report(args.analyse, scene, pack, wall, ranks, args.h_layer, args.out,
-                      dict(case="couette", run=name, run_dir=os.path.abspath(args.analyse), springs=springs_used,
-                           steps_planned=scene["steps"], table8=table8))
+            table8 = table8_row(min(TABLE8, key=lambda k: abs(k - run.packing.phi)))
+        return shear.report(run, args.out, dict(case="couette", run=name, run_dir=os.path.abspath(args.analyse),
+                                                table8=table8), h_layer=args.h_layer)
 
     n_particles = None
     phi = args.phi
@@ -395,11 +226,12 @@ def main(argv: list[str] | None = None) -> dict:
         return dict(run_dir=run_dir, **scene)
 
     wall = case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
-    results = report(run_dir, scene, pack, wall, args.np_fluid + args.np_dem, args.h_layer, args.out,
-                     dict(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration,
-                          tol_lambda=args.tol_lambda, n_max=args.n_max, a_over_delta=args.a_over_delta,
-                          seed=args.seed, springs=asdict(springs),
-                          table8=None if args.table8 is None else table8_row(phi)))
+    results = shear.report(shear.read_run(run_dir), args.out,
+                           dict(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration,
+                                tol_lambda=args.tol_lambda, n_max=args.n_max, a_over_delta=args.a_over_delta,
+                                seed=args.seed, springs=asdict(springs),
+                                table8=None if args.table8 is None else table8_row(phi)),
+                           wall_seconds=wall, ranks=args.np_fluid + args.np_dem, h_layer=args.h_layer)
     if not args.keep:
         fluid = os.path.join(run_dir, "fluid")
         shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)

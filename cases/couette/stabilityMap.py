@@ -27,7 +27,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 
-from fdm import output  # noqa: E402
+from fdmsubgrid import output  # noqa: E402
 
 sys.path.insert(0, HERE)
 import couette  # noqa: E402

@@ -32,7 +32,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 
-from fdm import checkpoint, output, rheology  # noqa: E402
+from fdmsubgrid import checkpoint, output, rheology  # noqa: E402
 
 PAPER_FIT = dict(alpha=0.803, phi_m=0.59)   # paper section 6.1, Eq. (55)
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed

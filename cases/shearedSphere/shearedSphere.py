@@ -13,7 +13,7 @@ What it measures:
                                                        hydrodynamic stresslet S^H, Eq. 12)
   the momentum balance: the fluid's shear force on the walls, mean of the two, per unit area,
       tau_w = eta gamma_dot + S_xy / V                 (V = L^2 H: the gap average of the stress,
-                                                       fdm.rheology.gap_shear_stress), its relative error
+                                                       fdmsubgrid.rheology.gap_shear_stress), its relative error
   the rotation Omega_z / (-gamma_dot/2)
 
   shearedSphere.py                       CI size: L = 12 a, H = 20 a, a/Delta = 3 (about 10 s)
@@ -34,7 +34,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdm import case, output, profiles, rheology  # noqa: E402
+from fdmsubgrid import case, output, profiles, rheology  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0

@@ -42,7 +42,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
-from fdm import case  # noqa: E402
+from fdmsubgrid import case  # noqa: E402
 
 VERSION = 3
 HELLO, STEP, INTEGRALS, VELOCITIES, STEPDONE, FINISH, ERROR, VOLUMES = range(1, 9)

@@ -1,6 +1,6 @@
 """Profiles of a wall-bounded suspension from particle snapshots (paper sections 6.1 and 6.2).
 
-    from fdm import profiles
+    from fdmsubgrid import profiles
     ch = profiles.Channel(lo=(0, -10, 0), hi=(20, 10, 20))            # walls y = -10, 10
     s = profiles.Snapshot(positions, radii, velocities=U, stresslet_h=SH, stresslet_c=SC, time=t)
     fine = profiles.profiles_on_planes(s, ch, ch.planes(0.02))        # Eqs. 49, 53, 59 on planes
@@ -50,8 +50,8 @@ ordinary least-squares line U_flow = u0 + gamma_dot y through the particles whos
 the core (|y_p - y_mid| < L_y/2 - H_layer), each particle one point (weighting="number", the
 default) or weighted by its volume (weighting="volume"); section 6.1 says "a linear regression of
 the particle velocity distribution of the particles situated inside the core region".
-The rheology from a run of snapshots (Eqs. 54-57) is in fdm.rheology; time averages and error
-bars in fdm.timeseries. Method and tests: docs/profiles.md, tests/test_profiles.py.
+The rheology from a run of snapshots (Eqs. 54-57) is in fdmsubgrid.rheology; time averages and error
+bars in fdmsubgrid.timeseries. Method and tests: docs/profiles.md, tests/test_profiles.py.
 """
 from __future__ import annotations
 
@@ -458,7 +458,7 @@ class CoreSeries:
 
 def core_series(snapshots: Sequence[Snapshot], channel: Channel, h_layer: float | None = None,
                 weighting: str = "number") -> CoreSeries:
-    """core_values of every snapshot of a run (in time order), for fdm.rheology.shear_rheology.
+    """core_values of every snapshot of a run (in time order), for fdmsubgrid.rheology.shear_rheology.
     H_layer default 5 a1 of the first snapshot."""
     if len(snapshots) == 0:
         raise ValueError("core_series needs at least one snapshot")
@@ -477,7 +477,7 @@ class ProfileAverage:
     """Time-averaged profiles over the snapshots with time >= start_time, on planes (edges None)
     or bins (edges (n+1,)); y (n,). Means: phi (n,), u_p (n, 3) = <phi u_p>/<phi>, omega_p (n, 3),
     sigma_h, sigma_c, sigma_p = sigma_h + sigma_c (n, 6). The *_error fields are the standard
-    errors by block averaging over the snapshots (fdm.timeseries.block_average; for u_p and
+    errors by block averaging over the snapshots (fdmsubgrid.timeseries.block_average; for u_p and
     omega_p the ratio of means, timeseries.ratio_of_means); None if not computed (errors=False),
     nan with fewer than 2 timeseries.MIN_BLOCKS snapshots. n_snapshots: snapshots averaged."""
 

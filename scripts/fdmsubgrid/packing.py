@@ -1,6 +1,6 @@
 """Random dense packings of spheres in a periodic box (numpy, scipy's KD-tree), written as LIGGGHTS data files.
 
-    from fdm import packing
+    from fdmsubgrid import packing
     p = packing.random_packing(1000, 0.45, bidisperse=True, seed=1)   # the paper's a1 = 1, a2 = 1.4
     p.min_gap, p.phi, p.box                                           # measured, not assumed
     packing.write_data("spheres.data", p)                            # atom_style sphere, type 1 / 2
@@ -9,7 +9,7 @@
 
 Command line (prints a summary, writes the data file):
 
-    python3 -m fdm.packing N PHI [--bidisperse] [--seed S] [--min-gap G] [--box-multiple D]
+    python3 -m fdmsubgrid.packing N PHI [--bidisperse] [--seed S] [--min-gap G] [--box-multiple D]
                                  [--shake SWEEPS] [--walls y] -o FILE
 
     p = packing.channel_packing((10, 12, 8), phi=0.3, seed=1)        # any box, walls at y = 0 and L_y
@@ -79,7 +79,7 @@ class Packing:
         return float(np.sum(4.0 / 3.0 * math.pi * self.radii ** 3) / np.prod(self.box))
 
     def spheres(self):
-        """[(x, y, z, a), ...] as fdm.case.write_dem_input takes them."""
+        """[(x, y, z, a), ...] as fdmsubgrid.case.write_dem_input takes them."""
         return [(float(x[0]), float(x[1]), float(x[2]), float(a)) for x, a in zip(self.positions, self.radii)]
 
     def gaps(self, cutoff):
@@ -462,7 +462,7 @@ def write_data(path, p, density=1000.0, scale=1.0, title=None):
     ntypes = int(p.types.max())
     with open(path, "w") as f:
         if title is None:  # LIGGGHTS reads a short first line only
-            title = "fdm.packing: %d spheres, box %s (%s), phi %.5f, min surface gap %.4g" % (
+            title = "fdmsubgrid.packing: %d spheres, box %s (%s), phi %.5f, min surface gap %.4g" % (
                 p.n, " ".join("%.10g" % b for b in p.box), p.boundary, p.phi, p.min_gap)
         f.write("%s\n\n%d atoms\n%d atom types\n\n" % (title[:200], p.n, ntypes))
         for d, axis in enumerate("xyz"):

@@ -1,7 +1,7 @@
 """Rheology of a suspension in simple shear from the core values of a run (paper 6.1, Eqs. 51-57),
 and the Maron-Pierce fit of the viscosity over several runs (Eq. 55).
 
-    from fdm import profiles, rheology
+    from fdmsubgrid import profiles, rheology
     series = profiles.core_series(snapshots, channel)             # one row per snapshot
     r = rheology.shear_rheology(series, eta=1.0)                  # steady part found by MSER-m
     r.eta_s.value, r.eta_s.error, r.n1_hat, r.sigma_c_hat[1], r.start_time
@@ -9,7 +9,7 @@ and the Maron-Pierce fit of the viscosity over several runs (Eq. 55).
     rheology.plot_viscosity("eta.png", phi_core, eta_s, eta_s_error, fit)
 
 What is computed. Axes: 1 = flow (channel.flow_axis), 2 = wall-normal (channel.wall_axis),
-3 = vorticity. Per snapshot (fdm.profiles.core_values): gamma_dot_core and the core particle
+3 = vorticity. Per snapshot (fdmsubgrid.profiles.core_values): gamma_dot_core and the core particle
 stresses Sigma^{h,core}, Sigma^{c,core} (Eq. 53 averaged over the core). With <.> the time
 average over the steady part, Sigma^p = Sigma^h + Sigma^c, eta the fluid viscosity:
 
@@ -24,9 +24,9 @@ a difference, and the fluid's Newtonian stress eta gamma_dot (e1 e2 + e2 e1) of 
 normal components (the particles' disturbance of the fluid is in their stresslets). The
 isotropic parts s^h delta/3 of S^H (Eq. 52) are kept in Sigma^h (they cancel in N1, N2, not in
 the Sigma^c_ii_hat, which are contact stresses only). Every quantity is a ratio of time averages;
-its error is the delta-method error of a ratio of means (fdm.timeseries.ratio_of_means), by block
+its error is the delta-method error of a ratio of means (fdmsubgrid.timeseries.ratio_of_means), by block
 averaging over the snapshots. The steady part starts at the latest start found by MSER-m
-(fdm.timeseries.detect_transient) on the series that enter these averages (phi_core,
+(fdmsubgrid.timeseries.detect_transient) on the series that enter these averages (phi_core,
 gamma_dot_core, Sigma^p_12, Sigma^p_11 - Sigma^p_22, Sigma^p_22 - Sigma^p_33, Sigma^c_11,
 Sigma^c_22, Sigma^c_33), unless start_time is given.
 
@@ -36,7 +36,7 @@ the core stress Sigma_12 of Eq. 51 equals the shear stress the suspension exerts
 
     tau_w = -F_w,1 (n_w . e2) / A_w,   F_w = fluid traction + sub-grid lubrication + contact
 
-with F_w the force on wall w per step (fdm.output.read_wall_loads: fdmFoam's viscous force on the
+with F_w the force on wall w per step (fdmsubgrid.output.read_wall_loads: fdmFoam's viscous force on the
 patch, and the particles' sub-grid wall force (Eq. D.6) and wall contacts from fix fdm/couple
 walls), n_w the wall's normal out of the suspension (-e2 at the low wall, +e2 at the high one), A_w
 its area. stress_balance time-averages tau_lo, tau_hi, their mean and its parts over the steady part
@@ -143,7 +143,7 @@ def wall_shear_stresses(loads, channel: Channel) -> dict[str, NDArray]:
     """Per step the shear stress the suspension exerts on the low and the high wall of the channel,
     tau_w = -F_w,1 (n_w . e2)/A_w (module docstring), and its parts: a dict of (T, 2) arrays
     (column 0 the low wall, 1 the high one) "total", "fluid", "subgrid", "contact". loads: an
-    fdm.output.WallLoads (forces on the walls per step, faces named like "ylo", "yhi")."""
+    fdmsubgrid.output.WallLoads (forces on the walls per step, faces named like "ylo", "yhi")."""
     axis = "xyz"[channel.wall_axis]
     lo, hi = loads.wall(axis + "lo"), loads.wall(axis + "hi")
     f1 = channel.flow_axis

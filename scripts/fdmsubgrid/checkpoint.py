@@ -6,9 +6,9 @@ step's time directory), fdmDEM CASE/dem/checkpoint/dem.<step> (one binary file, 
 dem/particle_checkpoint.h). Both are written to a temporary name and renamed once complete, and
 each code keeps its two newest.
 
-    python3 -m fdm.checkpoint select CASE        the newest step both codes have complete (prints it;
+    python3 -m fdmsubgrid.checkpoint select CASE        the newest step both codes have complete (prints it;
                                                  says on stderr which newer ones were passed over and why)
-    python3 -m fdm.checkpoint truncate CASE STEP cut every record at STEP: fdmFoam's steps.dat,
+    python3 -m fdmsubgrid.checkpoint truncate CASE STEP cut every record at STEP: fdmFoam's steps.dat,
                                                  particles.dat, walls.dat, fix fdm/couple's walls
                                                  file and the function objects' records keep
                                                  the steps up to STEP, the DEM's dumps the frames before

@@ -6,7 +6,7 @@ import time
 
 import numpy as np
 
-from . import PROJECT_DIR
+from .environment import program, run_environment
 
 HEADER = """FoamFile
 {{
@@ -178,7 +178,7 @@ PISO
 }
 """ % dict(tol_p=tol_p, tol_u=tol_u, ncorr=n_correctors))
 
-    # no system/decomposeParDict: fdmRun -f N writes the split for N ranks (fdm.decomposition)
+    # no system/decomposeParDict: fdmRun -f N writes the split for N ranks (fdmsubgrid.decomposition)
 
     foam_file(os.path.join(case_dir, "constant/transportProperties"), "dictionary", """
 nu              %.17g;   // kinematic viscosity eta/rho_f [m2/s]
@@ -265,12 +265,13 @@ def write_initial_velocity(case_dir, box, velocity):
 def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     """Run fdmRun on case_dir; returns the wall time in seconds. Raises RuntimeError with the
     end of fdmRun's report if the run fails."""
-    cmd = [os.path.join(PROJECT_DIR, "scripts", "fdmRun"), "-f", str(np_fluid), "-d", str(np_dem)]
+    cmd = [program("fdmRun"), "-f", str(np_fluid), "-d", str(np_dem)]
     if quiet:
         cmd.append("--quiet")
     cmd += list(extra) + [case_dir]
     t0 = time.time()
-    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
+    proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
+                          env=run_environment())
     wall = time.time() - t0
     if proc.returncode != 0:
         raise RuntimeError("fdmRun %s failed (exit %d):\n%s" % (case_dir, proc.returncode, proc.stdout[-4000:]))

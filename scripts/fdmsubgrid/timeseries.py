@@ -1,6 +1,6 @@
 """Time averages of correlated samples: error bars by block averaging, and the end of the transient.
 
-    from fdm import timeseries
+    from fdmsubgrid import timeseries
     avg = timeseries.block_average(x)              # x: (n,) or (n, ...) samples, equally spaced
     avg.mean, avg.error, avg.n_eff                 # mean, standard error, independent samples
     tr = timeseries.detect_transient(x, times)     # MSER-m: where the steady part starts

@@ -49,7 +49,7 @@ def particles(fluid_case):
 # ------------------------------------------------------------------------------------------------
 # Wall loads: the force of the fluid (fdmFoam, postProcessing/fdm/walls.dat) and of the particles
 # (fix fdm/couple ... walls FILE) on each wall, per step -- the momentum balance of a sheared
-# suspension (fdm.rheology.stress_balance, docs/profiles.md)
+# suspension (fdmsubgrid.rheology.stress_balance, docs/profiles.md)
 # ------------------------------------------------------------------------------------------------
 
 _AXES = "xyz"
@@ -99,7 +99,7 @@ def _header_lines(path: str, count: int) -> list:
 
 
 def _patch_face(patch: str) -> str:
-    """fdmFoam's patch name of a box face (fdm.case: xLow, yHigh, ...) as LIGGGHTS's (xlo, yhi)."""
+    """fdmFoam's patch name of a box face (fdmsubgrid.case: xLow, yHigh, ...) as LIGGGHTS's (xlo, yhi)."""
     if len(patch) > 1 and patch[0] in _AXES and patch[1:] in ("Low", "High"):
         return patch[0] + ("lo" if patch[1:] == "Low" else "hi")
     return patch
@@ -109,7 +109,7 @@ def read_wall_loads(run_dir: str, dem_file: str | None = "walls.dat") -> WallLoa
     """The wall loads of a coupled run (run_dir with fluid/ and dem/): fdmFoam's
     fluid/postProcessing/fdm/walls.dat and, unless dem_file is None, the particle side
     dem/<dem_file> of `fix fdm/couple ... walls FILE`; joined on their common steps. The fluid
-    patches are matched to the particle code's faces by name (fdm.case names the patch of the
+    patches are matched to the particle code's faces by name (fdmsubgrid.case names the patch of the
     face ylo yLow). A last, incomplete line (a killed run) is dropped with a warning."""
     fluid_path = os.path.join(run_dir, "fluid", "postProcessing", "fdm", "walls.dat")
     if not os.path.isfile(fluid_path):
@@ -170,7 +170,7 @@ SUSPENSION_DUMP_COLUMNS = ("id type radius x y z vx vy vz omegax omegay omegaz".
 # the columns of fix fdm/couple's per-atom array (1-based in LIGGGHTS, 0-based here)
 _F_FDM, _T_FDM, _F_SG, _T_SG = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)
 _S_H_TRACELESS, _S_H_TRACE, _S_C = slice(12, 18), 18, slice(19, 25)
-_DIAGONAL = (0, 3, 5)  # xx, yy, zz in the order xx xy xz yy yz zz (fdm.profiles.COMPONENTS)
+_DIAGONAL = (0, 3, 5)  # xx, yy, zz in the order xx xy xz yy yz zz (fdmsubgrid.profiles.COMPONENTS)
 
 
 def dump_custom_command(dump_id, every, path, group="all", fix_id="couple"):
@@ -221,7 +221,7 @@ def read_dump(path):
 
 
 def suspension_snapshots(path, dt, strain_rate=1.0, skip_first=True):
-    """The frames of a suspension dump (dump_custom_command) as fdm.profiles.Snapshot objects,
+    """The frames of a suspension dump (dump_custom_command) as fdmsubgrid.profiles.Snapshot objects,
     time = strain = step dt strain_rate, particles in id order: positions, radii, types, U_p,
     Omega_p, the hydrodynamic stresslet S^H = S^h + s^h delta/3 (Eq. 52; S^h the traceless fluid +
     sub-grid part of columns 13-18, s^h the trace of the force dipole, column 19) and the contact
@@ -375,7 +375,7 @@ def read_particle_records(path: str, mmap: bool = True) -> ParticleRecords:
 
 
 def record_snapshots(records, strain_rate: float = 1.0):
-    """The blocks of a records file (a path or ParticleRecords) as fdm.profiles.Snapshot objects,
+    """The blocks of a records file (a path or ParticleRecords) as fdmsubgrid.profiles.Snapshot objects,
     time = strain = record time x strain_rate, particles by tag: positions (wrapped into the box),
     radii, types, U_p, Omega_p, S^H = S_fluid + S_subgrid (the hydrodynamic stresslet, Eq. 52, not
     traceless) and S^c = S_contact (zero without stresslets). Also returns per block the

@@ -2,7 +2,7 @@
 uniform Cartesian mesh into N sub-domains with the least processor-boundary area, written to
 system/decomposeParDict (docs/fluid.md, "Parallel runs").
 
-    python3 -m fdm.decomposition FLUID_CASE N     (what fdmRun calls; exit 2 with a message if
+    python3 -m fdmsubgrid.decomposition FLUID_CASE N     (what fdmRun calls; exit 2 with a message if
                                                    the mesh cannot take N ranks)
 
 The rule for a case's own system/decomposeParDict: a dict that fdmRun wrote carries MARK and is
@@ -250,7 +250,7 @@ def prepare(fluid_case, n_ranks):
 
 def main(argv):
     if len(argv) != 3 or not argv[2].isdigit():
-        sys.stderr.write("usage: python3 -m fdm.decomposition FLUID_CASE N\n")
+        sys.stderr.write("usage: python3 -m fdmsubgrid.decomposition FLUID_CASE N\n")
         return 2
     try:
         print(prepare(argv[1], int(argv[2])))

@@ -2,7 +2,7 @@
 running fdmDEM, reading the per-step record of the Eq. (31) solve (scripts/benchmarkSubgrid.py,
 tests/test_subgrid_stability.py).
 
-    from fdm import demonly, packing
+    from fdmsubgrid import demonly, packing
     p = packing.random_packing(100, 0.5, walls=(1,))
     scene = demonly.Scene(p, solver="cg", tolerance=1e-10, steps=1000, dt=1e-3,
                           walls={"ylo": (-5, 0, 0), "yhi": (5, 0, 0)})
@@ -24,14 +24,15 @@ import time
 
 import numpy as np
 
-from . import PROJECT_DIR, packing as packing_module
+from . import packing as packing_module
+from .environment import program, run_environment
 
 THERMO = ("step iterations solveTotal pairBlocks wallBlocks contacts maxSpeed maxSpin").split()
 FACES = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
 
 
 class Scene:
-    """A LIGGGHTS scene for fdmDEM. packing: a fdm.packing.Packing (its box and boundary are used);
+    """A LIGGGHTS scene for fdmDEM. packing: a fdmsubgrid.packing.Packing (its box and boundary are used);
     walls: {face: (ux, uy, uz)} moving walls declared to the pair style (faces on the packing's
     wall-bounded axes); forces: {group-name: (ids or 'type N', (fx, fy, fz))} applied with fix
     addforce; contact: (kn, kt, mu_s, h_r) or None; fluid: None for transport none (viscosity eta,
@@ -59,7 +60,7 @@ class Scene:
             pair += " wall %s %r %r %r" % ((face,) + tuple(float(c) for c in u))
         if self.extra_pair:
             pair += " " + self.extra_pair
-        lines = ["# written by fdm.demonly (scripts/fdm/demonly.py)",
+        lines = ["# written by fdmsubgrid.demonly (scripts/fdmsubgrid/demonly.py)",
                  "atom_style      sphere",
                  "atom_modify     map array sort 0 0.0",
                  "boundary        %s" % p.boundary,
@@ -113,25 +114,14 @@ class Scene:
         return path
 
 
-def environment():
-    """os.environ plus what fdmDEM needs (etc/bashrc's library path and MPI-as-root flags)."""
-    env = dict(os.environ)
-    build = os.path.join(PROJECT_DIR, ".cache", "build")
-    lib = os.path.join(build, "lib")
-    if lib not in env.get("LD_LIBRARY_PATH", "").split(":"):
-        env["LD_LIBRARY_PATH"] = lib + (":" + env["LD_LIBRARY_PATH"] if env.get("LD_LIBRARY_PATH") else "")
-    env["PATH"] = os.path.join(build, "bin") + ":" + env.get("PATH", "")
-    if os.geteuid() == 0:
-        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    return env
+def environment() -> dict:
+    """os.environ plus what fdmDEM needs (environment.run_environment)."""
+    return run_environment()
 
 
-def fdmdem():
-    exe = shutil.which("fdmDEM", path=environment()["PATH"])
-    if not exe:
-        raise FileNotFoundError("fdmDEM not built: run ./Allwmake")
-    return exe
+def fdmdem() -> str:
+    """The fdmDEM binary (environment.program)."""
+    return program("fdmDEM")
 
 
 TIMING = re.compile(r"fdm/couple timing of this run \((\d+) runs?, (\d+) steps, ([0-9.eE+-]+) s\): particle solve "

@@ -1,0 +1,12 @@
+"""fdmsubgrid: the Python side of the fictitious-domain suspension simulator.
+
+Write coupled cases and run them with fdmRun (case), pack spheres (packing), read what the runs
+write (output), compute the profiles of a wall-bounded suspension and its rheology (profiles,
+rheology, timeseries), and the analysis of a sheared-suspension run folder (shear, the fdmProfiles
+command). ./Allwmake installs the package (editable) so that a notebook can `import fdmsubgrid`;
+the programs it runs are found through the environment (environment.program). docs/profiles.md.
+
+    from fdmsubgrid import output, profiles, rheology
+    snapshots, _ = output.record_snapshots("run/dem/particles.records")
+"""
+__version__ = "0.1.0"

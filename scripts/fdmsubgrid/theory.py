@@ -1,0 +1,70 @@
+"""Theoretical references from the project's resistance library, through its command-line tool
+fdmResistance (dem/resistance/, docs/resistance.md): one source of resistance functions for the solver,
+the tests and the post-processing."""
+import functools
+import json
+import math
+import subprocess
+
+import numpy as np
+
+from .environment import program, run_environment
+
+
+def resistance(*args: object) -> dict:
+    """JSON output of `fdmResistance args...` as a dict."""
+    out = subprocess.run([program("fdmResistance")] + [str(a) for a in args], check=True, stdout=subprocess.PIPE,
+                         text=True, env=run_environment()).stdout
+    return json.loads(out)
+
+
+def pair_squeeze_velocity(a1, a2, xi):
+    """Closing velocity of two spheres pushed together along their line of centres by equal and
+    opposite forces F, in units of F/(6 pi eta a1): full-range two-sphere theory (Jeffrey & Onishi)."""
+    return resistance("squeeze", "--a1", a1, "--a2", a2, "--xi", xi)["closing_velocity_normalised"]
+
+
+def wall_squeeze_velocity(a, eps):
+    """Velocity of a sphere pushed toward a plane wall by a force F, in units of F/(6 pi eta a):
+    1/X^A_wall (Brenner 1961)."""
+    return resistance("squeeze", "--a", a, "--eps", eps, "--wall")["closing_velocity_normalised"]
+
+
+def relative_errors(values, reference):
+    """(value - reference) / reference, element by element."""
+    return [(v - r) / r for v, r in zip(values, reference)]
+
+
+PAIR_CUTOFF = 0.65   # pair_style fdm/subgrid's default cut-off (mesh cells), docs/dem.md
+
+
+@functools.lru_cache(maxsize=4096)
+def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta: float = 1.0,
+                          cutoff: float = PAIR_CUTOFF, subgrid: bool = True,
+                          contact_in_mid_gap: bool = False) -> tuple[float, float]:
+    """(zeta_n, zeta_t) of two free spheres at surface gap `gap`: the force per unit closing speed
+    under equal and opposite loads along the line of centres, and per unit slip speed of the contact
+    points under equal and opposite tangential loads there (with their torques). The resistance is
+    the isolated Stokes drag (6 pi eta a, 8 pi eta a^3) plus, if subgrid, the sub-grid pair block of
+    fdmResistance (Eq. 21) at mesh size delta: Eq. (31) without the fluid's resolved part
+    (docs/contact.md, 3c). The contact points sit on the spheres' surfaces (a_i, a_j from the
+    centres), or with contact_in_mid_gap in the middle of the gap (docs/contact.md 2). Without the
+    sub-grid block, zeta_t of two equal spheres is 12/7 pi eta a."""
+    drag = [6 * math.pi * eta * a_i] * 3 + [8 * math.pi * eta * a_i ** 3] * 3 \
+        + [6 * math.pi * eta * a_j] * 3 + [8 * math.pi * eta * a_j ** 3] * 3
+    resistance_matrix = np.diag(drag)
+    if subgrid:
+        out = resistance("matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % (a_i + a_j + gap), 0, 0, "--a1", a_i,
+                         "--a2", a_j, "--delta", "%.17g" % delta, "--eta", eta, "--cutoff", cutoff)
+        resistance_matrix = resistance_matrix + np.array(out["R"])
+    d = np.array([1.0, 0.0, 0.0])       # from sphere i to sphere j
+    t = np.array([0.0, 1.0, 0.0])
+    zero = np.zeros(3)
+    lever_i, lever_j = (a_i + 0.5 * gap, a_j + 0.5 * gap) if contact_in_mid_gap else (a_i, a_j)
+    u = np.linalg.solve(resistance_matrix, np.concatenate([-d, zero, d, zero]))   # pulled apart
+    zeta_n = 1.0 / float((u[6:9] - u[0:3]) @ d)
+    u = np.linalg.solve(resistance_matrix, np.concatenate([t, np.cross(lever_i * d, t), -t,
+                                                           np.cross(-lever_j * d, -t)]))
+    slip = u[0:3] + np.cross(u[3:6], lever_i * d) - u[6:9] - np.cross(u[9:12], -lever_j * d)
+    zeta_t = 1.0 / float(slip @ t)
+    return zeta_n, zeta_t

@@ -1,0 +1,72 @@
+"""The Python package fdmsubgrid (scripts/fdmsubgrid) as a user meets it: importable from any folder
+after ./Allwmake (a notebook), declared by scripts/pyproject.toml, finding the project's programs
+through the environment rather than through the file's location."""
+import os
+import shutil
+import subprocess
+import sys
+import tomllib
+
+import pytest
+
+TESTS = os.path.dirname(os.path.abspath(__file__))
+PROJECT = os.path.dirname(TESTS)
+MODULES = ("case", "checkpoint", "decomposition", "demonly", "environment", "output", "packing", "periodicarray",
+           "profiles", "rheology", "shear", "theory", "timeseries")
+
+
+def clean_environment() -> dict:
+    """The environment of a new shell: no PYTHONPATH, no project variables, no project folders on the PATH."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH" and not k.startswith("FDM_")}
+    env["PATH"] = os.pathsep.join(p for p in env.get("PATH", "").split(os.pathsep) if not p.startswith(PROJECT))
+    return env
+
+
+def test_importable_from_any_folder_after_Allwmake():
+    # what a notebook does: no sys.path manipulation, started elsewhere
+    code = "import fdmsubgrid, %s; print(fdmsubgrid.__version__)" % ", ".join("fdmsubgrid." + m for m in MODULES)
+    proc = subprocess.run([sys.executable, "-c", code], cwd="/", env=clean_environment(), text=True,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    assert proc.returncode == 0, "import fdmsubgrid failed (./Allwmake installs it):\n" + proc.stdout
+
+
+def test_pyproject_declares_the_package_and_its_command():
+    with open(os.path.join(PROJECT, "scripts", "pyproject.toml"), "rb") as f:
+        project = tomllib.load(f)
+    assert project["project"]["name"] == "fdmsubgrid"
+    assert project["tool"]["setuptools"]["packages"] == ["fdmsubgrid"]
+    import fdmsubgrid
+    assert project["project"]["version"] == fdmsubgrid.__version__
+    module, function = project["project"]["scripts"]["fdmProfiles"].split(":")
+    assert callable(getattr(__import__(module, fromlist=[function]), function))
+    # every module of the package is listed here, so that the import test covers it
+    here = sorted(f[:-3] for f in os.listdir(os.path.join(PROJECT, "scripts", "fdmsubgrid"))
+                  if f.endswith(".py") and f != "__init__.py")
+    assert here == sorted(MODULES)
+
+
+def test_programs_found_through_the_environment(tmp_path):
+    # a copy of the package outside any checkout (a non-editable install): FDM_ROOT (etc/bashrc) is
+    # how it finds fdmRun and fdmResistance; without it, an error that says what to source
+    shutil.copytree(os.path.join(PROJECT, "scripts", "fdmsubgrid"), tmp_path / "fdmsubgrid")
+    code = "from fdmsubgrid.environment import program; print(program('fdmRun')); print(program('fdmResistance'))"
+    env = clean_environment()
+    env["PYTHONPATH"] = str(tmp_path)
+    with_root = subprocess.run([sys.executable, "-S", "-c", code], env=dict(env, FDM_ROOT=PROJECT), text=True,
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, cwd=str(tmp_path))
+    assert with_root.returncode == 0, with_root.stdout
+    fdm_run, resistance = with_root.stdout.split()
+    assert os.path.samefile(fdm_run, os.path.join(PROJECT, "scripts", "fdmRun"))
+    assert os.path.basename(resistance) == "fdmResistance" and os.access(resistance, os.X_OK)
+    without = subprocess.run([sys.executable, "-S", "-c", code], env=env, text=True, stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, cwd=str(tmp_path))
+    assert without.returncode != 0
+    assert "fdmRun not found" in without.stdout and "etc/bashrc" in without.stdout
+
+
+@pytest.mark.parametrize("name", ["fdmRun", "fdmProfiles"])
+def test_commands_on_the_path_of_etc_bashrc(env, name):
+    exe = shutil.which(name, path=env["PATH"])
+    assert exe is not None and os.path.samefile(exe, os.path.join(PROJECT, "scripts", name))
+    proc = subprocess.run([exe, "--help"], env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    assert proc.returncode == 0 and "usage" in proc.stdout.lower(), proc.stdout[-1000:]
