@@ -785,6 +785,7 @@ void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
   const motion::Statistics stats = motion::displacementRates(c, closePairs, walls, update->dt, options, moveRate_);
   run_.gapTargets += stats.pairGaps + stats.wallGaps;
   run_.gapLimited += stats.limited;
+  run_.gapHeld += stats.heldGaps;
   run_.gapFallbacks += stats.fallback ? 1 : 0;
   run_.gapSweepsMax = std::max(run_.gapSweepsMax, stats.sweeps);
   planPositions_ = c.x;
@@ -990,9 +991,10 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
   std::string gapStats = " (gap_update none)";
   if (gapUpdate_) {
     char g[200];
-    std::snprintf(g, sizeof g, " with log gaps: %.3g gap targets per step, at most %d sweeps, %ld limited, "
-                  "%ld steps kept straight (contradictory targets)",
-                  t.steps ? double(t.gapTargets) / t.steps : 0.0, t.gapSweepsMax, t.gapLimited, t.gapFallbacks);
+    std::snprintf(g, sizeof g, " with log gaps: %.3g gap targets and %.3g held contact gaps per step, at most %d "
+                  "sweeps, %ld limited, %ld steps kept straight (contradictory targets)",
+                  t.steps ? double(t.gapTargets) / t.steps : 0.0, t.steps ? double(t.gapHeld) / t.steps : 0.0,
+                  t.gapSweepsMax, t.gapLimited, t.gapFallbacks);
     gapStats = g;
   }
   char line[1400];

@@ -65,10 +65,11 @@ class FixFdmCouple : public Fix {
     double solve, exchange, gatherScatter;
     long steps, solves, solverIterations, solverIterationsMax;
     long gapTargets, gapLimited;   // log-gap targets of the position update, and those limited
+    long gapHeld;                  // contact (or closed) gaps held at their straight-step value
     long gapFallbacks;             // steps where the targets contradicted each other (straight step)
     int gapSweepsMax;
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
-               gapTargets(0), gapLimited(0), gapFallbacks(0), gapSweepsMax(0) {}
+               gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0) {}
   };
 
   void gather(std::vector<Particle> &particles);

@@ -12,6 +12,7 @@ namespace {
 struct Gap {
   int i, j;       // j < 0: a wall, index -1 - j
   double target;  // surface gap wanted at step n+1
+  double scale;   // what |gap - target| is compared with: the target, or h_r for a held contact gap
 };
 
 void minimumImage(double d[3], const double period[3])
@@ -86,15 +87,32 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
   for (size_t k = 0; k < rate.size(); k++) rate[k] = multistep ? 1.5 * c.u[k] - 0.5 * c.uPrevious[k] : c.u[k];
   if (!o.gapCorrection || !(dt > 0)) return stats;
 
+  // the straight step
+  std::vector<double> y(size_t(3) * n);
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < 3; k++) y[3 * i + k] = c.x[3 * i + k] + dt * rate[6 * i + k];
+
+  // Targets: log h for the gaps of lubrication; a gap held by a contact spring (h < h_r) or closed
+  // keeps the gap the straight step gives it (what the implicit springs of Eq. 31 assumed,
+  // docs/contact.md C2), so that the corrections of its particles' other gaps do not push it
+  // deeper into contact (in dense clusters they did: overlaps of 0.03-0.07 a1, docs/benchmarks.md)
   std::vector<Gap> gaps;
+  const double smallest = 1e-9 * (n ? *std::min_element(c.radius.begin(), c.radius.end()) : 1.0);
+  const auto held = [&](int i, int j, double straightGap) {
+    gaps.push_back(Gap{i, j, straightGap, std::max(std::max(o.contactGap, std::fabs(straightGap)), smallest)});
+    stats.heldGaps++;
+  };
   for (size_t p = 0; p + 1 < closePairs.size(); p += 2) {
     const int i = closePairs[p], j = closePairs[p + 1];
     double h, hdot, hp = 0, hdotp = 0, target;
     pairGap(c, c.x, c.u, i, j, h, hdot);
     if (previous) pairGap(c, c.xPrevious, c.uPrevious, i, j, hp, hdotp);
     if (logTarget(h, hdot, previous, hp, hdotp, dt, o, target, stats.limited)) {
-      gaps.push_back(Gap{i, j, target});
+      gaps.push_back(Gap{i, j, target, target});
       stats.pairGaps++;
+    } else if (o.holdContactGaps) {
+      double d[3];
+      held(i, j, separation(c, y, i, j, d) - c.radius[i] - c.radius[j]);
     }
   }
   for (int i = 0; i < n; i++)
@@ -104,21 +122,21 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
       if (!(h < c.radius[i])) continue;
       if (previous) wallGap(c, c.xPrevious, c.uPrevious, i, walls[w], hp, hdotp);
       if (logTarget(h, hdot, previous, hp, hdotp, dt, o, target, stats.limited)) {
-        gaps.push_back(Gap{i, -1 - int(w), target});
+        gaps.push_back(Gap{i, -1 - int(w), target, target});
         stats.wallGaps++;
+      } else if (o.holdContactGaps) {
+        held(i, -1 - int(w), wallGapOf(c, y, i, walls[w]));
       }
     }
-  if (gaps.empty()) return stats;
+  // held gaps alone are met by the straight step
+  if (stats.pairGaps + stats.wallGaps == 0) return stats;
 
-  // the straight step, then moved along the lines of centres until every gap has its target
+  // the straight step moved along the lines of centres until every gap has its target
   std::vector<char> touched(n, 0);
   for (const Gap &g : gaps) {
     touched[g.i] = 1;
     if (g.j >= 0) touched[g.j] = 1;
   }
-  std::vector<double> y(size_t(3) * n);
-  for (int i = 0; i < n; i++)
-    for (int k = 0; k < 3; k++) y[3 * i + k] = c.x[3 * i + k] + dt * rate[6 * i + k];
   double previousWorst = HUGE_VAL;
   for (stats.sweeps = 1; stats.sweeps <= o.maxSweeps; stats.sweeps++) {
     double worst = 0;
@@ -140,7 +158,7 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
         miss = g.target - wallGapOf(c, y, g.i, w);
         y[3 * g.i + w.axis] += intoFluid(w) * miss;
       }
-      worst = std::max(worst, std::fabs(miss) / g.target);
+      worst = std::max(worst, std::fabs(miss) / g.scale);
     }
     stats.worst = worst;
     if (worst <= o.tolerance) break;

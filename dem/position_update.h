@@ -12,7 +12,8 @@
        h_{n+1} = h_n exp( dt [3/2 (hdot/h)_n - 1/2 (hdot/h)_{n-1}] ),   hdot = d.(U_2 - U_1),
    and the straight step is then moved along the lines of centres (Gauss-Seidel sweeps, each pair
    shared in inverse proportion to the radii, walls do not move) until every such gap has its
-   target (gaps inside contact springs, h < h_r, keep the straight step). The target is exact for a rigid rotation (h unchanged) and for a lubrication squeeze at
+   target; gaps inside contact springs (h < h_r) and closed ones are held at the gap the straight
+   step gives them. The target is exact for a rigid rotation (h unchanged) and for a lubrication squeeze at
    constant force (hdot/h constant), keeps gaps positive at any dt, and differs from the straight
    step by O(dt^3): the scheme stays second order. Plain C++ (no LIGGGHTS), tested in
    dem/tests/test_position_update.cpp. */
@@ -51,14 +52,18 @@ struct Options {
   double tolerance = 1e-4;
   int maxSweeps = 30;
   double fallback = 0.5;             // still this far from a target after the sweeps: straight step
-  // Gaps below the roughness height h_r are held by contact springs (hdot not ~ h): they keep the
-  // straight step, whose stability limits docs/contact.md gives.
+  // Gaps below the roughness height h_r are held by contact springs (hdot not ~ h): they get no
+  // log target. With holdContactGaps they (and closed gaps) are held at the gap the straight step
+  // gives them while the other gaps are corrected, the displacement the implicit springs assumed;
+  // without, they are left alone and a particle's other corrections may move them.
   double contactGap = 0;
+  bool holdContactGaps = true;
 };
 
 struct Statistics {
   long pairGaps = 0, wallGaps = 0;   // gaps given a target this step
   long limited = 0;                  // targets where maxLogStep applied
+  long heldGaps = 0;                 // contact or closed gaps held at their straight-step value
   int sweeps = 0;                    // Gauss-Seidel sweeps used
   double worst = 0;                  // largest |gap - target| / target met in the last sweep
   bool fallback = false;             // the targets could not be met: the straight step was kept

@@ -325,3 +325,34 @@ TEST(PositionUpdate, GapsInsideContactSpringsKeepTheStraightStep)
   EXPECT_EQ(stats.pairGaps, 1);  // 2e-3 and 1.5e-3 are outside h_r = 1e-3: log targets
   EXPECT_EQ(stats.wallGaps, 1);
 }
+
+TEST(PositionUpdate, ContactGapsAreHeldWhileTheirNeighboursGapsAreCorrected)
+{
+  // spheres 0 - 1 in contact (h = 2e-3 < h_r = 5e-3), sphere 2 closing fast on sphere 1 (h = 0.02):
+  // its log target pushes 1 toward 0. Held, the contact gap keeps its straight-step value (the
+  // displacement the implicit springs assumed) and 0 and 1 move together; not held, sphere 1 was
+  // pushed into sphere 0 (the overlaps of dense suspensions, docs/dem.md "Position update")
+  motion::Configuration c;
+  c.n = 3;
+  c.radius = {1.0, 1.0, 1.0};
+  const double contact = 2e-3, lubrication = 0.02, dt = 0.05;
+  c.x = {0, 0, 0, 2 + contact, 0, 0, 4 + contact + lubrication, 0, 0};
+  c.u = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, -0.5, 0, 0, 0, 0, 0};
+  motion::Options o;
+  o.contactGap = 5e-3;
+  std::vector<double> rate;
+  motion::Statistics stats = motion::displacementRates(c, {0, 1, 1, 2}, {}, dt, o, rate);
+  EXPECT_EQ(stats.pairGaps, 1);
+  EXPECT_EQ(stats.heldGaps, 1);
+  EXPECT_FALSE(stats.fallback);
+  std::vector<double> y = moved(c, rate, dt);
+  EXPECT_NEAR(distance(y, 0, 1) - 2, contact, 1e-6);
+  EXPECT_NEAR(distance(y, 1, 2) - 2, lubrication * std::exp(-1.0), 1e-4 * lubrication);  // limited to a factor e
+  EXPECT_LT(y[0], -1e-3);  // the contact pair moved as one
+
+  o.holdContactGaps = false;
+  stats = motion::displacementRates(c, {0, 1, 1, 2}, {}, dt, o, rate);
+  EXPECT_EQ(stats.heldGaps, 0);
+  y = moved(c, rate, dt);
+  EXPECT_LT(distance(y, 0, 1) - 2, 0.0);
+}
