@@ -41,7 +41,7 @@ using fdm::text::point;
 }  // namespace
 
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
-  Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
+  Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), holdContactGaps_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0), wallOut_(nullptr), checkpointEvery_(0), checkpointSeconds_(0), resumed_(false)
@@ -104,6 +104,11 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       const std::string v = value(1);
       if (v != "log" && v != "none") error->all(FLERR, "fix fdm/couple: gap_update must be log or none");
       gapUpdate_ = (v == "log");
+      i++;
+    } else if (key == "contact_gaps") {
+      const std::string v = value(1);
+      if (v != "hold" && v != "free") error->all(FLERR, "fix fdm/couple: contact_gaps must be hold or free");
+      holdContactGaps_ = (v == "hold");
       i++;
     } else if (key == "stresslets") {
       const std::string v = value(1);
@@ -781,6 +786,7 @@ void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
   motion::Options options;
   options.adamsBashforth = adamsBashforth_;
   options.gapCorrection = gapUpdate_;
+  options.holdContactGaps = holdContactGaps_;
   if (pair_ && pair_->contactActive()) options.contactGap = pair_->roughness();
   const motion::Statistics stats = motion::displacementRates(c, closePairs, walls, update->dt, options, moveRate_);
   run_.gapTargets += stats.pairGaps + stats.wallGaps;

@@ -4,7 +4,7 @@
      fix ID all fdm/couple [transport socket|file] [host H] [port P] [portfile F] [directory D]
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
                            [stresslets yes|no] [solver cg|ldlt] [tolerance t] [integrator ab2|euler]
-                           [gap_update log|none] [checkpoint N] [walls FILE]
+                           [gap_update log|none] [contact_gaps hold|free] [checkpoint N] [walls FILE]
      fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
@@ -104,6 +104,7 @@ class FixFdmCouple : public Fix {
   bool move_;
   bool adamsBashforth_;      // position update: Adams-Bashforth 2 (default) or Euler
   bool gapUpdate_;           // log-gap correction of the position update (position_update.h)
+  bool holdContactGaps_;     // contact gaps held at their straight-step value during that correction
   bool haveVelocities_;
   std::vector<double> currentVelocity_, previousVelocity_;  // 6N by tag, U_n and U_{n-1}
   // The next position update, planned on rank 0 once U_n is known and broadcast: displacement

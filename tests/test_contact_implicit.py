@@ -115,3 +115,27 @@ def test_fluid_stops_a_sphere_escaping_through_a_wall(tmp_path, env):
                   r"\.\. 4 \(walls\): it crosses the wall y = 0 by (\S+) \((\S+) radii, more than the 0.05 radii "
                   r"accepted for a contact pressed into a wall\): it escapes through the wall", text)
     assert m and float(m.group(2)) > 0.05, text[-3000:]
+
+
+def test_dense_sheared_packing_keeps_contacts_shallow(tmp_path, env):
+    # phi 0.47 between walls at -U and +U without the fluid (cases/couette/demShear.py, the case's
+    # springs at dt 0.02): with the contact gaps held during the log-gap correction (the default)
+    # no pair overlaps by more than 0.02 a1 and no sphere reaches into a wall; left free, the
+    # corrections of the particles' lubrication gaps pushed them into their contacts (0.09 a1 and
+    # walls crossed by 0.07 a1 in 200 steps, docs/benchmarks.md "Stability map")
+    import json
+    import subprocess
+    import sys
+    project = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    script = os.path.join(project, "cases", "couette", "demShear.py")
+    out = tmp_path / "dem.json"
+    proc = subprocess.run([sys.executable, script, "--variant", "hold:kt=485.1", "free:kt=485.1:fix=contact_gaps+free",
+                           "--steps", "200", "--workdir", str(tmp_path), "--out", str(out)], env=env, text=True,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)
+    assert proc.returncode == 0, proc.stdout[-3000:]
+    rows = {r["variant"]: r for r in json.loads(out.read_text())["rows"]}
+    hold, free = rows["hold"], rows["free"]
+    assert hold["completed"] and free["completed"]
+    assert hold["min_pair_gap"] > -0.02 and hold["min_wall_gap"] > 0, hold
+    assert "held contact gaps per step" in hold["position_update"]
+    assert free["min_pair_gap"] < 2 * hold["min_pair_gap"], (hold, free)
