@@ -66,7 +66,7 @@ void FixFdmCouple::writeCheckpoint()
   const double t0 = MPI_Wtime();
   FixContactHistoryFdm *history = pair_ ? pair_->contactHistory() : nullptr;
   FixPropertyAtom *wallHistory = pair_ ? pair_->wallHistory() : nullptr;
-  const int wallWidth = wallHistory ? 3 * int(pair_->walls().size()) : 0;
+  const int wallWidth = wallHistory ? PairFdmSubgrid::wallHistoryWidth * int(pair_->walls().size()) : 0;
   // the history of this step is in the neighbour list; LIGGGHTS copies it to the atoms only
   // before atoms migrate: do it now (idempotent, as at every re-neighbouring)
   if (history) history->syncFromNeighbourList();
@@ -226,9 +226,9 @@ void FixFdmCouple::restoreCheckpoint()
   FixContactHistoryFdm *history = pair_ ? pair_->contactHistory() : nullptr;
   FixPropertyAtom *wallHistory = pair_ ? pair_->wallHistory() : nullptr;
   const std::vector<double> &lengths = c.arrays.at("contactHistoryLength");
-  if ((history != nullptr) != !lengths.empty() || (wallHistory ? 3 * int(pair_->walls().size()) : 0) != wallWidth)
+  if ((history != nullptr) != !lengths.empty() || (wallHistory ? PairFdmSubgrid::wallHistoryWidth * int(pair_->walls().size()) : 0) != wallWidth)
     error->all(FLERR, ("fdm/couple: cannot resume: " + resumeFile_ + " was written " +
-                       (lengths.empty() ? "without" : "with") + " contact and with " + std::to_string(wallWidth / 3) +
+                       (lengths.empty() ? "without" : "with") + " contact and with " + std::to_string(wallWidth / PairFdmSubgrid::wallHistoryWidth) +
                        " walls, the input's pair_style differs").c_str());
   std::vector<size_t> offset(size_t(c.natoms) + 1, 0);
   for (size_t t = 0; t < lengths.size(); t++) offset[t + 1] = offset[t] + size_t(lengths[t]);

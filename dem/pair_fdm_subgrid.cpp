@@ -258,7 +258,7 @@ void PairFdmSubgrid::init_style()
   if (contactActive() && !walls_.empty() && !wallHistory_) {
     // tangential spring elongation against each wall, per atom: migrates with the atom
     std::vector<std::string> args = {"fdm_wall_history", "all", "property/atom", "fdmWallShear", "vector", "yes", "no", "no"};
-    for (size_t k = 0; k < 3 * walls_.size(); k++) args.push_back("0");
+    for (size_t k = 0; k < wallHistoryWidth * walls_.size(); k++) args.push_back("0");
     std::vector<char *> argv;
     for (std::string &s : args) argv.push_back(&s[0]);
     wallHistory_ = modify->add_fix_property_atom(int(argv.size()), argv.data(), "pair fdm/subgrid");
@@ -611,6 +611,11 @@ void PairFdmSubgrid::contactForces()
         shear[0] = shear[1] = shear[2] = 0.0;
         continue;
       }
+      // with implicit springs a contact's tangential spring starts loading on the step after it
+      // formed: the move that closed the gap was made without the spring in Eq. (31), and loading
+      // it with that move's slip would be an explicit kick k_t dt v_t, unstable once k_t dt/zeta_t
+      // exceeds a few (docs/contact.md 2b, "New contacts")
+      const bool fresh = !touch[jj];
       touch[jj] = 1;
       const double r = std::sqrt(rsq);
       const double n[3] = {del[0] / r, del[1] / r, del[2] / r};  // from j to i
@@ -632,7 +637,7 @@ void PairFdmSubgrid::contactForces()
       const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - v[j][d] - wxn[d];
       double force[3], nxft[3];
-      const bool slides = contactLaw(n, normalForce, vr, dt, shear, force, nxft);
+      const bool slides = contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= leverI * nxft[d];
@@ -671,15 +676,18 @@ void PairFdmSubgrid::wallContactForces()
   for (int i = 0; i < atom->nlocal; i++) {
     for (size_t k = 0; k < walls_.size(); k++) {
       const Wall &wall = walls_[k];
-      double *shear = &history[i][3 * k];
+      double *shear = &history[i][wallHistoryWidth * k];
+      double &touching = shear[3];
       // n: from the wall into the fluid; h: centre-to-wall distance
       const double h = wall.side == 0 ? x[i][wall.axis] - domain->boxlo[wall.axis] :
                                         domain->boxhi[wall.axis] - x[i][wall.axis];
       const double gap = h - radius[i];
       if (gap >= hr_) {
-        shear[0] = shear[1] = shear[2] = 0.0;
+        shear[0] = shear[1] = shear[2] = touching = 0.0;
         continue;
       }
+      const bool fresh = touching == 0.0;   // a new contact: as for pairs (contactForces)
+      touching = 1.0;
       double n[3] = {0, 0, 0};
       n[wall.axis] = wall.side == 0 ? 1.0 : -1.0;
       const double normalForce = kn_ * (hr_ - gap);
@@ -688,7 +696,7 @@ void PairFdmSubgrid::wallContactForces()
       const double wxn[3] = {aw[1] * n[2] - aw[2] * n[1], aw[2] * n[0] - aw[0] * n[2], aw[0] * n[1] - aw[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - wall.velocity[d] - wxn[d];
       double force[3], nxft[3];
-      const bool slides = contactLaw(n, normalForce, vr, dt, shear, force, nxft);
+      const bool slides = contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];

@@ -74,6 +74,9 @@ class PairFdmSubgrid : public Pair {
   // The contact histories, for fix fdm/couple's checkpoints (null without contact, or without walls)
   class FixContactHistoryFdm *contactHistory() const;
   class FixPropertyAtom *wallHistory() const { return wallHistory_; }
+  // per atom and wall: the tangential spring elongation (3) and whether the contact was on at the
+  // last force evaluation (1, so that a new contact is known; see contactForces)
+  static const int wallHistoryWidth = 4;
   // Per-atom contact stresslet S^c (Eq. 52: xx xy xz yy yz zz) of the last compute, if requested.
   void requestContactStress(bool on) { contactStressRequested_ = on; }
   const double *contactStress(int i) const
