@@ -35,7 +35,6 @@ import math
 import os
 import re
 import shutil
-import subprocess
 import sys
 import threading
 import time
@@ -46,7 +45,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 from fdmsubgrid import theory  # noqa: E402
-from fdmsubgrid.demonly import environment, fdmdem  # noqa: E402
+from fdmsubgrid.demonly import fdmdem, run_in  # noqa: E402
 
 PI = math.pi
 # the scene: every length in units of a = 1 m, eta = 1 Pa s (the velocity scale F/(6 pi eta a))
@@ -85,14 +84,7 @@ def run_scene(scene, variables, workdir, name=None, timeout=900):
     variables = dict(dict(cint="explicit"), **variables)
     for key, v in dict(variables, out=out).items():
         cmd += ["-var", key, _value(v)]
-    with open(os.path.join(run_dir, "command"), "w") as f:
-        f.write(" ".join(cmd) + "\n")
-    t0 = time.time()
-    proc = subprocess.run(cmd, cwd=run_dir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                          errors="replace", timeout=timeout, env=environment())
-    seconds = time.time() - t0
-    with open(os.path.join(run_dir, "log"), "w") as f:
-        f.write(proc.stdout)
+    proc, seconds = run_in(cmd, run_dir, "log", timeout)
     data = None
     path = os.path.join(run_dir, out)
     if os.path.isfile(path):

@@ -66,6 +66,26 @@ TABLE8 = {
 }
 
 
+# The largest time step measured stable with the case's springs (docs/benchmarks.md, "Stability map":
+# 2 strain units of the 10 x 12 x 8 a1 scene, seed 1, a1/Delta = 3; phi_bulk -> dt gamma_dot_0). At
+# phi 0.47 the next step measured, 0.05, stops with overlapping spheres within 20 steps.
+MEASURED_DT_LIMITS = {0.27: 0.1, 0.47: 0.02}
+
+
+def time_step_warning(phi: float, dt: float) -> str | None:
+    """A warning if dt exceeds the largest time step measured stable at the nearest measured volume
+    fraction at or above phi (the densest measured one above it), else None."""
+    denser = [p for p in sorted(MEASURED_DT_LIMITS) if p >= phi - 1e-9]
+    reference = denser[0] if denser else max(MEASURED_DT_LIMITS)
+    limit = MEASURED_DT_LIMITS[reference]
+    if dt <= limit * (1 + 1e-9):
+        return None
+    beyond = "" if denser else " (phi_bulk %.3g is denser than any measured: the limit may be smaller)" % phi
+    return ("WARNING: dt = %g/gamma_dot_0 is beyond the largest time step measured stable at phi_bulk %g with "
+            "these springs, %g%s (docs/benchmarks.md, 'Stability map'): expect the run to stop with overlapping "
+            "spheres; a smaller --dt is safe" % (dt, reference, limit, beyond))
+
+
 @dataclass(frozen=True)
 class Springs:
     """The contact parameters of pair_style fdm/subgrid and how they were chosen."""
@@ -202,6 +222,9 @@ def main(argv: list[str] | None = None) -> dict:
     print("packing:", pack.summary())
     springs = choose_springs(pack.phi, dt, delta, args.kn, args.kt)
     print(springs.describe(dt))
+    warning = time_step_warning(pack.phi, dt)
+    if warning:
+        print(warning, flush=True)
 
     name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (pack.phi if n_particles is None else phi, *args.size,
                                                   args.a_over_delta, dt, args.seed,

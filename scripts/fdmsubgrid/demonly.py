@@ -15,6 +15,8 @@ products less one when it converges; 1 for ldlt), the particle-solve seconds of 
 increment of f_couple[3]: the pair style's collectBlocks + gather + assembly of R^SG + the solve),
 the sub-grid pair and wall blocks and contacts, the largest speed and spin. Positions go to a
 dump every `dump_every` steps (surface gaps, overlaps)."""
+from __future__ import annotations
+
 import math
 import os
 import re
@@ -194,16 +196,25 @@ def run(scene, run_dir, timeout=3600, np_dem=1, keep_log=True):
     cmd = [fdmdem(), "-in", "in.dem"]
     if np_dem > 1:
         cmd = ["mpirun", "-np", str(np_dem), "--bind-to", "none"] + cmd
+    proc, wall = run_in(cmd, run_dir, "log.dem" if keep_log else None, timeout)
+    return analyse(scene, run_dir, proc.stdout, proc.returncode, wall)
+
+
+def run_in(cmd: list, run_dir: str, log: str | None = "log.dem",
+           timeout: float = 3600) -> tuple[subprocess.CompletedProcess, float]:
+    """Runs cmd (fdmDEM and its arguments) in run_dir with the project's environment, the command
+    line written to run_dir/command and the screen output to run_dir/log (if given); returns the
+    completed process (stdout text, stderr merged) and the wall seconds."""
     with open(os.path.join(run_dir, "command"), "w") as f:
         f.write(" ".join(cmd) + "\n")
     t0 = time.time()
     proc = subprocess.run(cmd, cwd=run_dir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                           errors="replace", timeout=timeout, env=environment())
     wall = time.time() - t0
-    if keep_log:
-        with open(os.path.join(run_dir, "log.dem"), "w") as f:
+    if log:
+        with open(os.path.join(run_dir, log), "w") as f:
             f.write(proc.stdout)
-    return analyse(scene, run_dir, proc.stdout, proc.returncode, wall)
+    return proc, wall
 
 
 def analyse(scene, run_dir, text, returncode=0, wall=None):
