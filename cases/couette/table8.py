@@ -91,7 +91,8 @@ def run_row(phi: float, args: argparse.Namespace) -> str:
     if run_dir is None:
         subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(args.dt),
                         "--strain", str(args.strain), "--a-over-delta", str(args.a_over_delta),
-                        "--seed", str(args.seed), "--n-max", str(args.n_max), "--workdir", args.workdir], check=True)
+                        "--seed", str(args.seed), "--n-max", str(args.n_max), "--tol-lambda", str(args.tol_lambda),
+                        "--workdir", args.workdir], check=True)
         run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed)
     if steps_done(run_dir) >= steps_planned(run_dir):
         return run_dir
@@ -185,6 +186,9 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--np-fluid", type=int, default=1, help="MPI ranks of fdmFoam per run")
     p.add_argument("--n-max", type=int, default=50, help="fdmFoam's innerIterations nMax for scenes written now "
                    "(the dense rows stop at 50 in most steps: docs/benchmarks.md, 'Stability map')")
+    p.add_argument("--tol-lambda", type=float, default=1e-3, help="fdmFoam's innerIterations tolLambda for scenes "
+                   "written now (1e-2 keeps eta_s within its error bar at 2.4 times fewer fluid solves: "
+                   "docs/benchmarks.md, 'Sheared suspension: run time against error')")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(PROJECT, "docs", "table8.json"))
     p.add_argument("--analyse-only", action="store_true", help="report the runs as they stand; run nothing")

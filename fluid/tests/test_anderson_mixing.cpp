@@ -201,3 +201,75 @@ TEST(AndersonMixing, ResetForgetsTheHistory) {
   EXPECT_FALSE(mixing.mix(u.data(), g.data(), g.size()));
   EXPECT_EQ(g, plain);
 }
+
+TEST(AndersonMixing, KeptGramMatrixGivesTheIteratesOfTheTextbookFormula) {
+  // the Gram matrix kept from one iteration to the next (O(m n) per iteration) against Anderson's
+  // formula recomputed from scratch: gamma = argmin |f_k - dF gamma| by the normal equations of the
+  // whole window, x_{k+1} = G(x_k) - dG gamma; the window slides (m = 5 of 40 iterations)
+  const Poisson problem(30);
+  const int depth = 5;
+  fdm::AndersonMixing mixing(depth);
+  std::vector<double> u(problem.n, 0.0), v(problem.n, 0.0), previousG, previousF;
+  std::vector<std::vector<double>> dG, dF;
+  for (int k = 0; k < 40; k++) {
+    std::vector<double> g = problem.G(u);
+    mixing.mix(u.data(), g.data(), g.size());
+    u = g;
+    // the textbook formula on its own copy of the iterates
+    std::vector<double> G = problem.G(v), f(problem.n);
+    for (int i = 0; i < problem.n; i++) f[i] = G[i] - v[i];
+    if (!previousG.empty()) {
+      std::vector<double> a(problem.n), b(problem.n);
+      for (int i = 0; i < problem.n; i++) {
+        a[i] = G[i] - previousG[i];
+        b[i] = f[i] - previousF[i];
+      }
+      dG.push_back(a);
+      dF.push_back(b);
+      if (int(dF.size()) > depth) {
+        dG.erase(dG.begin());
+        dF.erase(dF.begin());
+      }
+    }
+    previousG = G;
+    previousF = f;
+    const int m = int(dF.size());
+    std::vector<double> next = G;
+    if (m > 0) {
+      // normal equations A gamma = r by Gaussian elimination with partial pivoting
+      std::vector<std::vector<double>> A(m, std::vector<double>(m + 1, 0.0));
+      for (int r = 0; r < m; r++) {
+        for (int c = 0; c < m; c++)
+          for (int i = 0; i < problem.n; i++) A[r][c] += dF[r][i] * dF[c][i];
+        for (int i = 0; i < problem.n; i++) A[r][m] += dF[r][i] * f[i];
+      }
+      for (int c = 0; c < m; c++) {
+        int p = c;
+        for (int r = c + 1; r < m; r++)
+          if (std::fabs(A[r][c]) > std::fabs(A[p][c])) p = r;
+        std::swap(A[c], A[p]);
+        for (int r = c + 1; r < m; r++) {
+          const double q = A[r][c] / A[c][c];
+          for (int j = c; j <= m; j++) A[r][j] -= q * A[c][j];
+        }
+      }
+      std::vector<double> gamma(m);
+      for (int r = m - 1; r >= 0; r--) {
+        double s = A[r][m];
+        for (int j = r + 1; j < m; j++) s -= A[r][j] * gamma[j];
+        gamma[r] = s / A[r][r];
+      }
+      for (int j = 0; j < m; j++)
+        for (int i = 0; i < problem.n; i++) next[i] -= gamma[j] * dG[j][i];
+    }
+    v = next;
+    double scale = 0, difference = 0;
+    for (int i = 0; i < problem.n; i++) {
+      scale = std::max(scale, std::fabs(v[i]));
+      difference = std::max(difference, std::fabs(u[i] - v[i]));
+    }
+    ASSERT_LE(difference, 1e-9 * scale) << "iteration " << k;
+    if (problem.error(v) < 1e-12) break;   // converged: the differences lose their meaning
+  }
+  EXPECT_EQ(mixing.size(), depth);
+}
