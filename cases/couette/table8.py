@@ -33,6 +33,7 @@ PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 
 from fdmsubgrid import checkpoint, output, rheology  # noqa: E402
+from fdmsubgrid.shear import steps_planned  # noqa: E402
 
 PAPER_FIT = dict(alpha=0.803, phi_m=0.59)   # paper section 6.1, Eq. (55)
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
@@ -43,15 +44,6 @@ def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int
     pattern = os.path.join(workdir, "table8_phi%g_*_ad%g_dt%g_seed%d" % (phi, a_over_delta, dt, seed))
     found = sorted(d for d in glob.glob(pattern) if os.path.isdir(d))
     return found[0] if found else None
-
-
-def steps_planned(run_dir: str) -> int:
-    with open(os.path.join(run_dir, "dem", "in.couette")) as f:
-        for line in f:
-            words = line.split()
-            if words[:1] == ["run"]:
-                return int(words[1])
-    raise ValueError("%s/dem/in.couette has no run command" % run_dir)
 
 
 def steps_done(run_dir: str) -> int:

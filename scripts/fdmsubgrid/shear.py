@@ -82,6 +82,20 @@ def dem_input(run_dir: str) -> str:
     raise RunFolderError("%s/dem: no LIGGGHTS input (in.*) with pair_style fdm/subgrid" % run_dir)
 
 
+def _run_steps(text: str, path: str) -> int:
+    """N of the `run N` command of a LIGGGHTS input (text, read from path)."""
+    found = re.search(r"^run\s+(\d+)", text, re.M)
+    if not found:
+        raise RunFolderError("%s: no run command" % path)
+    return int(found.group(1))
+
+
+def steps_planned(run_dir: str) -> int:
+    """The steps the run's LIGGGHTS input asks for (its `run N` command)."""
+    path = dem_input(run_dir)
+    return _run_steps(_read(path), path)
+
+
 def read_run(run_dir: str) -> ShearRun:
     """The scene of a run folder from its own files: dem/packing.data (the spheres), fluid/system/
     blockMeshDict (the mesh), fluid/constant/transportProperties (eta = nu rho), the LIGGGHTS input
@@ -103,25 +117,25 @@ def read_run(run_dir: str) -> ShearRun:
     path = dem_input(run_dir)
     dem = _read(path)
     dt = re.search(r"^timestep\s+(\S+)", dem, re.M)
-    run = re.search(r"^run\s+(\d+)", dem, re.M)
     walls = {m.group(1): float(m.group(2)) for m in
              re.finditer(r"\bwall (ylo|yhi) (\S+) \S+ \S+", dem)}
-    if not (dt and run and len(walls) == 2):
-        raise RunFolderError("%s: needs timestep, run and pair_style fdm/subgrid ... wall ylo UX UY UZ wall yhi "
+    if not (dt and len(walls) == 2):
+        raise RunFolderError("%s: needs timestep and pair_style fdm/subgrid ... wall ylo UX UY UZ wall yhi "
                              "UX UY UZ" % path)
     contact = re.search(r"fdm/subgrid contact (\S+) (\S+) (\S+) (\S+)", dem)
     springs = dict(zip(("kn", "kt", "mu_s", "h_r"), (float(v) for v in contact.groups()))) if contact else {}
     return ShearRun(run_dir=run_dir, packing=pack, box=tuple(float(v) for v in pack.box), mesh=mesh,
-                    dt=float(dt.group(1)), steps_planned=int(run.group(1)),
+                    dt=float(dt.group(1)), steps_planned=_run_steps(dem, path),
                     wall_velocities=(walls["ylo"], walls["yhi"]), eta=values["nu"] * values["rho"],
                     springs=springs)
 
 
-def run_seconds(run_dir: str) -> tuple[float, int]:
+def run_seconds(run_dir: str, steps: dict | None = None) -> tuple[float, int]:
     """(wall seconds, ranks) of a run from its step records (the sum over sessions of a resumed run:
     fluid solve + particle work + exchange of every step), ranks: fluid processor folders (or 1)
-    plus one particle rank."""
-    steps = output.steps(os.path.join(run_dir, "fluid"))
+    plus one particle rank. steps: the records (output.steps) if already read."""
+    if steps is None:
+        steps = output.steps(os.path.join(run_dir, "fluid"))
     seconds = float(np.sum(steps["fluidSeconds"]) + np.sum(steps["particleSeconds"]) + np.sum(steps["exchangeSeconds"]))
     fluid_ranks = len([d for d in os.listdir(os.path.join(run_dir, "fluid")) if d.startswith("processor")]) or 1
     return seconds, fluid_ranks + 1
@@ -144,10 +158,10 @@ def analyse(run: ShearRun, wall_seconds: float | None = None, ranks: int | None 
     ([channel, coarse profiles, fine profiles, snapshots]). The steady part starts where the MSER
     rule puts the end of the transient (docs/profiles.md), or at from_strain if given; the run time
     is the step records' (run_seconds) unless given."""
-    if wall_seconds is None or ranks is None:
-        wall_seconds, ranks = run_seconds(run.run_dir)
     rate = run.shear_rate
     steps = output.steps(os.path.join(run.run_dir, "fluid"))
+    if wall_seconds is None or ranks is None:
+        wall_seconds, ranks = run_seconds(run.run_dir, steps)
     if len(steps["time"]) == 0:
         raise RunFolderError("%s/fluid/postProcessing/fdm/steps.dat: no step recorded yet" % run.run_dir)
     snapshots, _ = output.record_snapshots(os.path.join(run.run_dir, "dem", "particles.records"), rate)
