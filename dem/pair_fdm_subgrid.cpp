@@ -21,12 +21,14 @@
 #include "update.h"
 
 #include "fdm/resistance/blocks.hpp"
+#include "fdm/resistance/squeeze_calibration.hpp"
 
 #include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <sstream>
 
 using namespace LAMMPS_NS;
@@ -45,7 +47,7 @@ std::string fmt(double x)
 }  // namespace
 
 PairFdmSubgrid::PairFdmSubgrid(LAMMPS *lmp) :
-  Pair(lmp), computeflag(0), lubrication_(true), cutoffCells_(0.65), wallCutoffCells_(0.75), kn_(0), kt_(0), mu_(0), hr_(0),
+  Pair(lmp), computeflag(0), lubrication_(true), calibrated_(false), cutoffCells_(0.65), wallCutoffCells_(0.75), kn_(0), kt_(0), mu_(0), hr_(0),
   unstableStepIsError_(true), implicit_(true), viscosity_(0),
   meshSize_(0), rangeGap_(0), rmin_(0), rmax_(0), distanceFactor_(1.0), history_(nullptr), wallHistory_(nullptr),
   contactStressRequested_(false), nmaxStress_(0), contactStress_(nullptr), contactsLast_(0), reported_(false),
@@ -96,6 +98,16 @@ void PairFdmSubgrid::settings(int narg, char **arg)
       cutoffCells_ = force->numeric(FLERR, arg[++i]);
       if (!(cutoffCells_ > 0)) error->all(FLERR, ("pair_style fdm/subgrid: cutoff " + fmt(cutoffCells_) +
                                                   " must be positive (mesh cells)").c_str());
+    } else if (key == "model") {
+      need(i, 1, "model cutoff|calibrated");
+      const std::string v = arg[++i];
+      if (v != "cutoff" && v != "calibrated")
+        error->all(FLERR, ("pair_style fdm/subgrid: model " + v + ": use cutoff or calibrated").c_str());
+      calibrated_ = (v == "calibrated");
+    } else if (key == "calibration") {
+      need(i, 1, "calibration FILE (the squeeze calibration table)");
+      calibrationFile_ = arg[++i];
+      calibrated_ = true;
     } else if (key == "wall_cutoff") {
       need(i, 1, "wall_cutoff k (the wall cut-off gap in mesh cells)");
       wallCutoffCells_ = force->numeric(FLERR, arg[++i]);
@@ -175,6 +187,19 @@ void PairFdmSubgrid::fluidParameters()
   meshSize_ = session.meshSize();
   // Two cut-offs: the solver resolves a wall gap less well than a pair gap of the same width
   // (measured with cases/pairSqueeze and cases/wallSqueeze, docs/validation.md)
+  if (calibrated_ && !model_) {
+    // the squeeze functions measured with the solver itself (Appendix B; squeeze_calibration.hpp)
+    const std::string path = calibrationFile_.empty() ? res::SqueezeCalibration::defaultPath() : calibrationFile_;
+    try {
+      const res::SqueezeCalibration table = res::SqueezeCalibration::read(path);
+      model_.reset(new res::CalibratedSubgridModel(table, meshSize_, cutoffCells_, wallCutoffCells_));
+      wallModel_.reset(new res::CalibratedSubgridModel(table, meshSize_, cutoffCells_, wallCutoffCells_));
+      calibration_.reset(new res::SqueezeCalibration(table));
+    } catch (const std::exception &e) {
+      session.abandon(std::string("fdmDEM: pair fdm/subgrid: ") + e.what());
+      error->all(FLERR, (std::string("pair fdm/subgrid: ") + e.what()).c_str());
+    }
+  }
   if (!model_) model_.reset(new res::CutoffSubgridModel(meshSize_, cutoffCells_));
   if (!wallModel_) wallModel_.reset(new res::CutoffSubgridModel(meshSize_, wallCutoffCells_));
 
@@ -215,6 +240,55 @@ void PairFdmSubgrid::fluidParameters()
   }
 }
 
+void PairFdmSubgrid::checkCalibration()
+{
+  // Every radius pair of the scene (and every radius against the walls) must be in the table: a
+  // pair outside it would have no measured correction (an error, naming it, rather than a silent
+  // fallback). The neighbour range grows to the calibrated squeeze range.
+  // the distinct radii of the scene over all ranks, with how many particles have each (a radius
+  // held by one particle has no pair with itself)
+  std::map<double, double> local;
+  for (int i = 0; i < atom->nlocal; i++) local[atom->radius[i]] += 1;
+  int n = int(local.size()), nmax = 0;
+  MPI_Allreduce(&n, &nmax, 1, MPI_INT, MPI_MAX, world);
+  std::vector<double> mine(2 * size_t(nmax), 0.0), all(2 * size_t(nmax) * comm->nprocs, 0.0);
+  size_t k = 0;
+  for (const auto &rc : local) {
+    mine[k++] = rc.first;
+    mine[k++] = rc.second;
+  }
+  MPI_Allgather(mine.data(), 2 * nmax, MPI_DOUBLE, all.data(), 2 * nmax, MPI_DOUBLE, world);
+  std::map<double, double> counts;
+  for (size_t m = 0; m + 1 < all.size(); m += 2)
+    if (all[m] > 0) counts[all[m]] += all[m + 1];
+  std::vector<double> radii;
+  for (const auto &rc : counts) radii.push_back(rc.first);
+  auto fail = [this](const std::string &problem) {
+    CouplingSession::instance().abandon("fdmDEM: pair fdm/subgrid: " + problem);  // the fluid is told why
+    error->all(FLERR, ("pair fdm/subgrid: " + problem).c_str());
+  };
+  if (radii.size() > 16)
+    fail("model calibrated: " + fmt(double(radii.size())) + " different radii; the calibration serves a few sizes "
+         "(docs/dem.md)");
+  for (size_t a = 0; a < radii.size(); a++) {
+    for (size_t b = a; b < radii.size(); b++) {
+      if (b == a && counts[radii[a]] < 2) continue;
+      if (!calibration_->coversPair(radii[a], radii[b], meshSize_))
+        fail("model calibrated: no squeeze calibration for radii " + fmt(radii[a]) + " and " + fmt(radii[b]) +
+             " at mesh size " + fmt(meshSize_) + " (a1/Delta " + fmt(radii[a] / meshSize_) + ", a2/a1 " +
+             fmt(radii[b] / radii[a]) + ") in " + calibration_->path() + ", which has " + calibration_->coverage() +
+             ": add it (python3 -m fdmsubgrid.calibration) or use 'model cutoff'");
+      rangeGap_ = std::max(rangeGap_, calibration_->pairRange(radii[a], radii[b], meshSize_) * rmin_);
+    }
+    if (!walls_.empty()) {
+      if (!calibration_->coversWall(radii[a], meshSize_))
+        fail("model calibrated: no wall squeeze calibration for radius " + fmt(radii[a]) + " at mesh size " +
+             fmt(meshSize_) + " (a/Delta " + fmt(radii[a] / meshSize_) + ") in " + calibration_->path() +
+             ", which has " + calibration_->coverage() + ": add it or use 'model cutoff'");
+    }
+  }
+}
+
 void PairFdmSubgrid::init_style()
 {
   if (!atom->sphere_flag) error->all(FLERR, "pair_style fdm/subgrid requires atom_style sphere");
@@ -246,6 +320,7 @@ void PairFdmSubgrid::init_style()
   // Pairs up to this surface gap must be in the neighbour list, and keep their contact history:
   // LIGGGHTS's granular list includes r < (r_i + r_j) * contact_distance_factor (+ skin).
   rangeGap_ = std::max(hr_, lubricationActive() ? cutoffCells_ * meshSize_ : 0.0);
+  if (lubricationActive() && calibration_) checkCalibration();
   distanceFactor_ = 1.0 + 1.000001 * rangeGap_ / (2.0 * rmin_);
   if (rangeGap_ > 0) neighbor->register_contact_dist_factor(distanceFactor_);
 
@@ -279,8 +354,11 @@ void PairFdmSubgrid::init_style()
     // Say what is active in this scene: a correction nobody can see is a correction nobody trusts.
     std::string line = "pair fdm/subgrid: ";
     if (lubricationActive())
-      line += "sub-grid lubrication ON (pairs within a surface gap of " + fmt(cutoffCells_) + " mesh cells = " +
-              fmt(cutoffCells_ * meshSize_) + " m" + (walls_.empty() ? std::string() : ", walls within " +
+      line += "sub-grid lubrication ON (pairs within a surface gap of " +
+              (calibration_ ? "up to " + fmt(rangeGap_) + " m (the calibrated squeeze; the other functions within " +
+                                  fmt(cutoffCells_) + " mesh cells)"
+                            : fmt(cutoffCells_) + " mesh cells = " + fmt(cutoffCells_ * meshSize_) + " m") +
+              (walls_.empty() ? std::string() : ", walls within " +
               fmt(wallCutoffCells_) + " mesh cells = " + fmt(wallCutoffCells_ * meshSize_) + " m") + "; viscosity " +
               fmt(viscosity_) + " Pa s; " + model_->describe() + ")";
     else

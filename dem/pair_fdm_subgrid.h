@@ -30,6 +30,7 @@
 namespace fdm {
 namespace resistance {
 class SubgridModel;
+class SqueezeCalibration;
 }
 }
 
@@ -106,6 +107,7 @@ class PairFdmSubgrid : public Pair {
  private:
   void allocate();
   void fluidParameters();
+  void checkCalibration();
   void contactForces();
   void wallContactForces();
   // returns true if the contact slides (its tangential force at the Coulomb cap)
@@ -121,6 +123,8 @@ class PairFdmSubgrid : public Pair {
 
   // settings
   bool lubrication_;
+  bool calibrated_;                 // model calibrated: the squeeze calibration of Appendix B
+  std::string calibrationFile_;     // its table (default: SqueezeCalibration::defaultPath())
   double cutoffCells_, wallCutoffCells_;
   double kn_, kt_, mu_, hr_;
   bool unstableStepIsError_;   // unstable_step error (default) | warn
@@ -130,6 +134,7 @@ class PairFdmSubgrid : public Pair {
   // from the fluid solver at the handshake (coupling session)
   double viscosity_, meshSize_;
   std::unique_ptr<fdm::resistance::SubgridModel> model_, wallModel_;  // pairs, walls
+  std::unique_ptr<fdm::resistance::SqueezeCalibration> calibration_;  // model calibrated
 
   double rangeGap_;            // largest surface gap with any pair interaction (contact or lubrication)
   double rmin_, rmax_, distanceFactor_;

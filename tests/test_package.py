@@ -11,8 +11,8 @@ import pytest
 
 TESTS = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(TESTS)
-MODULES = ("case", "checkpoint", "decomposition", "demonly", "environment", "output", "packing", "periodicarray",
-           "profiles", "rheology", "shear", "theory", "timeseries")
+MODULES = ("calibration", "case", "checkpoint", "decomposition", "demonly", "environment", "output", "packing",
+           "periodicarray", "profiles", "rheology", "shear", "squeeze", "theory", "timeseries")
 
 
 def clean_environment() -> dict:

@@ -8,42 +8,32 @@ import numpy as np
 import pytest
 
 from conftest import load_case_module
-from fdmsubgrid import case, output
+from fdmsubgrid import case, output, squeeze
 
 
-@pytest.fixture(scope="module")
-def pair_squeeze():
-    return load_case_module("pairSqueeze")
-
-
-@pytest.fixture(scope="module")
-def wall_squeeze():
-    return load_case_module("wallSqueeze")
-
-
-def test_pair_squeeze_unequal_spheres(tmp_path, env, pair_squeeze):
+def test_pair_squeeze_unequal_spheres(tmp_path, env):
     # a2/a1 = 1.4: the closing velocity under equal and opposite forces, against Jeffrey & Onishi
     from fdmsubgrid import theory
     xis = [1e-2, 1e-3, 1e-4]
     ref = [theory.pair_squeeze_velocity(1.0, 1.4, xi) for xi in xis]
-    on = pair_squeeze.run_pair(str(tmp_path), 1.4, xis, True, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-4)
+    on = squeeze.run_pair(str(tmp_path), 1.4, xis, True, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-4)
     assert on["converged"]
     errors = [(v - r) / r for v, r in zip(on["velocity"], ref)]
     assert max(abs(e) for e in errors) < 0.05, errors
     # without the correction the FDM alone cannot resolve the gap: the pair closes far too fast
-    off = pair_squeeze.run_pair(str(tmp_path), 1.4, [1e-3], False, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-4)
+    off = squeeze.run_pair(str(tmp_path), 1.4, [1e-3], False, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-4)
     assert (off["velocity"][0] - ref[1]) / ref[1] > 1.0, (off["velocity"], ref[1])
 
 
-def test_wall_squeeze(tmp_path, env, wall_squeeze):
+def test_wall_squeeze(tmp_path, env):
     from fdmsubgrid import theory
     epss = [1e-2, 1e-3]
     ref = [theory.wall_squeeze_velocity(1.0, e) for e in epss]
-    on = wall_squeeze.run_wall(str(tmp_path), epss, True, a_over_delta=4.0, L_over_a=8.0, H_over_a=10.0,
+    on = squeeze.run_wall(str(tmp_path), epss, True, a_over_delta=4.0, L_over_a=8.0, H_over_a=10.0,
                                tol_lambda=1e-4)
     errors = [(v - r) / r for v, r in zip(on["velocity"], ref)]
     assert max(abs(e) for e in errors) < 0.05, errors
-    off = wall_squeeze.run_wall(str(tmp_path), [1e-3], False, a_over_delta=4.0, L_over_a=8.0, H_over_a=10.0,
+    off = squeeze.run_wall(str(tmp_path), [1e-3], False, a_over_delta=4.0, L_over_a=8.0, H_over_a=10.0,
                                 tol_lambda=1e-4)
     assert (off["velocity"][0] - ref[1]) / ref[1] > 1.0, (off["velocity"], ref[1])
 

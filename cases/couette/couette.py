@@ -127,8 +127,9 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
 
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, strain: float,
                dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
-               text_dump: bool = False) -> dict:
-    """fluid/ and dem/ of the run; returns the scene's description. The particles are recorded every
+               text_dump: bool = False, model: str = "cutoff") -> dict:
+    """fluid/ and dem/ of the run; returns the scene's description. model: pair_style fdm/subgrid's
+    sub-grid model (cutoff, or calibrated: the squeeze calibration, docs/dem.md). The particles are recorded every
     dump_every steps in dem/particles.records (fix fdm/output), and written for ParaView with the
     fluid fields every write_every steps (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also
     the LIGGGHTS text dump dem/particles.dump of the same steps (for comparisons)."""
@@ -140,8 +141,8 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
                           first_step=(tol_lambda / 10, 3000), n_particles=pack.n, tol_u=1e-5, tol_p=1e-3,
                           acceleration=acceleration, write_interval=write_every)
-    pair = ("fdm/subgrid contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
-            % (springs.kn, springs.kt, springs.mu_s, springs.h_r, -U, U))
+    pair = ("fdm/subgrid model %s contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
+            % (model, springs.kn, springs.kt, springs.mu_s, springs.h_r, -U, U))
     spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]
     runs = (["fix             output all fdm/output records %d particles.records vtk %d vtk"
              % (dump_every, write_every)]
@@ -153,7 +154,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
                          fix_options="stresslets yes checkpoint %d walls walls.dat" % (10 * dump_every), runs=runs, name="in.couette")
     return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
-                wall_velocity=U, dt=dt, dump_every=dump_every, write_every=write_every)
+                wall_velocity=U, dt=dt, dump_every=dump_every, write_every=write_every, subgrid_model=model)
 
 
 def table8_row(phi: float) -> dict:
@@ -188,6 +189,9 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None,
                    help="analyse this run folder as it stands (a resumed, stopped or running run) and write --out")
+    p.add_argument("--model", choices=("cutoff", "calibrated"), default="cutoff",
+                   help="pair_style fdm/subgrid's sub-grid model (docs/dem.md): the cut-off model, or the squeeze "
+                        "functions calibrated with the solver itself (paper Appendix B)")
     case.add_run_options(p, HERE, tol_lambda=1e-3)
     args = p.parse_args(argv)
 
@@ -230,7 +234,8 @@ def main(argv: list[str] | None = None) -> dict:
 
     name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (pack.phi if n_particles is None else phi, *args.size,
                                                   args.a_over_delta, dt, args.seed,
-                                                  "" if args.acceleration == "anderson" else "_" + args.acceleration)
+                                                  ("" if args.acceleration == "anderson" else "_" + args.acceleration)
+                                                  + ("" if args.model == "cutoff" else "_" + args.model))
     if args.table8 is not None:
         name = "table8_" + name
     run_dir = os.path.join(args.workdir, name)
@@ -241,7 +246,7 @@ def main(argv: list[str] | None = None) -> dict:
     every = max(1, int(round(args.dump_every / (SHEAR_RATE * dt))))
     write_every = max(1, int(round(args.write_every / (SHEAR_RATE * dt))))
     scene = write_case(run_dir, pack, springs, args.a_over_delta, dt, args.strain, every, args.tol_lambda,
-                       args.acceleration, args.n_max, write_every, args.text_dump)
+                       args.acceleration, args.n_max, write_every, args.text_dump, args.model)
     packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
     print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
           "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,

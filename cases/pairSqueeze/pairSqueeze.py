@@ -16,60 +16,16 @@ Writes results.json and results_pairSqueeze.png here (docs/cases.md).
 """
 import argparse
 import json
-import math
 import os
-import shutil
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdmsubgrid import case, theory  # noqa: E402
+from fdmsubgrid.squeeze import box_extrapolated, run_pair  # noqa: E402
 
 XI_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
-
-
-def run_pair(workdir, ratio, xis, subgrid, a_over_delta=4.0, L_over_a=8.0, tol_lambda=1e-5, cutoff=None,
-             np_fluid=1, keep=False):
-    """One coupled run visiting every gap; returns the closing velocities (units F/(6 pi eta a1))."""
-    a1, a2 = 1.0, ratio
-    delta = a1 / a_over_delta
-    L = L_over_a * a1
-    eta = 1.0
-    F = 6 * math.pi * eta * a1
-    name = "lambda%g_ad%g_L%g_%s" % (ratio, a_over_delta, L_over_a, "subgrid" if subgrid else "nosubgrid")
-    run_dir = os.path.join(workdir, name)
-    if os.path.isdir(run_dir):
-        shutil.rmtree(run_dir)
-    box = case.Box((0, 0, 0), (L, L, L), delta)
-    centre = [L / 2 + 0.1 * delta, L / 2 + 0.2 * delta, L / 2 + 0.3 * delta]  # off the mesh's symmetry planes
-
-    def positions(xi):
-        gap = xi * (a1 + a2) / 2
-        return ((centre[0] - gap / 2 - a1, centre[1], centre[2]), (centre[0] + gap / 2 + a2, centre[1], centre[2]))
-
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
-                          n_particles=2)
-    runs = []
-    for k, xi in enumerate(xis):
-        p1, p2 = positions(xi)
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % p1)
-            runs.append("set             atom 2 x %r y %r z %r" % p2)
-        runs.append("run             1")
-    p1, p2 = positions(xis[0])
-    pair = "fdm/subgrid" + ("" if cutoff is None else " cutoff %g" % cutoff) + ("" if subgrid else " lubrication no")
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0, pair_style=pair,
-                         before_run="group           one id 1\ngroup           two id 2\n"
-                                    "fix             push1 one addforce %r 0 0\n"
-                                    "fix             push2 two addforce %r 0 0" % (F, -F),
-                         runs=runs, name="in.pairSqueeze")
-    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
-    U1 = parts["Ux"][parts["tag"] == 1]
-    U2 = parts["Ux"][parts["tag"] == 2]
-    velocity = [float(v) for v in (U1 - U2) / (F / (6 * math.pi * eta * a1))]
-    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
-                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
 
 
 def plot(results, path):
@@ -109,6 +65,9 @@ def main(argv=None):
     p.add_argument("--xi", type=float, nargs="+", default=XI_DEFAULT, help="reduced gaps, largest first")
     p.add_argument("--a-over-delta", type=float, default=4.0)
     p.add_argument("--L-over-a", type=float, default=8.0)
+    p.add_argument("--box-extrapolate", type=float, metavar="L2", default=None,
+                   help="also run in a box of side L2 (> L) and report the velocities extrapolated to an "
+                        "infinite box (V = V_inf + c L^-3)")
     case.add_run_options(p, HERE, tol_lambda=0.0001, cutoff=True)
     p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison runs")
     args = p.parse_args(argv)
@@ -118,13 +77,19 @@ def main(argv=None):
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()
     results = dict(case="pairSqueeze", a_over_delta=args.a_over_delta, L_over_a=args.L_over_a,
+                   box_extrapolated_with=args.box_extrapolate, model=args.model,
                    cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda, cases=[])
     for ratio in args.ratios:
         reference = [theory.pair_squeeze_velocity(1.0, ratio, xi) for xi in args.xi]
         entry = dict(**{"lambda": ratio}, xi=args.xi, theory=reference)
         for subgrid in ([True] if args.no_reference else [True, False]):
+            options = "model %s" % args.model if subgrid else ""
             r = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.L_over_a, args.tol_lambda,
-                         args.cutoff, args.np_fluid, args.keep)
+                         args.cutoff, args.np_fluid, args.keep, pair_options=options)
+            if args.box_extrapolate:
+                r2 = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.box_extrapolate,
+                              args.tol_lambda, args.cutoff, args.np_fluid, args.keep, pair_options=options)
+                r = box_extrapolated(r, r2, args.L_over_a, args.box_extrapolate)
             r["rel_error"] = theory.relative_errors(r["velocity"], reference)
             entry["subgrid" if subgrid else "nosubgrid"] = r
             print("lambda %g, sub-grid %s: %.0f s" % (ratio, "on" if subgrid else "off", r["wall_seconds"]))

@@ -16,53 +16,16 @@ Writes results.json and results_wallSqueeze.png here (docs/cases.md).
 """
 import argparse
 import json
-import math
 import os
-import shutil
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdmsubgrid import case, theory  # noqa: E402
+from fdmsubgrid.squeeze import box_extrapolated, run_wall  # noqa: E402
 
 EPS_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
-
-
-def run_wall(workdir, epss, subgrid, a_over_delta=4.0, L_over_a=8.0, H_over_a=16.0, tol_lambda=1e-5, cutoff=None,
-             np_fluid=1, keep=False):
-    """One coupled run visiting every gap; returns the velocities toward the wall (units F/(6 pi eta a))."""
-    a = 1.0
-    delta = a / a_over_delta
-    L, H = L_over_a * a, H_over_a * a
-    eta = 1.0
-    F = 6 * math.pi * eta * a
-    name = "ad%g_L%g_H%g_%s" % (a_over_delta, L_over_a, H_over_a, "subgrid" if subgrid else "nosubgrid")
-    run_dir = os.path.join(workdir, name)
-    if os.path.isdir(run_dir):
-        shutil.rmtree(run_dir)
-    box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
-    x, z = L / 2 + 0.1 * delta, L / 2 + 0.3 * delta  # off the mesh's symmetry planes
-
-    def position(eps):
-        return (x, a * (1 + eps), z)
-
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
-                          n_particles=1)
-    runs = []
-    for k, eps in enumerate(epss):
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % position(eps))
-        runs.append("run             1")
-    pair = ("fdm/subgrid" + ("" if cutoff is None else " cutoff %g" % cutoff) + " wall ylo 0 0 0 wall yhi 0 0 0" +
-            ("" if subgrid else " lubrication no"))
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
-                         before_run="fix             push all addforce 0 %r 0" % (-F), runs=runs,
-                         name="in.wallSqueeze")
-    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
-    velocity = [float(v) for v in -parts["Uy"] / (F / (6 * math.pi * eta * a))]
-    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
-                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
 
 
 def plot(results, path):
@@ -99,6 +62,9 @@ def main(argv=None):
     p.add_argument("--a-over-delta", type=float, default=4.0)
     p.add_argument("--L-over-a", type=float, default=8.0)
     p.add_argument("--H-over-a", type=float, default=10.0)
+    p.add_argument("--box-extrapolate", type=float, metavar="L2", default=None,
+                   help="also run in a box of side L2 (> L, H scaled with it) and report the velocities "
+                        "extrapolated to an infinite box (V = V_inf + c L^-3)")
     case.add_run_options(p, HERE, tol_lambda=0.0001, cutoff=True)
     p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison run")
     args = p.parse_args(argv)
@@ -109,10 +75,18 @@ def main(argv=None):
     t0 = time.time()
     reference = [theory.wall_squeeze_velocity(1.0, eps) for eps in args.eps]
     results = dict(case="wallSqueeze", a_over_delta=args.a_over_delta, L_over_a=args.L_over_a, H_over_a=args.H_over_a,
+                   box_extrapolated_with=args.box_extrapolate, model=args.model,
                    cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda, eps=args.eps, theory=reference)
     for subgrid in ([True] if args.no_reference else [True, False]):
+        options = "model %s" % args.model if subgrid else ""
         r = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.L_over_a, args.H_over_a, args.tol_lambda,
-                     args.cutoff, args.np_fluid, args.keep)
+                     args.cutoff, args.np_fluid, args.keep, pair_options=options)
+        if args.box_extrapolate:
+            scale = args.box_extrapolate / args.L_over_a
+            r2 = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.box_extrapolate,
+                          args.H_over_a * scale, args.tol_lambda, args.cutoff, args.np_fluid, args.keep,
+                          pair_options=options)
+            r = box_extrapolated(r, r2, args.L_over_a, args.box_extrapolate)
         r["rel_error"] = theory.relative_errors(r["velocity"], reference)
         results["subgrid" if subgrid else "nosubgrid"] = r
         print("sub-grid %s: %.0f s" % ("on" if subgrid else "off", r["wall_seconds"]))

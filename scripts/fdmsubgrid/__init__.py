@@ -3,7 +3,8 @@
 Write coupled cases and run them with fdmRun (case), pack spheres (packing), read what the runs
 write (output), compute the profiles of a wall-bounded suspension and its rheology (profiles,
 rheology, timeseries), and the analysis of a sheared-suspension run folder (shear, the fdmProfiles
-command). ./Allwmake installs the package (editable) so that a notebook can `import fdmsubgrid`;
+command); squeeze flows and the calibration of the solver's squeeze resistance (squeeze, calibration).
+./Allwmake installs the package (editable) so that a notebook can `import fdmsubgrid`;
 the programs it runs are found through the environment (environment.program). docs/profiles.md.
 
     from fdmsubgrid import output, profiles, rheology

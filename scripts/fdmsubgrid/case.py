@@ -284,6 +284,9 @@ def add_run_options(parser, case_dir, tol_lambda, cutoff=False):
     if cutoff:
         parser.add_argument("--cutoff", type=float, default=None,
                             help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
+        parser.add_argument("--model", choices=("cutoff", "calibrated"), default="cutoff",
+                            help="pair_style fdm/subgrid model: the cut-off model or the squeeze calibration "
+                                 "(docs/dem.md)")
     parser.add_argument("--tol-lambda", type=float, default=tol_lambda, help="fdmFoam's innerIterations tolLambda")
     parser.add_argument("--acceleration", choices=("anderson", "none"), default="anderson",
                         help="fdmFoam's inner-iteration acceleration (none: the plain iteration of paper 4.3)")

@@ -1,6 +1,11 @@
 // Cost of building the sub-grid blocks for 1000 particles with 6 close neighbours each (3000 pairs),
-// median over repeats.  Usage: fdmResistanceBench [repeats=50]
+// median over repeats.  Usage: fdmResistanceBench [repeats=50] [calibrated]
+// (calibrated: the squeeze calibration's model, CalibratedSubgridModel, with the shipped table)
 #include "fdm/resistance/resistance.hpp"
+#include "fdm/resistance/squeeze_calibration.hpp"
+
+#include <memory>
+#include <string>
 
 #include <algorithm>
 #include <chrono>
@@ -39,6 +44,7 @@ double secondsSince(const std::chrono::steady_clock::time_point& t0)
 int main(int argc, char** argv)
 {
     const int repeats = argc > 1 ? std::atoi(argv[1]) : 50;
+    const bool calibrated = argc > 2 && std::string(argv[2]) == "calibrated";
     const int particles = 1000, neighbours = 6, pairs = particles * neighbours / 2;
     const double delta = 0.2;  // a/Delta = 5 (paper's resolution) for a = 1
     std::mt19937 rng(42);
@@ -61,7 +67,12 @@ int main(int argc, char** argv)
         for (int k = 0; k < 3; ++k) x2[3 * n + k] = x[3 * list[n].i + k] + aMean * (2 + xi) * d[k] / norm;
     }
 
-    CutoffSubgridModel model(delta, 1.0);
+    std::unique_ptr<SubgridModel> owned;
+    if (calibrated)
+        owned.reset(new CalibratedSubgridModel(SqueezeCalibration::read(SqueezeCalibration::defaultPath()), delta, 1.0, 1.0));
+    else
+        owned.reset(new CutoffSubgridModel(delta, 1.0));
+    const SubgridModel& model = *owned;
     const std::chrono::steady_clock::time_point tFirst = std::chrono::steady_clock::now();
     PairBlock block;
     for (int n = 0; n < pairs; ++n) subgridPairBlock(model, &x[3 * list[n].i], &x2[3 * n], radius[list[n].i], radius[list[n].j], 1.0, block);
@@ -102,8 +113,8 @@ int main(int argc, char** argv)
         miss.push_back(secondsSince(t0));
     }
 
-    std::printf("fdmResistanceBench: %d particles x %d neighbours = %d pairs (radii 1 and 1.4, a/Delta = 5), %d repeats\n",
-                particles, neighbours, pairs, repeats);
+    std::printf("fdmResistanceBench: %d particles x %d neighbours = %d pairs (radii 1 and 1.4, a/Delta = 5), %d repeats, %s\n",
+                particles, neighbours, pairs, repeats, model.describe());
     std::printf("| what | median |\n|---|---|\n");
     std::printf("| %d sub-grid pair blocks (12x12 + stress rows), cached constants | %.3f ms |\n", pairs, 1e3 * median(blocksOnly));
     std::printf("| same + scatter into 6N triplets (%d entries) | %.3f ms |\n", 144 * pairs, 1e3 * median(withScatter));

@@ -1,0 +1,170 @@
+// The squeeze calibration (paper Appendix B; squeeze_calibration.hpp): reading the table, interpolating
+// it, refusing what it does not cover, the calibrated sub-grid model built on it, and the table shipped
+// in the repository against the lubrication limit of the theory.
+#include "fdm/resistance/resistance.hpp"
+#include "fdm/resistance/squeeze_calibration.hpp"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+using namespace fdm::resistance;
+
+namespace {
+
+const double pi = 3.14159265358979323846;
+
+std::string writeTable(const std::string& name, const std::string& text)
+{
+    const std::string path = std::string(::testing::TempDir()) + name;
+    std::ofstream(path.c_str()) << text;
+    return path;
+}
+
+// Two a/Delta, two ratios and a wall: xi * s_hat = c (1 - xi) on xi = 1e-5 ... 1 (values chosen by hand).
+std::string syntheticTable()
+{
+    std::string text = "# synthetic\n";
+    const double corners[4][3] = {{3, 1, 0.25}, {3, 1.4, 0.30}, {5, 1, 0.35}, {5, 1.4, 0.40}};
+    for (int k = 0; k < 5; ++k) {
+        const bool wall = (k == 4);
+        const double ad = wall ? 3 : corners[k][0], ratio = wall ? 1 : corners[k][1], c = wall ? 1.0 : corners[k][2];
+        text += std::string(wall ? "wall " : "pair ") + std::to_string(ad) + " " + std::to_string(ratio) + " 6 1 1 1 1 0\n";
+        const double xis[6] = {1e-5, 1e-4, 1e-3, 1e-2, 0.1, 1.0};
+        for (double xi : xis) {
+            char row[64];
+            std::snprintf(row, sizeof row, "%.10e %.10e\n", xi, c * (1 - xi));
+            text += row;
+        }
+    }
+    return text;
+}
+
+}  // namespace
+
+TEST(SqueezeCalibration, InterpolatesTheTableAndEndsAtItsLastRow)
+{
+    const SqueezeCalibration cal = SqueezeCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
+    const double delta = 1.0 / 3;
+    // at the nodes: the table itself
+    EXPECT_NEAR(cal.pairSHat(1, 1, delta, 1e-3) * 1e-3, 0.25 * (1 - 1e-3), 1e-12);
+    EXPECT_NEAR(cal.wallSHat(1, delta, 1e-2) * 1e-2, 1.0 * (1 - 1e-2), 1e-12);
+    // radii in either order are the same pair
+    EXPECT_DOUBLE_EQ(cal.pairSHat(1, 1.4, delta, 0.05), cal.pairSHat(1.4, 1, delta, 0.05));
+    // between nodes: linear in ln xi
+    const double xi = std::sqrt(1e-3 * 1e-2);
+    EXPECT_NEAR(cal.pairSHat(1, 1, delta, xi) * xi, 0.25 * (1 - 0.5 * (1e-3 + 1e-2)), 1e-12);
+    // bilinear between a/Delta 3 and 5 and ratios 1 and 1.4: the middle is the mean of the corners
+    EXPECT_NEAR(cal.pairSHat(1, 1.2, 0.25, 1e-4) * 1e-4, 0.325 * (1 - 1e-4), 1e-12);
+    // the correction ends at the last row, and below the first it keeps xi * s_hat
+    EXPECT_EQ(cal.pairSHat(1, 1, delta, 1.0), 0.0);
+    EXPECT_EQ(cal.pairSHat(1, 1, delta, 2.0), 0.0);
+    EXPECT_NEAR(cal.pairSHat(1, 1, delta, 1e-7) * 1e-7, 0.25 * (1 - 1e-5), 1e-12);
+    EXPECT_DOUBLE_EQ(cal.pairRange(1, 1, delta), 1.0);
+}
+
+TEST(SqueezeCalibration, RefusesWhatItDoesNotCover)
+{
+    const SqueezeCalibration cal = SqueezeCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
+    EXPECT_TRUE(cal.coversPair(1, 1.4, 0.25));
+    EXPECT_FALSE(cal.coversPair(1, 1, 0.5));   // a/Delta 2
+    EXPECT_FALSE(cal.coversPair(1, 2, 0.25));  // ratio 2
+    EXPECT_FALSE(cal.coversWall(1, 0.25));     // walls only at a/Delta 3
+    try {
+        cal.pairSHat(1, 2, 0.25, 0.01);
+        FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("a2/a1 2"), std::string::npos) << what;
+        EXPECT_NE(what.find("(3, 1.4)"), std::string::npos) << what;
+    }
+}
+
+TEST(SqueezeCalibration, MalformedTablesNameTheFileAndLine)
+{
+    const char* bad[] = {
+        "pair 3 1 2 0 0 0 0 0\n1e-3 0.2\n",                 // one row short
+        "pair 3 1 2 0 0 0 0 0\n1e-3 0.2\n1e-4 0.1\n",       // xi not increasing
+        "pair 3 0.7 2 0 0 0 0 0\n1e-3 0.2\n1e-2 0.1\n",     // ratio below 1
+        "pair 3 1 2 0 0 0 0 0\n1e-3 -0.2\n1e-2 0.1\n",      // negative correction
+        "sphere 3 1 2\n",                                    // unknown kind
+    };
+    for (const char* text : bad) {
+        const std::string path = writeTable("squeeze_bad.dat", text);
+        try {
+            SqueezeCalibration::read(path);
+            FAIL() << "accepted: " << text;
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_THROW(SqueezeCalibration::read("/nonexistent/squeeze.dat"), std::runtime_error);
+}
+
+// The calibrated model changes the squeeze functions only, and keeps the block frame-invariant,
+// symmetric and positive semi-definite.
+TEST(CalibratedSubgridModel, ReplacesTheSqueezeFunctionsOnly)
+{
+    const SqueezeCalibration cal = SqueezeCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
+    const double delta = 0.25;
+    const CalibratedSubgridModel model(cal, delta, 0.65, 0.75);
+    const CutoffSubgridModel cutoff(delta, 0.65);
+    const double a1 = 1.4, a2 = 1.0, xi = 0.02;
+    const PairSubgridBase b = model.pair(a1, a2, xi), c = cutoff.pair(a1, a2, xi);
+    EXPECT_NEAR(b.f[BaseX21A], -6 * pi * 1.0 * cal.pairSHat(a1, a2, delta, xi), 1e-12);
+    for (int f = 1; f < NumSubgridBase; ++f) EXPECT_EQ(b.f[f], c.f[f]) << subgridBaseName(SubgridBaseFunction(f));
+    // beyond the cut-off, only the squeeze
+    const PairSubgridBase far = model.pair(1, 1, 0.5);
+    EXPECT_LT(far.f[BaseX21A], 0);
+    for (int f = 1; f < NumSubgridBase; ++f) EXPECT_EQ(far.f[f], 0.0);
+    EXPECT_DOUBLE_EQ(model.pairRange(1, 1), 1.0);
+
+    const CalibratedSubgridModel wallModel(cal, 1.0 / 3, 0.65, 0.75);
+    const WallScalars w = wallModel.wall(1.0, 1e-3);
+    EXPECT_NEAR(w.f[WallXA], 6 * pi * cal.wallSHat(1.0, 1.0 / 3, 1e-3), 1e-12);
+
+    PairBlock block;
+    const double x1[3] = {0.3, 0.1, -0.2}, x2[3] = {0.3 + 0.6 * (a1 + a2) / 2 * (2 + xi), 0.8 * (a1 + a2) / 2 * (2 + xi), -0.2};
+    ASSERT_TRUE(subgridPairBlock(model, x1, x2, a1, a2, 1.0, block));
+    Eigen::Matrix<double, 12, 12> R;
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) R(i, j) = block.R[i][j];
+    EXPECT_LT((R - R.transpose()).norm(), 1e-12 * R.norm());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12> > eig(R);
+    EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12 * R.norm());
+    // a rigid translation of the pair meets no resistance
+    Eigen::Matrix<double, 12, 1> u = Eigen::Matrix<double, 12, 1>::Zero();
+    u(0) = u(6) = 0.3;
+    u(1) = u(7) = -0.7;
+    EXPECT_LT((R * u).norm(), 1e-12 * R.norm());
+}
+
+// The table shipped in the repository: the sizes the suspension runs need, and at small gaps the
+// correction is the theory's lubrication singularity (the solver's own resistance stays finite):
+// xi * s_hat -> 2 lambda^2/(1 + lambda)^3 for a pair (Jeffrey & Onishi's leading term of the squeeze
+// resistance in units of 6 pi eta a1), eps * s_hat -> 1 for a wall (Cox & Brenner).
+TEST(SqueezeCalibration, ShippedTableHasTheLubricationLimit)
+{
+    const SqueezeCalibration cal = SqueezeCalibration::read(SqueezeCalibration::defaultPath());
+    for (double ad : {3.0, 4.0, 5.0}) {
+        const double delta = 1 / ad;
+        for (double ratio : {1.0, 1.4}) {
+            ASSERT_TRUE(cal.coversPair(1, ratio, delta)) << "a/Delta " << ad << " ratio " << ratio;
+            const double lead = 2 * ratio * ratio / std::pow(1 + ratio, 3);
+            EXPECT_NEAR(cal.pairSHat(1, ratio, delta, 1e-5) * 1e-5 / lead, 1.0, 2e-3) << ad << " " << ratio;
+            EXPECT_GT(cal.pairSHat(1, ratio, delta, 0.3), 0.0);
+        }
+        ASSERT_TRUE(cal.coversWall(1, delta)) << "a/Delta " << ad;
+        EXPECT_NEAR(cal.wallSHat(1, delta, 1e-5) * 1e-5, 1.0, 2e-3) << ad;
+        EXPECT_GT(cal.wallSHat(1, delta, 0.3), 0.0);
+    }
+    // the bidisperse suspension at a1/Delta = 3 (a2 = 1.4 a1): every pair and wall gap is covered
+    EXPECT_TRUE(cal.coversPair(1.4, 1.4, 1.0 / 3));
+    EXPECT_TRUE(cal.coversWall(1.4, 1.0 / 3));
+}

@@ -1,0 +1,333 @@
+"""Calibration of the solver's own squeeze resistance (paper section 2.2 and Appendix B):
+R^SG = R^th - R^FDM measured, instead of the cut-off model's guess of what the mesh resolves.
+
+What is measured. Two spheres pushed together by equal and opposite forces +-F along their line of
+centres (and a sphere pushed toward a wall by F), with the sub-grid lubrication switched off
+(`pair_style fdm/subgrid lubrication no`): the closing velocity V_FDM(xi) of the fictitious-domain
+solver alone. For a pair the squeeze block of the sub-grid matrix (Appendix C.2: X11 = X22 = -X21,
+X12 = X21) acts on the relative velocity only, s e e^T with e = (1, -1) and s = -X21A^SG; by the
+Sherman-Morrison formula the closing velocity under the loads F e of the solver plus that block is
+exactly 1/(1/V_FDM + s/F): the squeeze resistances F/V add. So the correction that makes the coupled
+solver give the theory is
+
+    s(xi) = F/V_th(xi) - F/V_FDM(xi)          (pair: X21A^SG = -s;  wall: X^A_SG = s)
+
+with V_th the full-range theory (Jeffrey & Onishi; Brenner for the wall). In units of 6 pi eta a1
+(a1 the smaller sphere): s_hat = 1/V_hat_th - 1/V_hat_FDM.
+
+Box effect. The loads +-F are a force dipole: in a periodic box of side L its images change V by
+O(L^-3) (measured here: 19 % at xi = 1 for L = 8 a1, 4.6 % at 12 a1, a1/Delta = 3). The wall runs
+(net force on the sphere, taken by the walls) converge the same way. Two box sizes L1 < L2 are run
+and V is extrapolated as V_inf = V2 + (V2 - V1) L1^3/(L2^3 - L1^3); a third size checks it.
+
+Position in the mesh. V_FDM steps as the sphere surfaces cross cell centres; every gap is measured
+at several positions of the gap centre inside its cell (`offsets`) and averaged; the spread is the
+calibration's own scatter, reported.
+
+Fit. The averaged, extrapolated resistance r_FDM(xi) = 1/V_hat_FDM is fitted by a logistic curve in
+ln xi, r_FDM = r_inf + (r_0 - r_inf)/(1 + (xi/xi_1)^p): the plateau r_0 where the solver no longer
+sees the gap (below about a tenth of a cell), a rise around xi_1 (least squares in log r).
+
+Positivity and range. The correction s_hat = r_th - r_FDM,fit is kept where positive (where the
+solver already resists more than the theory, no correction); it ends at the first gap where it
+changes sign, and is tapered to zero between TAPER_START and TAPER_END.
+
+Output: a text table (`write_table`) the resistance library reads (CalibratedSubgridModel,
+docs/resistance.md): for every (kind, a/Delta, ratio) the columns xi and xi * s_hat(xi) on a
+logarithmic grid from 1e-5 to xi_max (xi * s_hat is smooth at both ends: it tends to the leading
+lubrication coefficient as xi -> 0 and to 0 at xi_max; linear interpolation in ln xi).
+
+    python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --out dem/resistance/data/squeeze_calibration.dat
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Dict, List, Sequence
+
+import numpy as np
+
+from . import squeeze, theory
+
+GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
+# positions of the gap centre inside its mesh cell (fractions of Delta)
+OFFSETS = [(0.1, 0.2, 0.3), (0.35, 0.45, 0.55), (0.6, 0.7, 0.8), (0.85, 0.95, 0.05)]
+BOXES = (8.0, 12.0)           # L/a1 of the two box sizes extrapolated
+TABLE_MIN_GAP = 1e-5          # the resistance library's smallest gap (minimumGap)
+TABLE_POINTS_PER_DECADE = 20
+# The correction is tapered to zero between TAPER_START and TAPER_END (linearly in ln xi): beyond a
+# gap of about one radius what the solver misses is its far-field discretisation error (1.5 % of the
+# squeeze resistance at xi = 1, a1/Delta = 3), not lubrication, and a longer range would cost
+# neighbour searches for nothing.
+TAPER_START, TAPER_END = 0.5, 1.0
+
+
+@functools.lru_cache(maxsize=None)
+def theory_velocity(kind: str, ratio: float, gap: float) -> float:
+    """V_hat_th: the closing velocity (pair) or the velocity toward the wall, in F/(6 pi eta a1)."""
+    if kind == "wall":
+        return theory.wall_squeeze_velocity(1.0, gap)
+    return theory.pair_squeeze_velocity(1.0, ratio, gap)
+
+
+def extrapolate_box(v1: np.ndarray, v2: np.ndarray, L1: float, L2: float) -> np.ndarray:
+    """V at an infinite box from two sizes, with V(L) = V_inf + c L^-3."""
+    return v2 + (v2 - v1) * L1 ** 3 / (L2 ** 3 - L1 ** 3)
+
+
+@dataclass
+class SqueezeCalibration:
+    """One (kind, a/Delta, ratio): measurements, their fit and the correction."""
+    kind: str                      # "pair" or "wall"
+    a_over_delta: float            # a1/Delta, a1 the smaller sphere (wall: the sphere)
+    ratio: float                   # a2/a1 >= 1 (wall: 1)
+    gaps: List[float]
+    boxes: List[float]
+    velocities: Dict[str, List[List[float]]] = field(default_factory=dict)   # "L" -> [offset][gap]
+    wall_seconds: float = 0.0
+
+    def mean_velocity(self, L: float) -> np.ndarray:
+        return np.mean(np.array(self.velocities["%g" % L]), axis=0)
+
+    def velocity_inf(self) -> np.ndarray:
+        """Box-extrapolated, offset-averaged V_hat_FDM."""
+        L1, L2 = self.boxes[0], self.boxes[1]
+        return extrapolate_box(self.mean_velocity(L1), self.mean_velocity(L2), L1, L2)
+
+    def spread(self) -> np.ndarray:
+        """Relative spread (max - min over the offsets, over the mean) at the largest box."""
+        v = np.array(self.velocities["%g" % self.boxes[1]])
+        return (v.max(axis=0) - v.min(axis=0)) / v.mean(axis=0)
+
+    def theory(self) -> np.ndarray:
+        return np.array([theory_velocity(self.kind, self.ratio, g) for g in self.gaps])
+
+    def fit(self) -> Dict[str, float]:
+        """r_FDM(xi) = r_inf + (r_0 - r_inf)/(1 + (xi/xi_1)^p) through r_FDM = 1/V_inf (least squares in
+        log r): a plateau r_0 where the solver no longer sees the gap, a rise around xi_1."""
+        from scipy.optimize import least_squares
+        gaps = np.array(self.gaps)
+        r_fdm = 1 / self.velocity_inf()
+
+        def residual(q: np.ndarray) -> np.ndarray:
+            return np.log(fitted_resistance(gaps, *q) / r_fdm)
+
+        x0 = [r_fdm.max(), r_fdm.min() * 0.5, 0.2, 1.5]
+        sol = least_squares(residual, x0=x0, bounds=([0, 0, 1e-3, 0.3], [np.inf, np.inf, 10, 6]))
+        rel = np.exp(sol.fun) - 1
+        r_0, r_inf, xi_1, power = (float(v) for v in sol.x)
+        return dict(r_0=r_0, r_inf=r_inf, xi_1=xi_1, p=power, rms_rel=float(np.sqrt(np.mean(rel ** 2))),
+                    max_rel=float(np.max(np.abs(rel))))
+
+    def correction(self, gap: float, fit: Dict[str, float]) -> float:
+        """s_hat(xi) = r_th(xi) - r_FDM,fit(xi) (units 6 pi eta a1), not clipped."""
+        r_th = 1 / theory_velocity(self.kind, self.ratio, round_gap(gap))
+        return r_th - float(fitted_resistance(np.array(gap), fit["r_0"], fit["r_inf"], fit["xi_1"], fit["p"]))
+
+    def table(self, fit: Dict[str, float]) -> List[tuple]:
+        """(xi, xi * s_hat * taper) from TABLE_MIN_GAP to the first sign change of s_hat or TAPER_END
+        (the last row is 0)."""
+        rows = []
+        n = int(round(TABLE_POINTS_PER_DECADE * math.log10(TAPER_END / TABLE_MIN_GAP)))
+        for k in range(n + 1):
+            xi = TABLE_MIN_GAP * 10 ** (k / TABLE_POINTS_PER_DECADE)
+            s = self.correction(xi, fit) * taper(xi)
+            if s <= 0:
+                if rows:  # interpolate the zero crossing
+                    xp, sp = rows[-1][0], rows[-1][1] / rows[-1][0]
+                    t = sp / (sp - s)
+                    x0 = math.exp(math.log(xp) + t * (math.log(xi) - math.log(xp)))
+                    rows.append((x0, 0.0))
+                break
+            rows.append((xi, xi * s))
+        return rows
+
+
+def taper(xi: float) -> float:
+    """1 below TAPER_START, 0 from TAPER_END, linear in ln xi between."""
+    if xi <= TAPER_START:
+        return 1.0
+    if xi >= TAPER_END:
+        return 0.0
+    return math.log(TAPER_END / xi) / math.log(TAPER_END / TAPER_START)
+
+
+def fitted_resistance(xi: np.ndarray, r_0: float, r_inf: float, xi_1: float, p: float) -> np.ndarray:
+    """The fit of the solver's squeeze resistance (units 6 pi eta a1)."""
+    return r_inf + (r_0 - r_inf) / (1 + (xi / xi_1) ** p)
+
+
+def round_gap(g: float) -> float:
+    """Gaps passed to fdmResistance (and cached) to 6 significant digits."""
+    return float("%.6g" % g)
+
+
+def measure(kind: str, a_over_delta: float, ratio: float, workdir: str, gaps: Sequence[float] = GAPS,
+            boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS,
+            tol_lambda: float = 1e-5, np_fluid: int = 1) -> SqueezeCalibration:
+    """Run the squeeze scenes with the sub-grid lubrication off at every box size and offset."""
+    cal = SqueezeCalibration(kind, a_over_delta, ratio if kind == "pair" else 1.0, list(gaps), list(boxes))
+    t0 = time.time()
+    for L in boxes:
+        rows = []
+        for off in offsets:
+            if kind == "pair":
+                r = squeeze.run_pair(workdir, ratio, gaps, False, a_over_delta, L, tol_lambda, np_fluid=np_fluid,
+                                     offset=off)
+            else:
+                r = squeeze.run_wall(workdir, gaps, False, a_over_delta, L, 1.25 * L, tol_lambda, np_fluid=np_fluid,
+                                     offset=off)
+            if not r["converged"]:
+                raise RuntimeError("calibration: %s a/Delta %g ratio %g L %g offset %s: a step did not converge"
+                                   % (kind, a_over_delta, ratio, L, off))
+            rows.append(r["velocity"])
+        cal.velocities["%g" % L] = rows
+    cal.wall_seconds = time.time() - t0
+    return cal
+
+
+def project_relative(path: str) -> str:
+    """path relative to the project's root if it lies inside it."""
+    from .environment import project_dir
+    root, full = project_dir(), os.path.realpath(path)
+    if root is None:
+        return full
+    root = os.path.realpath(root)
+    return os.path.relpath(full, root) if full.startswith(root + os.sep) else full
+
+
+def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str) -> str:
+    """The one command that measures and analyses these calibrations again."""
+    ads = sorted({c.a_over_delta for c in calibrations})
+    ratios = sorted({c.ratio for c in calibrations if c.kind == "pair"})
+    c0 = calibrations[0]
+    n_offsets = len(next(iter(c0.velocities.values())))
+    words = ["python3 -m fdmsubgrid.calibration", "--a-over-delta"] + ["%g" % a for a in ads]
+    words += (["--ratios"] + ["%g" % r for r in ratios]) if ratios else ["--no-pairs"]
+    if not any(c.kind == "wall" for c in calibrations):
+        words.append("--no-wall")
+    words += ["--boxes"] + ["%g" % L for L in c0.boxes] + ["--offsets", str(n_offsets), "--out", out]
+    return " ".join(words)
+
+
+def write_table(path: str, calibrations: Sequence[SqueezeCalibration], command: str) -> None:
+    """The text table CalibratedSubgridModel reads (dem/resistance/src/squeeze_calibration.cpp)."""
+    with open(path, "w") as f:
+        f.write("# Squeeze calibration of the fictitious-domain solver (paper Appendix B; docs/resistance.md)\n")
+        f.write("# s_hat(xi) = 1/V_th - 1/V_FDM: the squeeze resistance the sub-grid block adds, in units of\n")
+        f.write("# 6 pi eta a1 (a1 the smaller sphere). pair: X21A^SG = -6 pi a1 s_hat; wall: X^A_SG = 6 pi a s_hat.\n")
+        f.write("# Block header: kind a1/Delta a2/a1 rows r_0 r_inf xi_1 p fit_rms; then rows: xi  xi*s_hat\n")
+        f.write("# Regenerate: %s\n" % regenerate_command(calibrations, project_relative(path)))
+        if "--from-raw" in command:
+            f.write("# (this file was analysed from the measurements kept by earlier calls: --from-raw)\n")
+        for c in calibrations:
+            write_block(f, c)
+
+
+def write_block(f, c: SqueezeCalibration) -> None:
+    fit = c.fit()
+    rows = c.table(fit)
+    f.write("%s %.6g %.6g %d %.6g %.6g %.6g %.6g %.4g\n" % (c.kind, c.a_over_delta, c.ratio, len(rows), fit["r_0"],
+                                                        fit["r_inf"], fit["xi_1"], fit["p"], fit["rms_rel"]))
+    for xi, v in rows:
+        f.write("%.8e %.8e\n" % (xi, v))
+
+
+def summary(c: SqueezeCalibration) -> Dict:
+    fit = c.fit()
+    v_inf = c.velocity_inf()
+    v_th = c.theory()
+    return dict(kind=c.kind, a_over_delta=c.a_over_delta, ratio=c.ratio, gaps=c.gaps, boxes=c.boxes,
+                velocities=c.velocities, velocity_inf=v_inf.tolist(), velocity_theory=v_th.tolist(),
+                spread=c.spread().tolist(), fit=fit,
+                correction=[c.correction(g, fit) for g in c.gaps], xi_max=c.table(fit)[-1][0],
+                wall_seconds=c.wall_seconds)
+
+
+def plot(path: str, summaries: Sequence[Dict]) -> None:
+    """Figs. B.24-B.25 for the squeeze: theory, measured FDM resistance (each box, extrapolated) and fit."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    # one row per a1/Delta, one column per (kind, ratio)
+    rows = sorted({s["a_over_delta"] for s in summaries})
+    cols = sorted({(s["kind"], s["ratio"]) for s in summaries}, key=lambda kr: (kr[0] == "wall", kr[1]))
+    fig, axes = plt.subplots(len(rows), len(cols), figsize=(4.2 * len(cols), 3.6 * len(rows)), squeeze=False)
+    for s in summaries:
+        ax = axes[rows.index(s["a_over_delta"])][cols.index((s["kind"], s["ratio"]))]
+        gaps = np.array(s["gaps"])
+        fine = np.logspace(-4, 0, 60)
+        ax.loglog(fine, [1 / theory_velocity(s["kind"], s["ratio"], round_gap(g)) for g in fine], "k-", label="theory")
+        for L in s["boxes"]:
+            v = np.array(s["velocities"]["%g" % L])
+            ax.errorbar(gaps, 1 / v.mean(axis=0), yerr=[1 / v.min(axis=0) - 1 / v.mean(axis=0),
+                                                        1 / v.mean(axis=0) - 1 / v.max(axis=0)][::-1],
+                        fmt="x", ms=4, label="FDM, L = %g a1" % L)
+        ax.loglog(gaps, 1 / np.array(s["velocity_inf"]), "^", label="FDM, L → ∞")
+        f = s["fit"]
+        ax.loglog(fine, fitted_resistance(fine, f["r_0"], f["r_inf"], f["xi_1"], f["p"]), "-", color="C3", label="fit")
+        ax.set_xlabel(r"$\xi$" if s["kind"] == "pair" else r"$\varepsilon$")
+        ax.set_ylabel(r"squeeze resistance / $6\pi\eta a_1$")
+        ax.set_title("%s, a1/Δ = %g%s" % (s["kind"], s["a_over_delta"],
+                                          ", a2/a1 = %g" % s["ratio"] if s["kind"] == "pair" else ""), fontsize=9)
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv: Sequence[str] | None = None) -> List[Dict]:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--a-over-delta", type=float, nargs="+", default=[3.0, 4.0, 5.0])
+    p.add_argument("--ratios", type=float, nargs="+", default=[1.0, 1.4], help="a2/a1 of the pairs (>= 1)")
+    p.add_argument("--no-wall", action="store_true", help="measure the pairs only")
+    p.add_argument("--no-pairs", action="store_true", help="measure the wall only")
+    p.add_argument("--boxes", type=float, nargs=2, default=list(BOXES), help="the two box sizes L/a1")
+    p.add_argument("--offsets", type=int, default=len(OFFSETS), help="positions in the cell averaged (1-4)")
+    p.add_argument("--workdir", default="calibration_runs")
+    p.add_argument("--out", required=True, help="the table (text); its .json beside it holds every measurement")
+    p.add_argument("--from-raw", metavar="RAW_JSON", nargs="+", help="analyse the measurements earlier calls "
+                   "kept (<workdir>/measurements.json) instead of running")
+    args = p.parse_args(argv)
+    if any(r < 1 for r in args.ratios):
+        p.error("--ratios: a2/a1 must be >= 1 (a pair 1/1.4 is the pair 1.4 seen from the other sphere)")
+    os.makedirs(args.workdir, exist_ok=True)
+    raw_path = os.path.join(args.workdir, "measurements.json")
+    cals: List[SqueezeCalibration] = []
+    if args.from_raw:
+        for path in args.from_raw:
+            with open(path) as f:
+                cals += [SqueezeCalibration(**d) for d in json.load(f)]
+    else:
+        for ad in args.a_over_delta:
+            jobs = (([] if args.no_pairs else [("pair", r) for r in args.ratios])
+                    + ([] if args.no_wall else [("wall", 1.0)]))
+            for kind, ratio in jobs:
+                cals.append(measure(kind, ad, ratio, args.workdir, boxes=args.boxes, offsets=OFFSETS[:args.offsets]))
+                with open(raw_path, "w") as f:   # kept before any analysis
+                    json.dump([c.__dict__ for c in cals], f)
+    for c in cals:
+        s = summary(c)
+        fit = s["fit"]
+        print("%s a1/Delta %g a2/a1 %g: %.0f s, fit r_0 %.4f xi_1 %.4f p %.3f (rms %.2f %%, max %.2f %%), "
+              "correction up to xi %.3g" % (c.kind, c.a_over_delta, c.ratio, c.wall_seconds, fit["r_0"], fit["xi_1"],
+                                            fit["p"], 100 * fit["rms_rel"], 100 * fit["max_rel"], s["xi_max"]),
+              flush=True)
+    command = "python3 -m fdmsubgrid.calibration " + " ".join(argv if argv is not None else sys.argv[1:])
+    write_table(args.out, cals, command)
+    summaries = [summary(c) for c in cals]
+    json_path = os.path.splitext(args.out)[0] + ".json"
+    with open(json_path, "w") as f:
+        json.dump(summaries, f, indent=1)
+    plot(os.path.splitext(args.out)[0] + ".png", summaries)
+    return summaries
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,142 @@
+"""Squeeze flows with the coupled solver: two spheres pushed together along their line of centres,
+and a sphere pushed toward a plane wall, held at a list of gaps (one coupled step per gap,
+`fix fdm/couple ... move no`, each step warm-started from the previous one).
+
+The one runner of these scenes: cases/pairSqueeze and cases/wallSqueeze compare them with theory,
+the calibration of the solver's own squeeze resistance (calibration.py, paper Appendix B) measures
+them with the sub-grid lubrication switched off.
+
+Velocities are returned in units of F/(6 pi eta a1) (pair: the closing velocity (U1 - U2).d; wall:
+the velocity toward the wall).
+"""
+from __future__ import annotations
+
+import math
+import os
+import shutil
+from typing import Sequence
+
+from . import case
+
+# Where the scene sits inside its first mesh cell (fractions of Delta along x, y, z): off the mesh's
+# symmetry planes, as the squeeze cases have always used.
+DEFAULT_OFFSET = (0.1, 0.2, 0.3)
+
+
+def _pair_style(subgrid: bool, cutoff: float | None, extra: str) -> str:
+    words = ["fdm/subgrid"]
+    if cutoff is not None:
+        words.append("cutoff %g" % cutoff)
+    if extra:
+        words.append(extra)
+    if not subgrid:
+        words.append("lubrication no")
+    return " ".join(words)
+
+
+def _tag(subgrid: bool, offset: Sequence[float]) -> str:
+    name = "subgrid" if subgrid else "nosubgrid"
+    if tuple(offset) != DEFAULT_OFFSET:
+        name += "_off%g_%g_%g" % tuple(offset)
+    return name
+
+
+def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_over_delta: float = 4.0,
+             L_over_a: float = 8.0, tol_lambda: float = 1e-5, cutoff: float | None = None, np_fluid: int = 1,
+             keep: bool = False, offset: Sequence[float] = DEFAULT_OFFSET, pair_options: str = "") -> dict:
+    """Spheres of radii 1 and `ratio` in a periodic cube of side L_over_a, pushed together by forces
+    F = 6 pi eta a1 along x, at the reduced gaps `xis` (xi = 2r/(a1+a2) - 2, largest first).
+    `offset`: the centre of the gap inside its mesh cell (fractions of Delta); `pair_options`: more
+    pair_style fdm/subgrid keywords. Returns dict(velocity=[closing velocity / (F/(6 pi eta a1))],
+    wall_seconds, cells, inner_iterations, converged)."""
+    a1, a2 = 1.0, ratio
+    delta = a1 / a_over_delta
+    L = L_over_a * a1
+    eta = 1.0
+    F = 6 * math.pi * eta * a1
+    name = "lambda%g_ad%g_L%g_%s" % (ratio, a_over_delta, L_over_a, _tag(subgrid, offset))
+    run_dir = os.path.join(workdir, name)
+    if os.path.isdir(run_dir):
+        shutil.rmtree(run_dir)
+    box = case.Box((0, 0, 0), (L, L, L), delta)
+    centre = [L / 2 + o * delta for o in offset]
+
+    def positions(xi: float):
+        gap = xi * (a1 + a2) / 2
+        return ((centre[0] - gap / 2 - a1, centre[1], centre[2]), (centre[0] + gap / 2 + a2, centre[1], centre[2]))
+
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+                          n_particles=2)
+    runs = []
+    for k, xi in enumerate(xis):
+        p1, p2 = positions(xi)
+        if k > 0:
+            runs.append("set             atom 1 x %r y %r z %r" % p1)
+            runs.append("set             atom 2 x %r y %r z %r" % p2)
+        runs.append("run             1")
+    p1, p2 = positions(xis[0])
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0,
+                         pair_style=_pair_style(subgrid, cutoff, pair_options),
+                         before_run="group           one id 1\ngroup           two id 2\n"
+                                    "fix             push1 one addforce %r 0 0\n"
+                                    "fix             push2 two addforce %r 0 0" % (F, -F),
+                         runs=runs, name="in.pairSqueeze")
+    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    U1 = parts["Ux"][parts["tag"] == 1]
+    U2 = parts["Ux"][parts["tag"] == 2]
+    velocity = [float(v) for v in (U1 - U2) / (F / (6 * math.pi * eta * a1))]
+    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
+                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
+
+
+def run_wall(workdir: str, epss: Sequence[float], subgrid: bool, a_over_delta: float = 4.0, L_over_a: float = 8.0,
+             H_over_a: float = 16.0, tol_lambda: float = 1e-5, cutoff: float | None = None, np_fluid: int = 1,
+             keep: bool = False, offset: Sequence[float] = DEFAULT_OFFSET, pair_options: str = "") -> dict:
+    """A sphere of radius 1 between walls at rest at y = 0 and y = H_over_a, periodic in x and z
+    (side L_over_a), pushed toward y = 0 by F = 6 pi eta a at eps = h/a - 1 (largest first).
+    `offset`: the centre's x and z inside its mesh cell (fractions of Delta; the y entry is unused:
+    the gap sets y). Returns dict(velocity=[velocity toward the wall / (F/(6 pi eta a))], ...)."""
+    a = 1.0
+    delta = a / a_over_delta
+    L, H = L_over_a * a, H_over_a * a
+    eta = 1.0
+    F = 6 * math.pi * eta * a
+    name = "ad%g_L%g_H%g_%s" % (a_over_delta, L_over_a, H_over_a, _tag(subgrid, offset))
+    run_dir = os.path.join(workdir, name)
+    if os.path.isdir(run_dir):
+        shutil.rmtree(run_dir)
+    box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
+    x, z = L / 2 + offset[0] * delta, L / 2 + offset[2] * delta
+
+    def position(eps: float):
+        return (x, a * (1 + eps), z)
+
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+                          n_particles=1)
+    runs = []
+    for k, eps in enumerate(epss):
+        if k > 0:
+            runs.append("set             atom 1 x %r y %r z %r" % position(eps))
+        runs.append("run             1")
+    pair = _pair_style(subgrid, cutoff, ("wall ylo 0 0 0 wall yhi 0 0 0 " + pair_options).strip())
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
+                         before_run="fix             push all addforce 0 %r 0" % (-F), runs=runs,
+                         name="in.wallSqueeze")
+    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    velocity = [float(v) for v in -parts["Uy"] / (F / (6 * math.pi * eta * a))]
+    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
+                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
+
+
+def box_extrapolated(first: dict, second: dict, L1: float, L2: float) -> dict:
+    """The runs of one scene in boxes of side L1 < L2 (the wall scene: L and H scaled together)
+    combined into the infinite-box velocities, V(L) = V_inf + c L^-3 (the images of a force dipole;
+    checked against a third size in docs/validation.md): velocity is V_inf, velocity_by_box the two."""
+    import numpy as np
+    v1, v2 = np.array(first["velocity"]), np.array(second["velocity"])
+    v_inf = v2 + (v2 - v1) * L1 ** 3 / (L2 ** 3 - L1 ** 3)
+    return dict(velocity=[float(v) for v in v_inf], velocity_by_box={"%g" % L1: first["velocity"],
+                                                                     "%g" % L2: second["velocity"]},
+                wall_seconds=first["wall_seconds"] + second["wall_seconds"], cells=[first["cells"], second["cells"]],
+                inner_iterations=first["inner_iterations"] + second["inner_iterations"],
+                converged=first["converged"] and second["converged"])

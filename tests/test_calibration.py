@@ -1,0 +1,108 @@
+"""The squeeze calibration of Appendix B (scripts/fdmsubgrid/calibration.py and the table shipped in
+dem/resistance/data): the box extrapolation and the fit on synthetic data, the shipped fits against
+their own measurements, the table's layout, and the calibrated model in the coupled solver
+(pair_style fdm/subgrid model calibrated) against the two-sphere and sphere-wall theory."""
+import json
+import os
+
+import numpy as np
+import pytest
+
+from conftest import PROJECT
+from fdmsubgrid import calibration, squeeze, theory
+
+DATA = os.path.join(PROJECT, "dem", "resistance", "data")
+TABLE = os.path.join(DATA, "squeeze_calibration.dat")
+
+
+def test_box_extrapolation_removes_dipole_images():
+    v_inf = np.array([0.9, 0.5, 0.3])
+    c = np.array([40.0, -3.0, 10.0])
+    at = {L: v_inf + c / L ** 3 for L in (8.0, 12.0)}
+    assert np.allclose(calibration.extrapolate_box(at[8.0], at[12.0], 8.0, 12.0), v_inf, rtol=0, atol=1e-14)
+
+
+def test_fit_recovers_a_logistic_resistance():
+    gaps = calibration.GAPS
+    truth = dict(r_0=2.7, r_inf=0.6, xi_1=0.3, p=1.25)
+    r = calibration.fitted_resistance(np.array(gaps), **truth)
+    cal = calibration.SqueezeCalibration("pair", 3.0, 1.0, gaps, [8.0, 12.0],
+                                         {"8": [list(1 / r)], "12": [list(1 / r)]})
+    fit = cal.fit()
+    for k, v in truth.items():
+        assert fit[k] == pytest.approx(v, rel=1e-4), k
+    assert fit["max_rel"] < 1e-6
+
+
+def test_taper_is_continuous_and_ends_the_correction():
+    assert calibration.taper(calibration.TAPER_START) == 1.0
+    assert calibration.taper(calibration.TAPER_END) == 0.0
+    mid = np.sqrt(calibration.TAPER_START * calibration.TAPER_END)
+    assert calibration.taper(mid) == pytest.approx(0.5, abs=1e-12)
+
+
+def read_table(path):
+    """The blocks of a calibration table: {(kind, a/Delta, ratio): (header floats, rows array)}."""
+    blocks = {}
+    with open(path) as f:
+        lines = [ln.split() for ln in f if ln.strip() and not ln.startswith("#")]
+    k = 0
+    while k < len(lines):
+        head = lines[k]
+        n = int(head[3])
+        rows = np.array([[float(x) for x in ln] for ln in lines[k + 1:k + 1 + n]])
+        blocks[(head[0], float(head[1]), float(head[2]))] = ([float(x) for x in head[4:]], rows)
+        k += 1 + n
+    return blocks
+
+
+def test_shipped_table_covers_the_suspension_runs_and_is_well_formed():
+    blocks = read_table(TABLE)
+    for ad in (3.0, 4.0, 5.0):
+        for key in (("pair", ad, 1.0), ("pair", ad, 1.4), ("wall", ad, 1.0)):
+            assert key in blocks, key
+            _, rows = blocks[key]
+            assert np.all(np.diff(np.log(rows[:, 0])) > 0), key
+            assert rows[0, 0] == pytest.approx(calibration.TABLE_MIN_GAP)
+            assert rows[-1, 1] == 0.0 and rows[-1, 0] <= calibration.TAPER_END * (1 + 1e-9), key
+            assert np.all(rows[:-1, 1] > 0), key
+
+
+def test_shipped_fits_reproduce_their_measurements():
+    """Each fit through the box-extrapolated, position-averaged resistances: within 3 % rms and 7 % at
+    any gap (the spread over positions in the cell, reported beside it, is of the same size)."""
+    with open(os.path.join(DATA, "squeeze_calibration.json")) as f:
+        summaries = json.load(f)
+    assert len(summaries) >= 9
+    for s in summaries:
+        cal = calibration.SqueezeCalibration(s["kind"], s["a_over_delta"], s["ratio"], s["gaps"], s["boxes"],
+                                             s["velocities"])
+        fit = cal.fit()
+        label = "%s a/Delta %g ratio %g" % (s["kind"], s["a_over_delta"], s["ratio"])
+        assert fit["rms_rel"] < 0.03, label
+        assert fit["max_rel"] < 0.07, label
+        assert fit == pytest.approx(s["fit"], rel=1e-6), label   # the json is what the table was made from
+
+
+@pytest.mark.parametrize("ratio", [1.0, 1.4])
+def test_calibrated_pair_squeeze_against_theory(tmp_path, env, ratio):
+    """pair_style fdm/subgrid model calibrated at a1/Delta = 3 (the suspension resolution): the
+    closing velocity, box effect extrapolated away, against Jeffrey & Onishi."""
+    xis = [0.3, 0.1, 0.03, 1e-3]
+    ref = [theory.pair_squeeze_velocity(1.0, ratio, xi) for xi in xis]
+    runs = [squeeze.run_pair(str(tmp_path), ratio, xis, True, a_over_delta=3.0, L_over_a=L, tol_lambda=1e-5,
+                             pair_options="model calibrated") for L in (8.0, 12.0)]
+    r = squeeze.box_extrapolated(runs[0], runs[1], 8.0, 12.0)
+    assert r["converged"]
+    errors = theory.relative_errors(r["velocity"], ref)
+    assert max(abs(e) for e in errors) < 0.05, errors
+
+
+def test_calibrated_model_refuses_an_uncovered_resolution(tmp_path, env):
+    """a/Delta = 2 is not in the table: the run stops and names the radii, the mesh and the way out."""
+    with pytest.raises(RuntimeError) as failure:
+        squeeze.run_pair(str(tmp_path), 1.0, [0.01], True, a_over_delta=2.0, L_over_a=8.0, tol_lambda=1e-3,
+                         pair_options="model calibrated")
+    message = str(failure.value)
+    assert "no squeeze calibration for radii 1 and 1" in message
+    assert "model cutoff" in message
