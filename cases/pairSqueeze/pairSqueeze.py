@@ -23,7 +23,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdmsubgrid import case, theory  # noqa: E402
-from fdmsubgrid.squeeze import box_extrapolated, run_pair  # noqa: E402
+from fdmsubgrid.squeeze import DEFAULT_OFFSET, box_extrapolated, run_pair  # noqa: E402
 
 XI_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
 
@@ -65,6 +65,9 @@ def main(argv=None):
     p.add_argument("--xi", type=float, nargs="+", default=XI_DEFAULT, help="reduced gaps, largest first")
     p.add_argument("--a-over-delta", type=float, default=4.0)
     p.add_argument("--L-over-a", type=float, default=8.0)
+    p.add_argument("--offset", type=float, nargs=3, default=list(DEFAULT_OFFSET), metavar=("X", "Y", "Z"),
+                   help="where the gap centre sits in its mesh cell, fractions of Delta (default %s)"
+                        % " ".join("%g" % o for o in DEFAULT_OFFSET))
     p.add_argument("--box-extrapolate", type=float, metavar="L2", default=None,
                    help="also run in a box of side L2 (> L) and report the velocities extrapolated to an "
                         "infinite box (V = V_inf + c L^-3)")
@@ -85,10 +88,11 @@ def main(argv=None):
         for subgrid in ([True] if args.no_reference else [True, False]):
             options = "model %s" % args.model if subgrid else ""
             r = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.L_over_a, args.tol_lambda,
-                         args.cutoff, args.np_fluid, args.keep, pair_options=options)
+                         args.cutoff, args.np_fluid, args.keep, pair_options=options, offset=args.offset)
             if args.box_extrapolate:
                 r2 = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.box_extrapolate,
-                              args.tol_lambda, args.cutoff, args.np_fluid, args.keep, pair_options=options)
+                              args.tol_lambda, args.cutoff, args.np_fluid, args.keep, pair_options=options,
+                              offset=args.offset)
                 r = box_extrapolated(r, r2, args.L_over_a, args.box_extrapolate)
             r["rel_error"] = theory.relative_errors(r["velocity"], reference)
             entry["subgrid" if subgrid else "nosubgrid"] = r

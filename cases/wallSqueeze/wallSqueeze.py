@@ -23,7 +23,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdmsubgrid import case, theory  # noqa: E402
-from fdmsubgrid.squeeze import box_extrapolated, run_wall  # noqa: E402
+from fdmsubgrid.squeeze import DEFAULT_OFFSET, box_extrapolated, run_wall  # noqa: E402
 
 EPS_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
 
@@ -62,6 +62,9 @@ def main(argv=None):
     p.add_argument("--a-over-delta", type=float, default=4.0)
     p.add_argument("--L-over-a", type=float, default=8.0)
     p.add_argument("--H-over-a", type=float, default=10.0)
+    p.add_argument("--offset", type=float, nargs=3, default=list(DEFAULT_OFFSET), metavar=("X", "Y", "Z"),
+                   help="where the gap centre sits in its mesh cell, fractions of Delta (default %s)"
+                        % " ".join("%g" % o for o in DEFAULT_OFFSET))
     p.add_argument("--box-extrapolate", type=float, metavar="L2", default=None,
                    help="also run in a box of side L2 (> L, H scaled with it) and report the velocities "
                         "extrapolated to an infinite box (V = V_inf + c L^-3)")
@@ -80,12 +83,12 @@ def main(argv=None):
     for subgrid in ([True] if args.no_reference else [True, False]):
         options = "model %s" % args.model if subgrid else ""
         r = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.L_over_a, args.H_over_a, args.tol_lambda,
-                     args.cutoff, args.np_fluid, args.keep, pair_options=options)
+                     args.cutoff, args.np_fluid, args.keep, pair_options=options, offset=args.offset)
         if args.box_extrapolate:
             scale = args.box_extrapolate / args.L_over_a
             r2 = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.box_extrapolate,
                           args.H_over_a * scale, args.tol_lambda, args.cutoff, args.np_fluid, args.keep,
-                          pair_options=options)
+                          pair_options=options, offset=args.offset)
             r = box_extrapolated(r, r2, args.L_over_a, args.box_extrapolate)
         r["rel_error"] = theory.relative_errors(r["velocity"], reference)
         results["subgrid" if subgrid else "nosubgrid"] = r
