@@ -23,7 +23,8 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdmsubgrid import case, theory  # noqa: E402
-from fdmsubgrid.squeeze import DEFAULT_OFFSET, box_extrapolated, run_wall  # noqa: E402
+from fdmsubgrid import squeeze  # noqa: E402
+from fdmsubgrid.squeeze import box_extrapolated, run_wall  # noqa: E402
 
 EPS_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
 
@@ -62,12 +63,7 @@ def main(argv=None):
     p.add_argument("--a-over-delta", type=float, default=4.0)
     p.add_argument("--L-over-a", type=float, default=8.0)
     p.add_argument("--H-over-a", type=float, default=10.0)
-    p.add_argument("--offset", type=float, nargs=3, default=list(DEFAULT_OFFSET), metavar=("X", "Y", "Z"),
-                   help="where the gap centre sits in its mesh cell, fractions of Delta (default %s)"
-                        % " ".join("%g" % o for o in DEFAULT_OFFSET))
-    p.add_argument("--box-extrapolate", type=float, metavar="L2", default=None,
-                   help="also run in a box of side L2 (> L, H scaled with it) and report the velocities "
-                        "extrapolated to an infinite box (V = V_inf + c L^-3)")
+    squeeze.add_options(p)
     case.add_run_options(p, HERE, tol_lambda=0.0001, cutoff=True)
     p.add_argument("--no-reference", action="store_true", help="run without the sub-grid-off comparison run")
     args = p.parse_args(argv)

@@ -23,6 +23,16 @@ from . import case
 DEFAULT_OFFSET = (0.1, 0.2, 0.3)
 
 
+def add_options(parser) -> None:
+    """The options the squeeze cases share: --offset (the position in the cell) and --box-extrapolate."""
+    parser.add_argument("--offset", type=float, nargs=3, default=list(DEFAULT_OFFSET), metavar=("X", "Y", "Z"),
+                        help="where the gap centre sits in its mesh cell, fractions of Delta (default %s)"
+                             % " ".join("%g" % o for o in DEFAULT_OFFSET))
+    parser.add_argument("--box-extrapolate", type=float, metavar="L2", default=None,
+                        help="also run in a box of side L2 (> L; a wall scene's H scaled with it) and report the "
+                             "velocities extrapolated to an infinite box (V = V_inf + c L^-3)")
+
+
 def _pair_style(subgrid: bool, cutoff: float | None, extra: str) -> str:
     words = ["fdm/subgrid"]
     if cutoff is not None:
