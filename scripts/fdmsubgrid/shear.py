@@ -122,7 +122,7 @@ def read_run(run_dir: str) -> ShearRun:
     if not (dt and len(walls) == 2):
         raise RunFolderError("%s: needs timestep and pair_style fdm/subgrid ... wall ylo UX UY UZ wall yhi "
                              "UX UY UZ" % path)
-    contact = re.search(r"fdm/subgrid contact (\S+) (\S+) (\S+) (\S+)", dem)
+    contact = re.search(r"fdm/subgrid\b[^\n]*?\bcontact (\S+) (\S+) (\S+) (\S+)", dem)
     springs = dict(zip(("kn", "kt", "mu_s", "h_r"), (float(v) for v in contact.groups()))) if contact else {}
     return ShearRun(run_dir=run_dir, packing=pack, box=tuple(float(v) for v in pack.box), mesh=mesh,
                     dt=float(dt.group(1)), steps_planned=_run_steps(dem, path),
