@@ -191,10 +191,9 @@ void PairFdmSubgrid::fluidParameters()
     // the squeeze functions measured with the solver itself (Appendix B; squeeze_calibration.hpp)
     const std::string path = calibrationFile_.empty() ? res::SqueezeCalibration::defaultPath() : calibrationFile_;
     try {
-      const res::SqueezeCalibration table = res::SqueezeCalibration::read(path);
-      model_.reset(new res::CalibratedSubgridModel(table, meshSize_, cutoffCells_, wallCutoffCells_));
-      wallModel_.reset(new res::CalibratedSubgridModel(table, meshSize_, cutoffCells_, wallCutoffCells_));
-      calibration_.reset(new res::SqueezeCalibration(table));
+      calibration_.reset(new res::SqueezeCalibration(res::SqueezeCalibration::read(path)));
+      model_.reset(new res::CalibratedSubgridModel(*calibration_, meshSize_, cutoffCells_, wallCutoffCells_));
+      wallModel_.reset(new res::CalibratedSubgridModel(*calibration_, meshSize_, cutoffCells_, wallCutoffCells_));
     } catch (const std::exception &e) {
       session.abandon(std::string("fdmDEM: pair fdm/subgrid: ") + e.what());
       error->all(FLERR, (std::string("pair fdm/subgrid: ") + e.what()).c_str());

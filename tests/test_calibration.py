@@ -19,7 +19,7 @@ def test_box_extrapolation_removes_dipole_images():
     v_inf = np.array([0.9, 0.5, 0.3])
     c = np.array([40.0, -3.0, 10.0])
     at = {L: v_inf + c / L ** 3 for L in (8.0, 12.0)}
-    assert np.allclose(calibration.extrapolate_box(at[8.0], at[12.0], 8.0, 12.0), v_inf, rtol=0, atol=1e-14)
+    assert np.allclose(squeeze.extrapolate_box(at[8.0], at[12.0], 8.0, 12.0), v_inf, rtol=0, atol=1e-14)
 
 
 def test_fit_recovers_a_logistic_resistance():

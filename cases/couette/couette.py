@@ -189,10 +189,7 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None,
                    help="analyse this run folder as it stands (a resumed, stopped or running run) and write --out")
-    p.add_argument("--model", choices=("cutoff", "calibrated"), default="cutoff",
-                   help="pair_style fdm/subgrid's sub-grid model (docs/dem.md): the cut-off model, or the squeeze "
-                        "functions calibrated with the solver itself (paper Appendix B)")
-    case.add_run_options(p, HERE, tol_lambda=1e-3)
+    case.add_run_options(p, HERE, tol_lambda=1e-3, model=True)
     args = p.parse_args(argv)
 
     if args.analyse:

@@ -51,7 +51,7 @@ def paper_contact(a1=1.0, kn=2e4, kt=200.0):
 def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0, size=(12.0, 8.0, 6.0), dt=0.05,
                    tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True,
                    gap_update="log", integrator="ab2", r_x0=None, acceleration="anderson",
-                   mean_flow_correction=True, tol_velocity=0.0):
+                   mean_flow_correction=True, tol_velocity=0.0, model="cutoff"):
     """One coupled run from r_x = r_x0 (default -r_x_end) to +r_x_end (r_x_end = 6, the paper's, or
     less in a box shorter than 14 a1: the minimum image in the periodic x must stay unambiguous);
     returns the relative trajectory and the gaps."""
@@ -82,7 +82,8 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
                           first_step=(tol_lambda / 10 if tol_lambda > 0 else 0.0, 3000), n_particles=2,
                           tol_u=1e-5, tol_p=1e-4, acceleration=acceleration, tol_velocity=tol_velocity,
                           mean_flow_correction=mean_flow_correction)
-    pair = "fdm/subgrid%s wall ylo %r 0 0 wall yhi %r 0 0" % ("" if cutoff is None else " cutoff %g" % cutoff, -U, U)
+    pair = "fdm/subgrid model %s%s wall ylo %r 0 0 wall yhi %r 0 0" % (
+        model, "" if cutoff is None else " cutoff %g" % cutoff, -U, U)
     if not lubrication:
         pair += " lubrication no"
     if contact:
@@ -212,7 +213,7 @@ def main(argv=None):
         t = run_trajectory(args.workdir, ratio, ry, cont, args.a_over_delta, tuple(args.size), args.dt,
                            tol_lambda=args.tol_lambda, cutoff=args.cutoff, np_fluid=args.np_fluid, keep=args.keep,
                            gap_update=args.gap_update, integrator=args.integrator,
-                           r_x0=contact_r_x0 if cont else args.r_x0, acceleration=args.acceleration)
+                           r_x0=contact_r_x0 if cont else args.r_x0, acceleration=args.acceleration, model=args.model)
         s = summarise(t, cont[3] / a1 if cont else None)
         s.update(ratio=ratio, r_y0=ry, contact=bool(cont), wall_seconds=t["wall_seconds"], steps=t["steps"],
                  inner_iterations_mean=t["inner_iterations_mean"], unconverged_steps=t["unconverged_steps"],

@@ -76,11 +76,6 @@ def theory_velocity(kind: str, ratio: float, gap: float) -> float:
     return theory.pair_squeeze_velocity(1.0, ratio, gap)
 
 
-def extrapolate_box(v1: np.ndarray, v2: np.ndarray, L1: float, L2: float) -> np.ndarray:
-    """V at an infinite box from two sizes, with V(L) = V_inf + c L^-3."""
-    return v2 + (v2 - v1) * L1 ** 3 / (L2 ** 3 - L1 ** 3)
-
-
 @dataclass
 class SqueezeCalibration:
     """One (kind, a/Delta, ratio): measurements, their fit and the correction."""
@@ -98,7 +93,7 @@ class SqueezeCalibration:
     def velocity_inf(self) -> np.ndarray:
         """Box-extrapolated, offset-averaged V_hat_FDM."""
         L1, L2 = self.boxes[0], self.boxes[1]
-        return extrapolate_box(self.mean_velocity(L1), self.mean_velocity(L2), L1, L2)
+        return squeeze.extrapolate_box(self.mean_velocity(L1), self.mean_velocity(L2), L1, L2)
 
     def spread(self) -> np.ndarray:
         """Relative spread (max - min over the offsets, over the mean) at the largest box."""
@@ -216,8 +211,10 @@ def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str) -> 
     return " ".join(words)
 
 
-def write_table(path: str, calibrations: Sequence[SqueezeCalibration], command: str) -> None:
-    """The text table CalibratedSubgridModel reads (dem/resistance/src/squeeze_calibration.cpp)."""
+def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Sequence[Dict],
+                tables: Sequence[List[tuple]], command: str) -> None:
+    """The text table CalibratedSubgridModel reads (dem/resistance/src/squeeze_calibration.cpp): per
+    calibration its fit and its rows (SqueezeCalibration.fit, .table)."""
     with open(path, "w") as f:
         f.write("# Squeeze calibration of the fictitious-domain solver (paper Appendix B; docs/resistance.md)\n")
         f.write("# s_hat(xi) = 1/V_th - 1/V_FDM: the squeeze resistance the sub-grid block adds, in units of\n")
@@ -226,27 +223,25 @@ def write_table(path: str, calibrations: Sequence[SqueezeCalibration], command: 
         f.write("# Regenerate: %s\n" % regenerate_command(calibrations, project_relative(path)))
         if "--from-raw" in command:
             f.write("# (this file was analysed from the measurements kept by earlier calls: --from-raw)\n")
-        for c in calibrations:
-            write_block(f, c)
+        for c, fit, rows in zip(calibrations, fits, tables):
+            write_block(f, c, fit, rows)
 
 
-def write_block(f, c: SqueezeCalibration) -> None:
-    fit = c.fit()
-    rows = c.table(fit)
+def write_block(f, c: SqueezeCalibration, fit: Dict[str, float], rows: List[tuple]) -> None:
     f.write("%s %.6g %.6g %d %.6g %.6g %.6g %.6g %.4g\n" % (c.kind, c.a_over_delta, c.ratio, len(rows), fit["r_0"],
                                                         fit["r_inf"], fit["xi_1"], fit["p"], fit["rms_rel"]))
     for xi, v in rows:
         f.write("%.8e %.8e\n" % (xi, v))
 
 
-def summary(c: SqueezeCalibration) -> Dict:
-    fit = c.fit()
+def summary(c: SqueezeCalibration, fit: Dict[str, float], table: List[tuple]) -> Dict:
+    """What the .json beside the table keeps of one calibration."""
     v_inf = c.velocity_inf()
     v_th = c.theory()
     return dict(kind=c.kind, a_over_delta=c.a_over_delta, ratio=c.ratio, gaps=c.gaps, boxes=c.boxes,
                 velocities=c.velocities, velocity_inf=v_inf.tolist(), velocity_theory=v_th.tolist(),
                 spread=c.spread().tolist(), fit=fit,
-                correction=[c.correction(g, fit) for g in c.gaps], xi_max=c.table(fit)[-1][0],
+                correction=[c.correction(g, fit) for g in c.gaps], xi_max=table[-1][0],
                 wall_seconds=c.wall_seconds)
 
 
@@ -312,16 +307,17 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                 cals.append(measure(kind, ad, ratio, args.workdir, boxes=args.boxes, offsets=OFFSETS[:args.offsets]))
                 with open(raw_path, "w") as f:   # kept before any analysis
                     json.dump([c.__dict__ for c in cals], f)
-    for c in cals:
-        s = summary(c)
+    fits = [c.fit() for c in cals]
+    tables = [c.table(fit) for c, fit in zip(cals, fits)]
+    summaries = [summary(c, fit, table) for c, fit, table in zip(cals, fits, tables)]
+    for c, s in zip(cals, summaries):
         fit = s["fit"]
         print("%s a1/Delta %g a2/a1 %g: %.0f s, fit r_0 %.4f xi_1 %.4f p %.3f (rms %.2f %%, max %.2f %%), "
               "correction up to xi %.3g" % (c.kind, c.a_over_delta, c.ratio, c.wall_seconds, fit["r_0"], fit["xi_1"],
                                             fit["p"], 100 * fit["rms_rel"], 100 * fit["max_rel"], s["xi_max"]),
               flush=True)
     command = "python3 -m fdmsubgrid.calibration " + " ".join(argv if argv is not None else sys.argv[1:])
-    write_table(args.out, cals, command)
-    summaries = [summary(c) for c in cals]
+    write_table(args.out, cals, fits, tables, command)
     json_path = os.path.splitext(args.out)[0] + ".json"
     with open(json_path, "w") as f:
         json.dump(summaries, f, indent=1)

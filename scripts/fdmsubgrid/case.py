@@ -278,12 +278,14 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     return wall
 
 
-def add_run_options(parser, case_dir, tol_lambda, cutoff=False):
+def add_run_options(parser, case_dir, tol_lambda, cutoff=False, model=False):
     """The options every coupled case's script shares: --tol-lambda, --acceleration, --np-fluid,
-    --workdir, --out, --keep (and --cutoff for the cases with pair_style fdm/subgrid)."""
+    --workdir, --out, --keep; with cutoff, --cutoff and --model (pair_style fdm/subgrid's cut-off and
+    sub-grid model; model=True gives --model alone)."""
     if cutoff:
         parser.add_argument("--cutoff", type=float, default=None,
                             help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
+    if cutoff or model:
         parser.add_argument("--model", choices=("cutoff", "calibrated"), default="cutoff",
                             help="pair_style fdm/subgrid model: the cut-off model or the squeeze calibration "
                                  "(docs/dem.md)")

@@ -16,6 +16,8 @@ import os
 import shutil
 from typing import Sequence
 
+import numpy as np
+
 from . import case
 
 # Where the scene sits inside its first mesh cell (fractions of Delta along x, y, z): off the mesh's
@@ -31,6 +33,20 @@ def add_options(parser) -> None:
     parser.add_argument("--box-extrapolate", type=float, metavar="L2", default=None,
                         help="also run in a box of side L2 (> L; a wall scene's H scaled with it) and report the "
                              "velocities extrapolated to an infinite box (V = V_inf + c L^-3)")
+
+
+def _fresh_run_dir(workdir: str, name: str) -> str:
+    """<workdir>/<name>, emptied of an earlier run."""
+    run_dir = os.path.join(workdir, name)
+    if os.path.isdir(run_dir):
+        shutil.rmtree(run_dir)
+    return run_dir
+
+
+def _result(velocity, wall_seconds: float, box, steps) -> dict:
+    """What run_pair and run_wall return."""
+    return dict(velocity=[float(v) for v in velocity], wall_seconds=wall_seconds, cells=box.n[0] * box.n[1] * box.n[2],
+                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
 
 
 def _pair_style(subgrid: bool, cutoff: float | None, extra: str) -> str:
@@ -64,10 +80,7 @@ def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_
     L = L_over_a * a1
     eta = 1.0
     F = 6 * math.pi * eta * a1
-    name = "lambda%g_ad%g_L%g_%s" % (ratio, a_over_delta, L_over_a, _tag(subgrid, offset))
-    run_dir = os.path.join(workdir, name)
-    if os.path.isdir(run_dir):
-        shutil.rmtree(run_dir)
+    run_dir = _fresh_run_dir(workdir, "lambda%g_ad%g_L%g_%s" % (ratio, a_over_delta, L_over_a, _tag(subgrid, offset)))
     box = case.Box((0, 0, 0), (L, L, L), delta)
     centre = [L / 2 + o * delta for o in offset]
 
@@ -94,9 +107,7 @@ def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_
     wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     U1 = parts["Ux"][parts["tag"] == 1]
     U2 = parts["Ux"][parts["tag"] == 2]
-    velocity = [float(v) for v in (U1 - U2) / (F / (6 * math.pi * eta * a1))]
-    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
-                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
+    return _result((U1 - U2) / (F / (6 * math.pi * eta * a1)), wall, box, steps)
 
 
 def run_wall(workdir: str, epss: Sequence[float], subgrid: bool, a_over_delta: float = 4.0, L_over_a: float = 8.0,
@@ -111,10 +122,7 @@ def run_wall(workdir: str, epss: Sequence[float], subgrid: bool, a_over_delta: f
     L, H = L_over_a * a, H_over_a * a
     eta = 1.0
     F = 6 * math.pi * eta * a
-    name = "ad%g_L%g_H%g_%s" % (a_over_delta, L_over_a, H_over_a, _tag(subgrid, offset))
-    run_dir = os.path.join(workdir, name)
-    if os.path.isdir(run_dir):
-        shutil.rmtree(run_dir)
+    run_dir = _fresh_run_dir(workdir, "ad%g_L%g_H%g_%s" % (a_over_delta, L_over_a, H_over_a, _tag(subgrid, offset)))
     box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
     x, z = L / 2 + offset[0] * delta, L / 2 + offset[2] * delta
 
@@ -133,18 +141,19 @@ def run_wall(workdir: str, epss: Sequence[float], subgrid: bool, a_over_delta: f
                          before_run="fix             push all addforce 0 %r 0" % (-F), runs=runs,
                          name="in.wallSqueeze")
     wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
-    velocity = [float(v) for v in -parts["Uy"] / (F / (6 * math.pi * eta * a))]
-    return dict(velocity=velocity, wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
-                inner_iterations=[int(n) for n in steps["innerIterations"]], converged=bool(steps["converged"].all()))
+    return _result(-parts["Uy"] / (F / (6 * math.pi * eta * a)), wall, box, steps)
+
+
+def extrapolate_box(v1: np.ndarray, v2: np.ndarray, L1: float, L2: float) -> np.ndarray:
+    """V at an infinite box from the sizes L1 < L2, with V(L) = V_inf + c L^-3."""
+    return v2 + (v2 - v1) * L1 ** 3 / (L2 ** 3 - L1 ** 3)
 
 
 def box_extrapolated(first: dict, second: dict, L1: float, L2: float) -> dict:
     """The runs of one scene in boxes of side L1 < L2 (the wall scene: L and H scaled together)
     combined into the infinite-box velocities, V(L) = V_inf + c L^-3 (the images of a force dipole;
     checked against a third size in docs/validation.md): velocity is V_inf, velocity_by_box the two."""
-    import numpy as np
-    v1, v2 = np.array(first["velocity"]), np.array(second["velocity"])
-    v_inf = v2 + (v2 - v1) * L1 ** 3 / (L2 ** 3 - L1 ** 3)
+    v_inf = extrapolate_box(np.array(first["velocity"]), np.array(second["velocity"]), L1, L2)
     return dict(velocity=[float(v) for v in v_inf], velocity_by_box={"%g" % L1: first["velocity"],
                                                                      "%g" % L2: second["velocity"]},
                 wall_seconds=first["wall_seconds"] + second["wall_seconds"], cells=[first["cells"], second["cells"]],

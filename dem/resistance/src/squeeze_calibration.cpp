@@ -246,8 +246,9 @@ double CalibratedSubgridModel::wallRange(double a) const
 PairSubgridBase CalibratedSubgridModel::pair(double a1, double a2, double xi) const
 {
     PairSubgridBase b = pairCutoff_.pair(a1, a2, xi);  // zero beyond the cut-off's range
+    // s_hat >= 0 (the reader refuses negative rows, the weights are >= 0): the squeeze stays dissipative,
+    // and the other functions are the cut-off model's, already through makeDissipative
     b.f[BaseX21A] = -6 * pi * std::min(a1, a2) * calibration_.pairSHat(a1, a2, meshSize_, std::max(xi, minimumGap));
-    makeDissipative(b, 0.5 * (a1 + a2) * (2 + xi));
     return b;
 }
 

@@ -29,7 +29,7 @@ public:
         double aOverDelta, ratio;
         std::vector<double> logXi, xiS;  // ln xi and xi * s_hat(xi), increasing xi; the last xiS is 0
         double xiMax() const { return logXi.empty() ? 0 : std::exp(logXi.back()); }
-        double sHat(double xi) const;    // 0 from xiMax; xi floored at the first row
+        double sHat(double xi) const;    // 0 from xiMax; below the first row xi * s_hat is held
     };
 
     SqueezeCalibration() {}
