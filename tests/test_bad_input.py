@@ -364,3 +364,17 @@ def test_time_step_beyond_explicit_limit_with_implicit_springs(tmp_path, env):
                   r"normal spring of two spheres at the contact gap h_r\): stable with the implicit springs", dem)
     assert m and float(m.group(1)) > 1000 and 1e-4 < float(m.group(2)) < 1e-3, dem[-3000:]
     assert "ERROR" not in dem and "WARNING: pair_style fdm/subgrid: time step" not in dem
+
+
+def test_pressure_gradient_along_a_wall_normal(tmp_path, env):
+    """gradP0 along x in a box with walls normal to x: the walls would hold it as a hydrostatic
+    pressure and nothing flows (issue 12). fdmFoam refuses it at start, naming the entry, the value
+    and the direction."""
+    box = case.Box((0, 0, 0), (4, 4, 4), 0.5, faces=(((0, 0, 0), (0, 0, 0)), "cyclic", "cyclic"))
+    root = make_case(tmp_path, box=box)
+    status, out, wall = run_fdm(root, env)
+    assert status != 0
+    text = logs(root)
+    assert re.search(r"gradP0 \(-0.01 0 0\) Pa/m has a component along x, which is not periodic", text), text[-2000:]
+    assert "fdmProperties" in text
+    assert wall < 30

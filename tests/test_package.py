@@ -12,7 +12,8 @@ import pytest
 TESTS = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(TESTS)
 MODULES = ("calibration", "case", "checkpoint", "decomposition", "demonly", "environment", "output", "packing",
-           "periodicarray", "profiles", "rheology", "shear", "squeeze", "theory", "timeseries")
+           "periodicarray", "poiseuille", "profiles", "rheology", "sbm", "shear", "squeeze", "suspension", "theory",
+           "timeseries")
 
 
 def clean_environment() -> dict:

@@ -8,20 +8,10 @@ x and z are periodic. The suspension: spheres of radii a1 = 1 and a2 = 1.4 a1 in
 walls), sub-grid lubrication for pairs and walls, stresslets on. Units: a1 = 1 m, eta = 1 Pa s,
 gamma_dot_0 = 1 1/s (time = strain).
 
-The contact springs follow the rules of docs/contact.md ("A recipe"), computed and printed:
-  F_max = 6 pi eta a2^2 gamma_dot_0 eta_MP(phi)      the design load: the Stokes drag scale of the large
-                                                     sphere times the suspension's relative viscosity
-                                                     from the paper's Maron-Pierce fit (Eq. 55:
-                                                     alpha = 0.803, phi_m = 0.59)
-  k_n   = 2 F_max / h_r                              a contact under F_max sits at h = h_r/2 (recipe step 2)
-  k_t   = min(k_n, 0.5 zeta_t / dt)                  the tangential spring within half its explicit ab2
-                                                     limit: the implicit tangential springs are not stable
-                                                     at k_t dt/zeta_t of 100 or more in a suspension
-                                                     (docs/benchmarks.md, "Stability map": k_t = k_n
-                                                     blew up phi 0.47 at dt 0.02 within 10 steps)
-with zeta_n, zeta_t the normal and slip resistances of a free a1-a1 pair at the gap h_r/2 (Stokes drag
-plus the sub-grid block at this a1/Delta, fdmResistance); the time steps zeta_n/k_n and zeta_t/k_t
-that would bound explicit springs (ab2) are printed.
+The contact springs follow the rules of docs/contact.md ("A recipe", fdmsubgrid.suspension), computed
+and printed, with the design load F_max = 6 pi a2^2 tau for the shear stress tau = eta gamma_dot_0
+eta_MP(phi) (the relative viscosity from the paper's Maron-Pierce fit, Eq. 55: alpha = 0.803,
+phi_m = 0.59); the scene is written by fdmsubgrid.suspension.write_case, shared with cases/poiseuille.
 
   couette.py                         the small scene (about 40 spheres, 10 x 12 x 8 a1, a1/Delta = 3,
                                      3 strain units at dt = 0.02): a few minutes
@@ -33,26 +23,24 @@ Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png her
 """
 
 import argparse
-import math
 import os
 import shutil
 import sys
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output, packing, shear, theory  # noqa: E402
+from fdmsubgrid import case, packing, shear, suspension  # noqa: E402
 
-A1 = 1.0
-TANGENTIAL_SAFETY = 0.5       # k_t dt / zeta_t of the rule (docs/contact.md recipe step 4)
-A2 = packing.A2_OVER_A1 * A1
-ETA = 1.0
+A1 = suspension.A1
+A2 = suspension.A2
+ETA = suspension.ETA
 SHEAR_RATE = 1.0
-ROUGHNESS = 5e-3 * A1        # h_r (section 6)
-FRICTION = 0.5               # mu_s (section 6)
-MARON_PIERCE = (0.803, 0.59)  # alpha, phi_m of the paper's fit (Eq. 55, Fig. 21)
+ROUGHNESS = suspension.ROUGHNESS   # h_r (section 6)
+FRICTION = suspension.FRICTION     # mu_s (section 6)
+MARON_PIERCE = suspension.MARON_PIERCE
 
 # Table 8: phi_bulk -> (phi_core, gamma_core/gamma_0, (Lx, Ly, Lz)/a1, N_P, dt)
 TABLE8 = {
@@ -88,73 +76,25 @@ def time_step_warning(phi: float, dt: float) -> str | None:
             "spheres; a smaller --dt is safe" % (dt, reference, limit, beyond))
 
 
-@dataclass(frozen=True)
-class Springs:
-    """The contact parameters of pair_style fdm/subgrid and how they were chosen."""
-
-    kn: float
-    kt: float
-    mu_s: float
-    h_r: float
-    design_load: float
-    zeta_n: float
-    zeta_t: float
-    dt_limit_normal: float
-    dt_limit_tangential: float
-
-    def describe(self, dt: float) -> str:
-        return ("contact springs (docs/contact.md recipe): design load F_max = %.4g N, kn = 2 F_max/h_r = %.4g N/m, "
-                "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a1-a1 pair at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
-                "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential (the springs are implicit; "
-                "k_t is kept at half its limit), dt = %g is %.2f of the smaller"
-                % (self.design_load, self.kn, self.kt, self.mu_s, self.h_r / A1, self.zeta_n, self.zeta_t,
-                   self.dt_limit_normal, self.dt_limit_tangential, dt,
-                   dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
+def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None
+                   ) -> suspension.Springs:
+    """The springs by the rule of the module docstring (docs/contact.md) for the shear stress
+    eta gamma_dot_0 eta_MP(phi), unless given."""
+    return suspension.choose_springs(ETA * SHEAR_RATE * suspension.maron_pierce_viscosity(phi), dt, delta, kn, kt)
 
 
-def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None) -> Springs:
-    """The springs by the rule of the module docstring (docs/contact.md), unless given."""
-    alpha, phi_m = MARON_PIERCE
-    relative_viscosity = alpha / (1.0 - min(phi, 0.9 * phi_m) / phi_m) ** 2
-    design_load = 6 * math.pi * ETA * A2 ** 2 * SHEAR_RATE * relative_viscosity
-    zeta_n, zeta_t = theory.pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta, ETA)
-    kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
-    # k_t dt/zeta_t <= 0.5: stiffer implicit tangential springs blew up dense suspensions (growth x10
-    # per step at k_t dt/zeta_t ~ 300-400, docs/benchmarks.md "Stability map")
-    kt = min(kn, TANGENTIAL_SAFETY * zeta_t / dt) if kt is None else kt
-    return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
-
-
-def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, strain: float,
-               dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
-               text_dump: bool = False, model: str = "cutoff") -> dict:
-    """fluid/ and dem/ of the run; returns the scene's description. model: pair_style fdm/subgrid's
-    sub-grid model (cutoff, or calibrated: the squeeze calibration, docs/dem.md). The particles are recorded every
-    dump_every steps in dem/particles.records (fix fdm/output), and written for ParaView with the
-    fluid fields every write_every steps (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also
-    the LIGGGHTS text dump dem/particles.dump of the same steps (for comparisons)."""
-    delta = A1 / a_over_delta
-    Lx, Ly, Lz = (float(v) for v in pack.box)
-    U = SHEAR_RATE * Ly / 2
-    box = case.Box((0, 0, 0), (Lx, Ly, Lz), delta, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
+def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
+               strain: float, dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50,
+               write_every: int = 100000, text_dump: bool = False, model: str = "cutoff") -> dict:
+    """fluid/ and dem/ of the run (suspension.write_case with the walls at -U and +U); returns the
+    scene's description."""
+    U = SHEAR_RATE * float(pack.box[1]) / 2
     steps = int(round(strain / (SHEAR_RATE * dt)))
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=n_max,
-                          first_step=(tol_lambda / 10, 3000), n_particles=pack.n, tol_u=1e-5, tol_p=1e-3,
-                          acceleration=acceleration, write_interval=write_every)
-    pair = ("fdm/subgrid model %s contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
-            % (model, springs.kn, springs.kt, springs.mu_s, springs.h_r, -U, U))
-    spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]
-    runs = (["fix             output all fdm/output records %d particles.records vtk %d vtk"
-             % (dump_every, write_every)]
-            + (output.dump_custom_command("particles", dump_every, "particles.dump") if text_dump else [])
-            + ["thermo_style    custom step f_couple[1] f_couple[2] f_couple[6] f_couple[7] f_couple[8]",
-               "thermo          %d" % dump_every,
-               "run             %d upto" % steps])   # upto: a resumed run ends at the same step
-    # a checkpoint every 10 snapshots and at the end: fdmRun --resume continues a killed run (docs/coupling.md)
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
-                         fix_options="stresslets yes checkpoint %d walls walls.dat" % (10 * dump_every), runs=runs, name="in.couette")
-    return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
-                wall_velocity=U, dt=dt, dump_every=dump_every, write_every=write_every, subgrid_model=model)
+    scene = suspension.write_case(run_dir, pack, springs, a_over_delta, dt, steps, dump_every, tol_lambda,
+                                  acceleration, n_max, write_every, text_dump, model, wall_velocities=(-U, U),
+                                  name="in.couette")
+    scene.update(wall_velocity=U)
+    return scene
 
 
 def table8_row(phi: float) -> dict:
@@ -244,7 +184,6 @@ def main(argv: list[str] | None = None) -> dict:
     write_every = max(1, int(round(args.write_every / (SHEAR_RATE * dt))))
     scene = write_case(run_dir, pack, springs, args.a_over_delta, dt, args.strain, every, args.tol_lambda,
                        args.acceleration, args.n_max, write_every, args.text_dump, args.model)
-    packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
     print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
           "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
                               " x ".join("%g" % v for v in args.size), scene["cells"], scene["steps"], dt, every))

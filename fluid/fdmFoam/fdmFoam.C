@@ -98,6 +98,9 @@ int main(int argc, char *argv[])
         gradP0.value()
     );
 
+    meanFlowCorrection meanFlow(grid, U, nu.value(), correctMeanFlow);
+    Info<< meanFlow.description().c_str() << endl;
+
     #include "createOutput.H"
 
     // The inner iteration's acceleration and its stopping test
@@ -106,8 +109,6 @@ int main(int argc, char *argv[])
         andersonDepth, alphaLambda, alphaLambda/grid.delta()
     );
     innerConvergence convergence;
-    meanFlowCorrection meanFlow(grid, U, nu.value(), correctMeanFlow);
-    Info<< meanFlow.description().c_str() << endl;
     scalarList radii;
 
     scalar fluidTime = 0, particleTime = 0, outputTime = 0, checkpointTime = 0;

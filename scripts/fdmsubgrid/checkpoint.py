@@ -207,7 +207,7 @@ def truncate(case_dir, step):
     eps = 1e-9 * max(abs(t_step), 1e-300)
     summary = []
     # fdmFoam's records: by DEM step
-    for name in ("steps.dat", "particles.dat", "walls.dat"):
+    for name in ("steps.dat", "particles.dat", "walls.dat", "channelProfile.dat"):
         path = os.path.join(fluid, "postProcessing", "fdm", name)
         if os.path.isfile(path):
             summary.append("%s: %d lines after step %d removed" % (name, _cut_lines(path, lambda v: v <= step + 0.5),

@@ -51,6 +51,7 @@ class ShearRun:
     wall_velocities: tuple[float, float]   # x velocity of the walls y = 0 and y = L_y
     eta: float
     springs: dict
+    grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0)   # the imposed pressure gradient (Eqs. 42, 58)
 
     @property
     def cells(self) -> int:
@@ -99,7 +100,8 @@ def steps_planned(run_dir: str) -> int:
 def read_run(run_dir: str) -> ShearRun:
     """The scene of a run folder from its own files: dem/packing.data (the spheres), fluid/system/
     blockMeshDict (the mesh), fluid/constant/transportProperties (eta = nu rho), the LIGGGHTS input
-    (time step, steps, wall velocities and contact springs of pair_style fdm/subgrid)."""
+    (time step, steps, wall velocities and contact springs of pair_style fdm/subgrid), fluid/constant/
+    fdmProperties (the imposed pressure gradient gradP0, zero if absent)."""
     pack = packing.read_data(os.path.join(run_dir, "dem", "packing.data"), walls=(1,))
     mesh_path = os.path.join(run_dir, "fluid", "system", "blockMeshDict")
     found = re.search(r"hex \([\d ]+\) \((\d+) (\d+) (\d+)\)", _read(mesh_path))
@@ -124,10 +126,13 @@ def read_run(run_dir: str) -> ShearRun:
                              "UX UY UZ" % path)
     contact = re.search(r"fdm/subgrid\b[^\n]*?\bcontact (\S+) (\S+) (\S+) (\S+)", dem)
     springs = dict(zip(("kn", "kt", "mu_s", "h_r"), (float(v) for v in contact.groups()))) if contact else {}
+    properties_path = os.path.join(run_dir, "fluid", "constant", "fdmProperties")
+    grad = re.search(r"^\s*gradP0\s+\(([^)]*)\)\s*;", _read(properties_path), re.M)
+    grad_p0 = tuple(float(v) for v in grad.group(1).split()) if grad else (0.0, 0.0, 0.0)
     return ShearRun(run_dir=run_dir, packing=pack, box=tuple(float(v) for v in pack.box), mesh=mesh,
                     dt=float(dt.group(1)), steps_planned=_run_steps(dem, path),
                     wall_velocities=(walls["ylo"], walls["yhi"]), eta=values["nu"] * values["rho"],
-                    springs=springs)
+                    springs=springs, grad_p0=grad_p0)
 
 
 def run_seconds(run_dir: str, steps: dict | None = None) -> tuple[float, int]:

@@ -107,6 +107,33 @@ Foam::string Foam::meanFlowCorrection::description() const
 }
 
 
+Foam::List<Foam::vector> Foam::meanFlowCorrection::planeAverages
+(
+    const volVectorField& U
+) const
+{
+    const label n = nPlanes();
+    List<vector> averages(n, Zero);
+    if (!active())
+    {
+        return averages;
+    }
+    forAll(U, celli)
+    {
+        averages[plane_[celli]] += U[celli];
+    }
+    Pstream::listCombineGather(averages, plusEqOp<vector>());
+    Pstream::listCombineScatter(averages);
+    const Vector<label>& nCells = grid_.nCells();
+    const scalar cellsPerPlane = scalar(nCells.x())*nCells.y()*nCells.z()/n;
+    forAll(averages, j)
+    {
+        averages[j] /= cellsPerPlane;
+    }
+    return averages;
+}
+
+
 void Foam::meanFlowCorrection::correct
 (
     volVectorField& U,

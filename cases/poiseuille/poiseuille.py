@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""A frictional bidisperse suspension driven through a plane channel by a pressure gradient (paper
+section 6.2, Eqs. 58-63, Fig. 23): shear-induced migration toward the centre, its profiles, the momentum
+balance and the Suspension Balance Model.
+
+Walls y = 0 and y = L_y at rest, x and z periodic, the uniform pressure gradient dP0/dx = -8 eta U_c/L_y^2
+(Eq. 58) with U_c = L_y/4 (units a1 = 1 m, eta = 1 Pa s: the Newtonian wall shear rate 4 U_c/L_y and the
+wall shear stress tau_w = |dP0/dx| L_y/2 are 1). Times in units of L_y/(2 U_c) (= 2 s). The suspension
+and its contact (h_r = 5e-3 a1, mu_s = 0.5, sub-grid lubrication, stresslets) as in cases/couette, the
+scene written by the same code (fdmsubgrid.suspension); the springs by docs/contact.md's rule for the
+wall shear stress tau_w.
+
+  poiseuille.py                 the small channel (8 x 12 x 8 a1, phi_bulk 0.45, a1/Delta = 3, 40 time
+                                units at dt 0.05): migration begins; about 15 minutes
+  poiseuille.py --duration 2    a few steps (the CI test)
+  poiseuille.py --paper         writes the paper's (40, 40, 20) a1 channel (not run; --run runs it)
+  poiseuille.py --analyse RUN   the analysis of a run folder as it stands
+  poiseuille.py --help          every option
+Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_poiseuille.png here (docs/cases.md).
+The migration time grows as L_y^2: the paper reached the steady state after about 1500 time units at
+L_y = 40 a1 (docs/validation.md, "Pressure-driven flow").
+"""
+
+import argparse
+import os
+import shutil
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
+from fdmsubgrid import case, packing, poiseuille, sbm, suspension  # noqa: E402
+
+PAPER_SIZE = (40.0, 40.0, 20.0)       # (L_x, L_y, L_z)/a1, section 6.2
+PAPER_DT = 1e-3                       # L_y/(2 U_c)
+NEWTONIAN_WALL_SHEAR_RATE = 1.0       # 4 U_c/L_y: sets U_c = L_y/4
+
+
+def pressure_gradient(width: float) -> tuple[float, float]:
+    """(dP0/dx, U_c) of Eq. (58) for the channel width L_y, with U_c = L_y/4."""
+    u_c = NEWTONIAN_WALL_SHEAR_RATE * width / 4
+    return -8 * suspension.ETA * u_c / width ** 2, u_c
+
+
+def main(argv: list[str] | None = None) -> dict:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--phi", type=float, default=0.45, help="phi_bulk (section 6.2: 0.45)")
+    p.add_argument("--size", type=float, nargs=3, default=[8.0, 12.0, 8.0], metavar=("LX", "LY", "LZ"),
+                   help="channel in units of a1 (walls normal to y); each a whole number of cells")
+    p.add_argument("--paper", action="store_true", help="the paper's (40, 40, 20) a1 channel: written, not run "
+                   "(with --run, run)")
+    p.add_argument("--run", action="store_true", help="with --paper: run it too")
+    p.add_argument("--a-over-delta", type=float, default=3.0, help="a1/Delta, mesh cells per small radius")
+    p.add_argument("--dt", type=float, default=0.05, help="time step in units of L_y/(2 U_c)")
+    p.add_argument("--duration", type=float, default=40.0, help="time to run, in units of L_y/(2 U_c)")
+    p.add_argument("--seed", type=int, default=1, help="seed of the random packing")
+    p.add_argument("--dump-every", type=float, default=0.5, help="time between two particle snapshots")
+    p.add_argument("--write-every", type=float, default=20.0, help="time between two writes of the fluid fields "
+                   "and the particles' ParaView files")
+    p.add_argument("--kn", type=float, default=None, help="normal spring [N/m] (default: the rule)")
+    p.add_argument("--kt", type=float, default=None, help="tangential spring [N/m] (default: the rule)")
+    p.add_argument("--n-max", type=int, default=50, help="fdmFoam's innerIterations nMax")
+    p.add_argument("--np-dem", type=int, default=1, help="MPI ranks of fdmDEM")
+    p.add_argument("--couette", nargs="+", default=None, metavar="RESULTS_JSON",
+                   help="fit the SBM's material functions from these Couette results (default: the paper's "
+                        "Maron-Pierce viscosity and Sigma_hat_22 = -0.8 (phi/phi_m)^2, fdmsubgrid.sbm)")
+    p.add_argument("--from-time", type=float, default=None, help="average from this time on (default: the end of "
+                   "the migration transient by the MSER rule)")
+    p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
+    p.add_argument("--analyse", metavar="RUN_DIR", default=None, help="analyse this run folder as it stands")
+    case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
+    args = p.parse_args(argv)
+    material = sbm.from_couette_results(args.couette) if args.couette else None
+
+    if args.analyse:
+        return report(args.analyse, args.out, material, args.from_time)
+
+    if args.paper:
+        args.size = list(PAPER_SIZE)
+    delta = suspension.A1 / args.a_over_delta
+    for L, name in zip(args.size, "xyz"):
+        if abs(L / delta - round(L / delta)) > 1e-9 * L / delta:
+            p.error("--size: L%s = %g a1 is not a whole number of cells of a1/%g" % (name, L, args.a_over_delta))
+    if args.duration <= 0 or args.dt <= 0:
+        p.error("--duration and --dt must be positive")
+    if not 0 < args.phi < 0.6:
+        p.error("--phi %g: a random packing needs 0 < phi_bulk < 0.6" % args.phi)
+
+    width = float(args.size[1])
+    grad, u_c = pressure_gradient(width)
+    time_unit = width / (2 * u_c)
+    dt = args.dt * time_unit
+    pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
+                                   wall_gap=2 * suspension.ROUGHNESS)
+    print("packing:", pack.summary())
+    tau_w = abs(grad) * width / 2
+    springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt)
+    print(springs.describe(dt))
+
+    name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (args.phi, *args.size, args.a_over_delta, args.dt, args.seed,
+                                                  "" if args.model == "cutoff" else "_" + args.model)
+    run_dir = os.path.join(args.workdir, name)
+    if os.path.exists(run_dir):
+        if not args.overwrite:
+            raise SystemExit("poiseuille: %s already holds a run; --overwrite replaces it" % run_dir)
+        shutil.rmtree(run_dir)
+    steps = int(round(args.duration / args.dt))
+    every = max(1, int(round(args.dump_every / args.dt)))
+    write_every = max(1, int(round(args.write_every / args.dt)))
+    scene = suspension.write_case(run_dir, pack, springs, args.a_over_delta, dt, steps, every, args.tol_lambda,
+                                  args.acceleration, args.n_max, write_every, model=args.model,
+                                  grad_p0=(grad, 0.0, 0.0), name="in.poiseuille")
+    print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, channel %s a1, %d cells, dP0/dx = %.4g Pa/m (U_c = %g), "
+          "%d steps of dt %g L_y/(2U_c), a snapshot every %d steps"
+          % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
+             " x ".join("%g" % v for v in args.size), scene["cells"], grad, u_c, steps, args.dt, every))
+    if args.paper and not args.run:
+        print("the paper's channel written, not run: fdmRun -f N -d M %s" % run_dir)
+        return dict(run_dir=run_dir, **scene)
+
+    case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
+    results = report(run_dir, args.out, material, args.from_time)
+    if not args.keep:
+        fluid = os.path.join(run_dir, "fluid")
+        shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
+        for d in os.listdir(fluid):
+            if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
+                shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+    return results
+
+
+def report(run_dir: str, out: str, material=None, from_time=None) -> dict:
+    """Analyse a run folder (fdmsubgrid.poiseuille.analyse), write `out` and the figure beside it."""
+    import json
+    results, fig = poiseuille.analyse(run_dir, material, from_time)
+    results.update(case="poiseuille", run=os.path.basename(os.path.normpath(run_dir)), run_dir=os.path.abspath(run_dir))
+    figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_poiseuille.png")
+    poiseuille.plot(figure, fig)
+    results["figure"] = os.path.basename(figure)
+    with open(out, "w") as f:
+        json.dump(results, f, indent=1)
+    for k in ("phi_bulk", "time", "steady_from", "phi_center", "phi_center_initial", "phi_wall_layer",
+              "jammed_width_over_a1", "u_center_star", "shear_stress_linearity_rel_error",
+              "shear_stress_linearity_wall_layer_rel_error", "wall_force_balance_rel_error", "wall_shear_stress_asymmetry", "sbm_phi_rms_diff",
+              "sbm_u_rms_diff", "inner_iterations_mean", "unconverged_steps", "wall_seconds"):
+        print("%-45s %s" % (k, results[k]))
+    print("wrote %s and %s" % (out, figure))
+    return results
+
+
+if __name__ == "__main__":
+    main()

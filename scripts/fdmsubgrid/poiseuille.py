@@ -1,0 +1,282 @@
+"""Pressure-driven suspension flow (paper section 6.2, Eqs. 58-63): the profiles, the migration and the
+momentum balance of a run folder of cases/poiseuille, and the comparison with the Suspension Balance
+Model (fdmsubgrid.sbm).
+
+The channel: walls at rest at y = 0 and y = L_y, x and z periodic, the uniform pressure gradient
+dP0/dx = -8 eta U_c/L_y^2 (Eq. 58). Times are in units of L_y/(2 U_c), velocities u* = u/(2 U_c) and
+y* = (y - L_y/2)/L_y (Eq. 61).
+
+What `analyse` measures (docs/profiles.md, "Pressure-driven flow"):
+- the migration transient: phi in the central slab |y*| < a1/L_y (2 a1 wide) and in the wall layers
+  (within 2.5 a1 of either wall) at every particle snapshot; the steady part starts where the MSER rule
+  puts the end of the central series' transient (fdmsubgrid.timeseries), or at a given time;
+- the steady profiles, time-averaged with block-averaging errors: fine (planes every 0.02 a1) and coarse
+  (bins of width a1, Eq. 60) phi(y) (Eq. 49) and u_p*(y) (Eqs. 59, 61), Sigma^c_yy(y) and Sigma_xy(y);
+- the momentum balance: in steady Stokes flow the total shear stress is exactly Sigma_xy(y) =
+  (dP0/dx)(y - L_y/2). Its parts on the cell faces: the fluid term eta d<u>/dy from the plane averages
+  of the whole velocity field (fluid and rigid particle interiors, fdmFoam's channelProfile.dat), and
+  the particle terms Sigma^h_xy + Sigma^c_xy of Eq. 53; the deviation from the line, over the wall
+  stress tau_w = |dP0/dx| L_y/2, in the core and in the wall layers. The line is anchored at the walls'
+  own shear stresses (fluid + sub-grid + contact, every step): the slab between a wall and the plane y
+  balances exactly, Sigma_xy(y) = tau_lo + (dP0/dx)(y - y_lo), and tau_lo - tau_hi = 2 tau_w (the
+  wall force balance, reported); tau_lo + tau_hi vanishes only in a symmetric state (the wall
+  asymmetry, reported);
+- the jammed zone: the width of the central coarse bins where phi >= phi_m;
+- the SBM (Eqs. 62a, 62b, 63) solved over the region 2.5 a1 from the walls with the measured mean phi of
+  that region and the measured u_p* at its edge; the rms differences of phi and u* from the coarse
+  profiles inside it.
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import output, profiles, rheology, sbm, shear, timeseries
+
+CENTRAL_HALF_WIDTH = 1.0        # a1: the central slab of the migration series
+WALL_LAYER = sbm.LAYER_OVER_A1  # a1: the wall layers (the region the SBM leaves out)
+MIN_SNAPSHOTS = 8
+
+
+class PoiseuilleRunError(ValueError):
+    """A run folder that is not a pressure-driven channel; the message names the file."""
+
+
+@dataclass(frozen=True)
+class Scales:
+    """The flow's scales from its pressure gradient: G = dP0/dx, U_c = -G L_y^2/(8 eta) (Eq. 58),
+    tau_w = |G| L_y/2, the time unit L_y/(2 U_c)."""
+
+    grad: float
+    u_c: float
+    tau_w: float
+    time_unit: float
+    width: float
+
+
+def scales(run: shear.ShearRun) -> Scales:
+    """The scales of a run, after checking it is a pressure-driven channel (walls at rest, dP0/dx < 0
+    along the flow axis x, no gradient along the walls' normal)."""
+    path = os.path.join(run.run_dir, "fluid", "constant", "fdmProperties")
+    g = run.grad_p0
+    if not (g[0] < 0 and g[1] == 0):
+        raise PoiseuilleRunError("%s: gradP0 = (%g %g %g) Pa/m: a pressure-driven channel needs dP0/dx < 0 along x "
+                                 "and none along the walls' normal y" % (path, *g))
+    if any(abs(u) > 0 for u in run.wall_velocities):
+        raise PoiseuilleRunError("%s: the walls move (%g, %g): a pressure-driven channel has walls at rest"
+                                 % (shear.dem_input(run.run_dir), *run.wall_velocities))
+    width = float(run.box[1])
+    u_c = -g[0] * width ** 2 / (8 * run.eta)
+    return Scales(grad=float(g[0]), u_c=u_c, tau_w=abs(g[0]) * width / 2, time_unit=width / (2 * u_c), width=width)
+
+
+def read_channel_profile(run_dir: str) -> dict:
+    """fdmFoam's channelProfile.dat: step (T,), time (T,), u (T, n, 3) the plane averages of U over the n
+    cell planes from the low wall up, delta the cell width."""
+    path = os.path.join(run_dir, "fluid", "postProcessing", "fdm", "channelProfile.dat")
+    if not os.path.isfile(path):
+        raise PoiseuilleRunError("%s not found: fdmFoam writes it in a channel with the mean-flow correction on "
+                                 "(innerIterations { meanFlowCorrection yes; }, the default)" % path)
+    with open(path) as f:
+        header = f.readline()
+        text = f.read()
+    try:
+        n = int(header.split("over the ")[1].split()[0])
+        delta = float(header.split("cell width ")[1].split()[0])
+    except (IndexError, ValueError):
+        raise PoiseuilleRunError("%s: the header does not give the planes and the cell width" % path) from None
+    text = text[:text.rfind("\n") + 1] if not text.endswith("\n") else text
+    data = np.loadtxt(text.splitlines(), ndmin=2) if text.strip() else np.zeros((0, 2 + 3 * n))
+    if data.shape[1] != 2 + 3 * n:
+        raise PoiseuilleRunError("%s: %d columns, expected %d (step, time, 3 per plane)" % (path, data.shape[1],
+                                                                                            2 + 3 * n))
+    return dict(step=data[:, 0].astype(int), time=data[:, 1], u=data[:, 2:].reshape(-1, n, 3), delta=delta)
+
+
+def fluid_shear_stress(profile: dict, eta: float, selected: NDArray) -> tuple[NDArray, NDArray]:
+    """(faces y (n+1,), eta d<u_x>/dy on them) averaged over the selected steps (bool (T,)): centred
+    differences between the planes' centres, and from the wall (at rest) to the first centre."""
+    u = profile["u"][selected, :, 0].mean(axis=0)
+    d = profile["delta"]
+    n = len(u)
+    faces = d * np.arange(n + 1)
+    slope = np.empty(n + 1)
+    slope[1:-1] = np.diff(u) / d
+    slope[0] = u[0] / (0.5 * d)
+    slope[-1] = -u[-1] / (0.5 * d)
+    return faces, eta * slope
+
+
+def _layer_mask(y: NDArray, channel: profiles.Channel) -> NDArray:
+    return (y - channel.y_lo < WALL_LAYER - 1e-9) | (channel.y_hi - y < WALL_LAYER - 1e-9)
+
+
+def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None) -> tuple[dict, dict]:
+    """The results of a run (a flat dict, the keys of cases/poiseuille/results.json) and what the figure
+    needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions)."""
+    run = shear.read_run(run_dir)
+    sc = scales(run)
+    channel = run.channel
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    if len(steps["time"]) == 0:
+        raise PoiseuilleRunError("%s/fluid/postProcessing/fdm/steps.dat: no step recorded yet" % run_dir)
+    snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"), 1.0 / sc.time_unit)
+    if len(snapshots) < MIN_SNAPSHOTS:
+        raise ValueError("%s: %d particle snapshots are too few for time averages (%d at least): run longer"
+                         % (run_dir, len(snapshots), MIN_SNAPSHOTS))
+    times = np.array([s.time for s in snapshots])
+    mid = channel.y_mid
+    phi_center = np.array([profiles.volume_fraction(s, channel, mid - CENTRAL_HALF_WIDTH, mid + CENTRAL_HALF_WIDTH)
+                           for s in snapshots])
+    phi_walls = np.array([0.5 * (profiles.volume_fraction(s, channel, channel.y_lo, channel.y_lo + WALL_LAYER)
+                                 + profiles.volume_fraction(s, channel, channel.y_hi - WALL_LAYER, channel.y_hi))
+                          for s in snapshots])
+    phi_integral = np.array([profiles.volume_fraction(s, channel) for s in snapshots])
+    if from_time is not None:
+        start = int(np.searchsorted(times, from_time - 1e-9))
+        steady_detected = True
+    elif len(snapshots) >= 4 * timeseries.MIN_BLOCKS:
+        tr = timeseries.detect_transient(phi_center, times)
+        start, steady_detected = tr.start, tr.steady
+    else:
+        start, steady_detected = len(snapshots) // 2, False
+    start = min(start, len(snapshots) - MIN_SNAPSHOTS)
+    t0 = float(times[start])
+    kept = snapshots[start:]
+
+    coarse = profiles.average_profiles(kept, channel)
+    fine = profiles.average_profiles(kept, channel, y=channel.planes(0.02), errors=False)
+    xy, yy = profiles.component(0, 1), profiles.component(1, 1)
+
+    # momentum balance on the cell faces
+    prof = read_channel_profile(run_dir)
+    sel = prof["time"] / sc.time_unit >= t0 - 1e-9
+    faces, fluid = fluid_shear_stress(prof, run.eta, sel)
+    particle = profiles.average_profiles(kept, channel, y=faces + channel.y_lo, errors=False)
+    total = fluid + particle.sigma_p[:, xy]
+    loads = output.read_wall_loads(run_dir)
+    tau = rheology.wall_shear_stresses(loads, channel)["total"]
+    wsel = np.asarray(loads.times, dtype=float) / sc.time_unit >= t0 - 1e-9
+    tau_lo, tau_hi = (float(v) for v in tau[wsel].mean(axis=0))
+    # the exact balance of the slab between a wall and the plane y: Sigma_xy(y) = tau_lo + G (y - y_lo)
+    # = tau_hi + G (y - y_hi); the mean of the two. It is G (y - y_mid) once the two walls carry equal
+    # loads (a symmetric steady state); their difference is the wall asymmetry
+    y_abs = faces + channel.y_lo
+    line = 0.5 * (tau_lo + sc.grad * (y_abs - channel.y_lo) + tau_hi + sc.grad * (y_abs - channel.y_hi))
+    deviation = np.abs(total - line) / sc.tau_w
+    layer = _layer_mask(y_abs, channel)
+
+    # the central coarse bins at phi_m or above
+    phi_m = (material or sbm.MaterialFunctions.maron_pierce_power_law()).phi_m
+    jammed = coarse.phi >= phi_m
+    widths = np.diff(coarse.edges)
+    centre = int(np.argmin(np.abs(coarse.y - mid)))
+    jammed_width = 0.0
+    if jammed[centre]:
+        lo = centre
+        while lo > 0 and jammed[lo - 1]:
+            lo -= 1
+        hi = centre
+        while hi < len(jammed) - 1 and jammed[hi + 1]:
+            hi += 1
+        jammed_width = float(widths[lo:hi + 1].sum())
+
+    # the SBM over the region 2.5 a1 from the walls
+    y_star = lambda y: (np.asarray(y) - mid) / sc.width  # noqa: E731
+    u_star = lambda u: np.asarray(u) / (2 * sc.u_c)  # noqa: E731
+    region = (channel.y_lo + WALL_LAYER, channel.y_hi - WALL_LAYER)
+    phi_region = float(np.mean([profiles.volume_fraction(s, channel, *region) for s in kept]))
+    u_fine = u_star(fine.u_p[:, 0])
+    edge_u = float(np.nanmean(np.interp(region, fine.y, np.nan_to_num(u_fine))))
+    material = material or sbm.MaterialFunctions.maron_pierce_power_law()
+    model = sbm.solve(material, phi_region, y_edge=0.5 - WALL_LAYER / sc.width, u_edge=edge_u)
+    inside = (coarse.edges[:-1] >= region[0] - 1e-9) & (coarse.edges[1:] <= region[1] + 1e-9)
+    # the model averaged over each coarse bin, as the simulation's bins are
+    model_phi, model_u = [], []
+    for a, b in zip(coarse.edges[:-1][inside], coarse.edges[1:][inside]):
+        yy_ = np.linspace(y_star(a), y_star(b), 201)
+        p_, u_ = model.at(yy_)
+        model_phi.append(np.mean(p_))
+        model_u.append(np.sum(p_ * u_) / np.sum(p_))     # phi-weighted, as Eq. 59
+    model_phi, model_u = np.array(model_phi), np.array(model_u)
+    sbm_phi_rms = float(np.sqrt(np.mean((coarse.phi[inside] - model_phi) ** 2))) if inside.any() else math.nan
+    sbm_u_rms = float(np.sqrt(np.mean((u_star(coarse.u_p[inside, 0]) - model_u) ** 2))) if inside.any() else math.nan
+
+    wall_seconds, ranks = shear.run_seconds(run_dir, steps)
+    inner = steps["innerIterations"]
+    pack = run.packing
+    u_center = float(np.interp(mid, coarse.y, u_star(coarse.u_p[:, 0])))
+    results = dict(
+        phi_bulk=pack.phi, phi_bulk_integral_max_error=float(np.max(np.abs(phi_integral - pack.phi))),
+        L=list(run.box), time=float(times[-1]), steady_from=t0, steady_detected=bool(steady_detected),
+        snapshots_averaged=len(kept),
+        phi_center=float(np.mean(phi_center[start:])),
+        phi_center_err=float(timeseries.block_average(phi_center[start:]).error) if len(kept) >= 2 * timeseries.MIN_BLOCKS else math.nan,
+        phi_center_initial=float(phi_center[0]),
+        phi_wall_layer=float(np.mean(phi_walls[start:])),
+        phi_sbm_region=phi_region,
+        jammed_width_over_a1=jammed_width, phi_m=phi_m,
+        u_center_star=u_center, u_center_star_newtonian=0.5,
+        shear_stress_linearity_rel_error=float(np.max(deviation[~layer])),
+        shear_stress_linearity_wall_layer_rel_error=float(np.max(deviation[layer])),
+        wall_force_balance_rel_error=abs(tau_lo - tau_hi - 2 * sc.tau_w) / (2 * sc.tau_w),
+        wall_shear_stress_asymmetry=abs(tau_lo + tau_hi) / sc.tau_w,
+        sbm_phi_rms_diff=sbm_phi_rms, sbm_u_rms_diff=sbm_u_rms, sbm_jammed_width_over_a1=2 * model.y_jammed * sc.width,
+        sbm_material=material.describe,
+        grad_p0=sc.grad, u_c=sc.u_c, tau_w=sc.tau_w, time_unit=sc.time_unit,
+        cells=run.cells, mesh=list(run.mesh), n_particles=pack.n, n_a1=int(np.sum(pack.types == 1)),
+        n_a2=int(np.sum(pack.types == 2)), dt=run.dt / sc.time_unit, steps=int(len(inner)),
+        steps_planned=run.steps_planned, inner_iterations_mean=float(inner.mean()),
+        inner_iterations_max=int(inner.max()), unconverged_steps=int(np.sum(steps["converged"] == 0)),
+        wall_seconds=wall_seconds, ranks=ranks, core_seconds=wall_seconds * ranks, springs=dict(run.springs))
+    figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, times=times, phi_center=phi_center,
+                  phi_walls=phi_walls, model=model, faces=faces + channel.y_lo, total=total, fluid=fluid,
+                  particle=particle.sigma_p[:, xy], line=line, sigma_c_yy=coarse.sigma_c[:, yy], start=t0, phi_m=phi_m)
+    return results, figure
+
+
+def plot(path: str, fig: dict) -> str:
+    """The figure of a run (Fig. 23 and more): phi(y*) and u_p*(y*) fine and coarse with error bars and
+    the SBM and the Newtonian parabola; the migration transient; the shear stress against the line."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+    sc: Scales = fig["scales"]
+    ch: profiles.Channel = fig["channel"]
+    ys = lambda y: (np.asarray(y) - ch.y_mid) / sc.width  # noqa: E731
+    us = lambda u: np.asarray(u) / (2 * sc.u_c)  # noqa: E731
+    coarse, fine, model = fig["coarse"], fig["fine"], fig["model"]
+    f = Figure(figsize=(12, 8.5))
+    ax = f.subplots(2, 2)
+    a = ax[0, 0]
+    a.plot(ys(fine.y), fine.phi, ":", color="0.5", lw=0.8, label="simulation (fine)")
+    a.errorbar(ys(coarse.y), coarse.phi, yerr=coarse.phi_error, fmt="o", ms=4, capsize=2, label="simulation (bins a1)")
+    a.plot(model.y, model.phi, "-", color="C3", label="SBM (Eqs. 62-63)")
+    a.axhline(fig["phi_m"], color="0.7", lw=0.5, label="phi_m")
+    a.set_xlabel("y*"), a.set_ylabel("phi"), a.legend(fontsize=8), a.set_title("volume fraction")
+    a = ax[0, 1]
+    a.plot(ys(fine.y), us(fine.u_p[:, 0]), ":", color="0.5", lw=0.8, label="simulation (fine)")
+    a.errorbar(ys(coarse.y), us(coarse.u_p[:, 0]), yerr=us(coarse.u_p_error[:, 0]) if coarse.u_p_error is not None else None,
+               fmt="o", ms=4, capsize=2, label="simulation (bins a1)")
+    a.plot(model.y, model.u, "-", color="C3", label="SBM")
+    yy = np.linspace(-0.5, 0.5, 201)
+    a.plot(yy, (1 - 4 * yy ** 2) / 2, "--", color="0.6", label="Newtonian (1 - 4y*^2)/2")
+    a.set_xlabel("y*"), a.set_ylabel("u_p* = u_p/(2U_c)"), a.legend(fontsize=8), a.set_title("particle velocity")
+    a = ax[1, 0]
+    a.plot(fig["times"], fig["phi_center"], label="centre |y| < a1")
+    a.plot(fig["times"], fig["phi_walls"], label="wall layers (2.5 a1)")
+    a.axvline(fig["start"], color="0.6", ls="--", lw=0.8, label="steady from")
+    a.set_xlabel("t 2U_c/L_y"), a.set_ylabel("phi"), a.legend(fontsize=8), a.set_title("migration")
+    a = ax[1, 1]
+    a.plot(ys(fig["faces"]), fig["total"] / sc.tau_w, "o", ms=3, label="total")
+    a.plot(ys(fig["faces"]), fig["fluid"] / sc.tau_w, "-", lw=0.8, label="fluid eta d<u>/dy")
+    a.plot(ys(fig["faces"]), fig["particle"] / sc.tau_w, "-", lw=0.8, label="particles (Eq. 53)")
+    a.plot(ys(fig["faces"]), fig["line"] / sc.tau_w, "k--", lw=0.8, label="walls' stress + (dP0/dx) y")
+    a.set_xlabel("y*"), a.set_ylabel("Sigma_xy / tau_w"), a.legend(fontsize=8), a.set_title("momentum balance")
+    f.tight_layout()
+    f.savefig(path, dpi=110)
+    return path

@@ -1,0 +1,118 @@
+"""The scene of a frictional bidisperse suspension between two walls (paper section 6): the contact
+springs by the rules of docs/contact.md and the fluid and particle inputs of a run, shared by the
+Couette (cases/couette, section 6.1) and Poiseuille (cases/poiseuille, section 6.2) cases.
+
+Units: a1 = 1 m, eta = 1 Pa s. The suspension: spheres of radii a1 and a2 = 1.4 a1 in equal volumes
+(fdmsubgrid.packing.channel_packing), frictional contact with h_r = 5e-3 a1 and mu_s = 0.5 (pairs and
+walls), sub-grid lubrication for pairs and walls, stresslets on. The walls are normal to y, x and z
+periodic; each wall moves along x at its own speed, and a uniform pressure gradient may drive the flow.
+
+The contact springs (docs/contact.md, "A recipe"):
+  F_max = 6 pi a2^2 tau                              the design load: the Stokes drag scale of the large
+                                                     sphere under the suspension's shear stress tau
+                                                     (Couette: eta gamma_dot_0 eta_MP(phi), the relative
+                                                     viscosity from the paper's Maron-Pierce fit, Eq. 55;
+                                                     Poiseuille: the wall shear stress |dP0/dx| L_y/2)
+  k_n   = 2 F_max / h_r                              a contact under F_max sits at h = h_r/2 (recipe step 2)
+  k_t   = min(k_n, 0.5 zeta_t / dt)                  the tangential spring within half its explicit ab2
+                                                     limit: the implicit tangential springs are not stable
+                                                     at k_t dt/zeta_t of 100 or more in a suspension
+                                                     (docs/benchmarks.md, "Stability map")
+with zeta_n, zeta_t the normal and slip resistances of a free a1-a1 pair at the gap h_r/2 (Stokes drag
+plus the sub-grid block at this a1/Delta, fdmResistance).
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+from . import case, output, packing, theory
+
+A1 = 1.0
+A2 = packing.A2_OVER_A1 * A1
+ETA = 1.0
+ROUGHNESS = 5e-3 * A1         # h_r (section 6)
+FRICTION = 0.5                # mu_s (section 6)
+MARON_PIERCE = (0.803, 0.59)  # alpha, phi_m of the paper's fit (Eq. 55, Fig. 21)
+TANGENTIAL_SAFETY = 0.5       # k_t dt / zeta_t of the rule (docs/contact.md recipe step 4)
+
+
+def maron_pierce_viscosity(phi: float) -> float:
+    """The paper's relative viscosity (Eq. 55), held finite above 0.9 phi_m."""
+    alpha, phi_m = MARON_PIERCE
+    return alpha / (1.0 - min(phi, 0.9 * phi_m) / phi_m) ** 2
+
+
+@dataclass(frozen=True)
+class Springs:
+    """The contact parameters of pair_style fdm/subgrid and how they were chosen."""
+
+    kn: float
+    kt: float
+    mu_s: float
+    h_r: float
+    design_load: float
+    zeta_n: float
+    zeta_t: float
+    dt_limit_normal: float
+    dt_limit_tangential: float
+
+    def describe(self, dt: float) -> str:
+        return ("contact springs (docs/contact.md recipe): design load F_max = %.4g N, kn = 2 F_max/h_r = %.4g N/m, "
+                "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a1-a1 pair at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
+                "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential (the springs are implicit; "
+                "k_t is kept at half its limit), dt = %g is %.2f of the smaller"
+                % (self.design_load, self.kn, self.kt, self.mu_s, self.h_r / A1, self.zeta_n, self.zeta_t,
+                   self.dt_limit_normal, self.dt_limit_tangential, dt,
+                   dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
+
+
+def choose_springs(stress: float, dt: float, delta: float, kn: float | None = None,
+                   kt: float | None = None) -> Springs:
+    """The springs by the rule of the module docstring for the shear stress `stress` [Pa], unless
+    given."""
+    design_load = 6 * math.pi * A2 ** 2 * stress
+    zeta_n, zeta_t = theory.pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta, ETA)
+    kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
+    # k_t dt/zeta_t <= 0.5: stiffer implicit tangential springs blew up dense suspensions (growth x10
+    # per step at k_t dt/zeta_t ~ 300-400, docs/benchmarks.md "Stability map")
+    kt = min(kn, TANGENTIAL_SAFETY * zeta_t / dt) if kt is None else kt
+    return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
+
+
+def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, steps: int,
+               dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
+               text_dump: bool = False, model: str = "cutoff", wall_velocities: tuple[float, float] = (0.0, 0.0),
+               grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension") -> dict:
+    """fluid/ and dem/ of the run; returns the scene's description. wall_velocities: the x velocities of
+    the walls y = 0 and y = L_y; grad_p0: the uniform pressure gradient (Eq. 58) [Pa/m]. model:
+    pair_style fdm/subgrid's sub-grid model (cutoff, or calibrated: the squeeze calibration,
+    docs/dem.md). The particles are recorded every dump_every steps in dem/particles.records (fix
+    fdm/output), and written for ParaView with the fluid fields every write_every steps
+    (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also the LIGGGHTS text dump
+    dem/particles.dump of the same steps (for comparisons)."""
+    delta = A1 / a_over_delta
+    Lx, Ly, Lz = (float(v) for v in pack.box)
+    u_lo, u_hi = (float(u) for u in wall_velocities)
+    box = case.Box((0, 0, 0), (Lx, Ly, Lz), delta, faces=("cyclic", ((u_lo, 0, 0), (u_hi, 0, 0)), "cyclic"))
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, grad_p0=tuple(grad_p0),
+                          tol_lambda=tol_lambda, n_max=n_max, first_step=(tol_lambda / 10, 3000), n_particles=pack.n,
+                          tol_u=1e-5, tol_p=1e-3, acceleration=acceleration, write_interval=write_every)
+    pair = ("fdm/subgrid model %s contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
+            % (model, springs.kn, springs.kt, springs.mu_s, springs.h_r, u_lo, u_hi))
+    spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]
+    runs = (["fix             output all fdm/output records %d particles.records vtk %d vtk"
+             % (dump_every, write_every)]
+            + (output.dump_custom_command("particles", dump_every, "particles.dump") if text_dump else [])
+            + ["thermo_style    custom step f_couple[1] f_couple[2] f_couple[6] f_couple[7] f_couple[8]",
+               "thermo          %d" % dump_every,
+               "run             %d upto" % steps])   # upto: a resumed run ends at the same step
+    # a checkpoint every 10 snapshots and at the end: fdmRun --resume continues a killed run (docs/coupling.md)
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
+                         fix_options="stresslets yes checkpoint %d walls walls.dat" % (10 * dump_every), runs=runs,
+                         name=name)
+    packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
+    return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
+                wall_velocities=[u_lo, u_hi], grad_p0=list(grad_p0), dt=dt, dump_every=dump_every,
+                write_every=write_every, subgrid_model=model)

@@ -1,0 +1,81 @@
+"""cases/poiseuille (paper 6.2) on a small channel: a bidisperse frictional suspension at phi_bulk 0.45
+driven by a pressure gradient between walls at rest, run by the real fdmFoam and fdmDEM for a few
+steps (about 30 s); the exact checks of the analysis (the phi integral, the walls' force balance, the
+linear shear stress in the core) and the case's bad input. The SBM's own tests: test_sbm.py."""
+import os
+
+import numpy as np
+import pytest
+
+from conftest import load_case_module
+from fdmsubgrid import poiseuille, shear
+
+SMALL = ["--size", "8", "12", "8", "--duration", "2", "--dump-every", "0.1", "--seed", "2"]
+
+
+@pytest.fixture(scope="module")
+def case_module():
+    return load_case_module("poiseuille")
+
+
+@pytest.fixture(scope="module")
+def small_run(case_module, tmp_path_factory, env):
+    work = tmp_path_factory.mktemp("poiseuille")
+    return case_module.main(SMALL + ["--workdir", str(work), "--out", str(work / "results.json")])
+
+
+def test_small_channel_runs_converged_with_the_results_keys(small_run):
+    r = small_run
+    assert r["unconverged_steps"] == 0 and r["steps"] == 40
+    for key in ("phi_bulk", "L", "time", "steady_from", "phi_center", "phi_wall_layer", "jammed_width_over_a1",
+                "u_center_star", "shear_stress_linearity_rel_error", "sbm_phi_rms_diff", "sbm_u_rms_diff",
+                "cells", "n_particles", "wall_seconds", "core_seconds"):
+        assert key in r, key
+    assert r["L"] == [8.0, 12.0, 8.0] and r["time"] == pytest.approx(2.0)
+    assert abs(r["phi_bulk"] - 0.45) < 0.01 and r["n_particles"] > 40
+    # the scales of Eq. 58 with U_c = L_y/4: tau_w = 1, the time unit L_y/(2U_c) = 2 s
+    assert r["tau_w"] == pytest.approx(1.0) and r["time_unit"] == pytest.approx(2.0)
+    assert os.path.isfile(os.path.join(os.path.dirname(r["run_dir"]), r["figure"]))
+
+
+def test_phi_integral_is_exact(small_run):
+    """Eq. 49 integrated over the channel is phi_bulk at every snapshot (the spheres stay between the walls)."""
+    assert small_run["phi_bulk_integral_max_error"] < 1e-10
+
+
+def test_momentum_balance(small_run):
+    """The walls carry the pressure gradient's whole force, tau_lo - tau_hi = |dP0/dx| L_y, to the
+    solver's tolerance; and the shear stress of Eqs. 51-53 on the cell faces (fluid eta d<u>/dy from
+    fdmFoam's plane averages plus the particles' stresslets) follows the exact line in the core within
+    a loose bound (a short, unsteady run: the paper's 5 % is for time averages in the steady state)."""
+    r = small_run
+    assert r["wall_force_balance_rel_error"] < 0.01
+    assert r["shear_stress_linearity_rel_error"] < 0.2
+    # the flow goes down the gradient, slower than the Newtonian parabola's centre (0.5)
+    assert 0 < r["u_center_star"] < 0.5
+
+
+def test_channel_profile_record_is_the_mean_velocity(small_run):
+    """fdmFoam's channelProfile.dat: one line per step, the plane averages of U; at rest walls and a
+    flow along x only: u_y averages to zero on every plane (continuity, to the pressure solver's
+    tolerance 1e-3 and the forcing inside the particles: 1.5e-3 of u_x measured), u_x > 0."""
+    prof = poiseuille.read_channel_profile(small_run["run_dir"])
+    assert len(prof["step"]) == 40 and prof["u"].shape[1] == 36
+    assert np.max(np.abs(prof["u"][:, :, 1])) < 1e-2 * np.max(np.abs(prof["u"][:, :, 0]))
+    assert np.all(prof["u"][:, :, 0] > 0)
+
+
+def test_analysis_refuses_a_couette_run(tmp_path):
+    """A run folder whose walls move and whose fluid has no pressure gradient is not a pressure-driven
+    channel: the analysis says so and names the file."""
+    couette = load_case_module("couette")
+    out = couette.main(["--table8", "0.27", "--workdir", str(tmp_path), "--dt", "0.04"])
+    with pytest.raises(poiseuille.PoiseuilleRunError, match=r"fdmProperties: gradP0 = \(0 0 0\)"):
+        poiseuille.scales(shear.read_run(out["run_dir"]))
+
+
+def test_bad_options_are_refused(case_module, tmp_path):
+    with pytest.raises(SystemExit):
+        case_module.main(["--size", "8", "12.1", "8", "--workdir", str(tmp_path)])
+    with pytest.raises(SystemExit):
+        case_module.main(["--phi", "0.7", "--workdir", str(tmp_path)])
