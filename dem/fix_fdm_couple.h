@@ -66,10 +66,12 @@ class FixFdmCouple : public Fix {
     long steps, solves, solverIterations, solverIterationsMax;
     long gapTargets, gapLimited;   // log-gap targets of the position update, and those limited
     long gapHeld;                  // contact (or closed) gaps held at their straight-step value
-    long gapFallbacks;             // steps where the targets contradicted each other (straight step)
+    long gapFallbacks;             // steps where the targets contradicted each other (the fallback:
+                                   // straight, every gap kept above its bound)
     int gapSweepsMax;
+    double gapBoundWorst;          // largest relative bound violation the fallback left
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
-               gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0) {}
+               gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0) {}
   };
 
   void gather(std::vector<Particle> &particles);

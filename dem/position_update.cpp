@@ -13,6 +13,7 @@ struct Gap {
   int i, j;       // j < 0: a wall, index -1 - j
   double target;  // surface gap wanted at step n+1
   double scale;   // what |gap - target| is compared with: the target, or h_r for a held contact gap
+  double lower;   // the bound of the fallback: min(target, h_n), which the positions x_n meet
 };
 
 void minimumImage(double d[3], const double period[3])
@@ -98,8 +99,9 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
   // deeper into contact (in dense clusters they did: overlaps of 0.03-0.07 a1, docs/benchmarks.md)
   std::vector<Gap> gaps;
   const double smallest = 1e-9 * (n ? *std::min_element(c.radius.begin(), c.radius.end()) : 1.0);
-  const auto held = [&](int i, int j, double straightGap) {
-    gaps.push_back(Gap{i, j, straightGap, std::max(std::max(o.contactGap, std::fabs(straightGap)), smallest)});
+  const auto held = [&](int i, int j, double straightGap, double gapNow) {
+    gaps.push_back(Gap{i, j, straightGap, std::max(std::max(o.contactGap, std::fabs(straightGap)), smallest),
+                       std::min(straightGap, gapNow)});
     stats.heldGaps++;
   };
   for (size_t p = 0; p + 1 < closePairs.size(); p += 2) {
@@ -108,11 +110,11 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
     pairGap(c, c.x, c.u, i, j, h, hdot);
     if (previous) pairGap(c, c.xPrevious, c.uPrevious, i, j, hp, hdotp);
     if (logTarget(h, hdot, previous, hp, hdotp, dt, o, target, stats.limited)) {
-      gaps.push_back(Gap{i, j, target, target});
+      gaps.push_back(Gap{i, j, target, target, std::min(target, h)});
       stats.pairGaps++;
     } else if (o.holdContactGaps) {
       double d[3];
-      held(i, j, separation(c, y, i, j, d) - c.radius[i] - c.radius[j]);
+      held(i, j, separation(c, y, i, j, d) - c.radius[i] - c.radius[j], h);
     }
   }
   for (int i = 0; i < n; i++)
@@ -122,10 +124,10 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
       if (!(h < c.radius[i])) continue;
       if (previous) wallGap(c, c.xPrevious, c.uPrevious, i, walls[w], hp, hdotp);
       if (logTarget(h, hdot, previous, hp, hdotp, dt, o, target, stats.limited)) {
-        gaps.push_back(Gap{i, -1 - int(w), target, target});
+        gaps.push_back(Gap{i, -1 - int(w), target, target, std::min(target, h)});
         stats.wallGaps++;
       } else if (o.holdContactGaps) {
-        held(i, -1 - int(w), wallGapOf(c, y, i, walls[w]));
+        held(i, -1 - int(w), wallGapOf(c, y, i, walls[w]), h);
       }
     }
   // held gaps alone are met by the straight step
@@ -137,17 +139,23 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
     touched[g.i] = 1;
     if (g.j >= 0) touched[g.j] = 1;
   }
-  double previousWorst = HUGE_VAL;
-  for (stats.sweeps = 1; stats.sweeps <= o.maxSweeps; stats.sweeps++) {
+  // One Gauss-Seidel sweep: each gap moved to its target (bounds = false), or, on the fallback,
+  // only pushed apart where it is below its bound (bounds = true); returns the largest relative miss
+  const auto sweep = [&](bool bounds) {
     double worst = 0;
     for (const Gap &g : gaps) {
-      double miss;
+      double miss;  // > 0: push apart
+      double d[3] = {0, 0, 0}, r = 0;
       if (g.j >= 0) {
-        double d[3];
-        const double r = separation(c, y, g.i, g.j, d);
-        const double ai = c.radius[g.i], aj = c.radius[g.j];
-        miss = ai + aj + g.target - r;  // > 0: push apart
+        r = separation(c, y, g.i, g.j, d);
+        miss = (bounds ? g.lower : g.target) - (r - c.radius[g.i] - c.radius[g.j]);
+      } else {
+        miss = (bounds ? g.lower : g.target) - wallGapOf(c, y, g.i, walls[size_t(-1 - g.j)]);
+      }
+      if (bounds && miss <= 0) continue;
+      if (g.j >= 0) {
         // the smaller sphere (less drag) takes the larger share
+        const double ai = c.radius[g.i], aj = c.radius[g.j];
         const double wi = aj / (ai + aj), wj = ai / (ai + aj);
         for (int k = 0; k < 3; k++) {
           y[3 * g.i + k] -= wi * miss * d[k] / r;
@@ -155,11 +163,15 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
         }
       } else {
         const Wall &w = walls[size_t(-1 - g.j)];
-        miss = g.target - wallGapOf(c, y, g.i, w);
         y[3 * g.i + w.axis] += intoFluid(w) * miss;
       }
       worst = std::max(worst, std::fabs(miss) / g.scale);
     }
+    return worst;
+  };
+  double previousWorst = HUGE_VAL;
+  for (stats.sweeps = 1; stats.sweeps <= o.maxSweeps; stats.sweeps++) {
+    const double worst = sweep(false);
     stats.worst = worst;
     if (worst <= o.tolerance) break;
     // inconsistent targets (see Options::tolerance): stop once the sweeps no longer gain
@@ -168,10 +180,23 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
   }
   stats.sweeps = std::min(stats.sweeps, o.maxSweeps);
   if (stats.worst > o.fallback) {
-    // the targets contradict each other (relative motions of gaps far from lubrication's
-    // hdot ~ h, at a large dt): this step keeps the straight step rather than a bad compromise
+    // The targets contradict each other (relative motions of gaps far from lubrication's hdot ~ h
+    // at a large dt, or many coupled gaps of a dense cluster): no compromise between them is
+    // good. The fallback starts again from the straight step and only keeps every gap from
+    // closing below its bound, min(target, h_n) (a held contact gap: min(straight gap, h_n)),
+    // pushing apart along the lines of centres: the closing lubrication gaps cannot overshoot
+    // their log targets into contact, which the straight step alone let them do (the whole step
+    // was straight before 2026-11-25: in the phi 0.37 Table 8 scene at dt 0.04 at nearly every
+    // step, and a pair driven together at 3.7 a1 gamma_dot overlapped by 0.07 a1). The positions
+    // x_n meet every bound, so the sweeps have a solution.
     stats.fallback = true;
-    return stats;
+    for (int i = 0; i < n; i++)
+      for (int k = 0; k < 3; k++) y[3 * i + k] = c.x[3 * i + k] + dt * rate[6 * i + k];
+    for (stats.boundSweeps = 1; stats.boundSweeps <= o.maxBoundSweeps; stats.boundSweeps++) {
+      stats.worstBound = sweep(true);
+      if (stats.worstBound <= o.tolerance) break;
+    }
+    stats.boundSweeps = std::min(stats.boundSweeps, o.maxBoundSweeps);
   }
   for (int i = 0; i < n; i++)
     if (touched[i])

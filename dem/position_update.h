@@ -51,7 +51,9 @@ struct Options {
   // other: the sweeps stop at this fraction of each target gap, or after maxSweeps.
   double tolerance = 1e-4;
   int maxSweeps = 30;
-  double fallback = 0.5;             // still this far from a target after the sweeps: straight step
+  double fallback = 0.5;             // still this far from a target after the sweeps: the fallback,
+                                     // the straight step with every gap kept above its bound
+  int maxBoundSweeps = 200;          // sweeps of the fallback
   // Gaps below the roughness height h_r are held by contact springs (hdot not ~ h): they get no
   // log target. With holdContactGaps they (and closed gaps) are held at the gap the straight step
   // gives them while the other gaps are corrected, the displacement the implicit springs assumed;
@@ -66,7 +68,10 @@ struct Statistics {
   long heldGaps = 0;                 // contact or closed gaps held at their straight-step value
   int sweeps = 0;                    // Gauss-Seidel sweeps used
   double worst = 0;                  // largest |gap - target| / target met in the last sweep
-  bool fallback = false;             // the targets could not be met: the straight step was kept
+  bool fallback = false;             // the targets could not be met: the straight step, with every gap
+                                     // kept from closing below min(target, h_n)
+  int boundSweeps = 0;               // sweeps of the fallback
+  double worstBound = 0;             // largest relative violation of a bound left by the fallback
 };
 
 // The displacement rates (6n: translation, rotation) of the step from n to n+1: x_{n+1} = x_n +
