@@ -79,3 +79,36 @@ def test_bad_options_are_refused(case_module, tmp_path):
         case_module.main(["--size", "8", "12.1", "8", "--workdir", str(tmp_path)])
     with pytest.raises(SystemExit):
         case_module.main(["--phi", "0.7", "--workdir", str(tmp_path)])
+
+
+def test_migration_time_recovers_an_exponential_approach():
+    t = np.linspace(0, 300, 301)
+    rng = np.random.default_rng(1)
+    phi = 0.58 - (0.58 - 0.46) * np.exp(-t / 60.0) + 0.003 * rng.standard_normal(t.size)
+    tau, err, phi_inf = poiseuille.migration_time(t, phi)
+    assert abs(tau - 60.0) < 3 * err + 1.0 and err < 3.0
+    assert phi_inf == pytest.approx(0.58, abs=0.003)
+    # no rise: no time scale
+    assert np.isnan(poiseuille.migration_time(t, 0.46 - 0.01 * t / 300)[0])
+
+
+def test_fluid_shear_stress_of_the_newtonian_parabola():
+    """The Newtonian channel u = 4 U_c y (L - y)/L^2 sampled at 36 cell centres: eta du/dy on the faces
+    and averaged over bins of a1 equals the exact (dP0/dx)(y - L/2) (to O(Delta^2) at the walls,
+    exact inside: a parabola's centred difference is exact)."""
+    L, n, eta, u_c = 12.0, 36, 1.0, 3.0
+    d = L / n
+    centres = d * (np.arange(n) + 0.5)
+    u = np.zeros((1, n, 3))
+    u[0, :, 0] = 4 * u_c * centres * (L - centres) / L ** 2
+    prof = dict(step=np.array([1]), time=np.array([0.1]), u=u, delta=d)
+    grad = -8 * eta * u_c / L ** 2
+    faces, tau = poiseuille.fluid_shear_stress(prof, eta, np.array([True]))
+    exact = grad * (faces - L / 2)
+    assert np.max(np.abs(tau[1:-1] - exact[1:-1])) < 1e-12
+    assert np.max(np.abs(tau[[0, -1]] - exact[[0, -1]])) < 0.06 * abs(exact[0])
+    edges = np.linspace(0, L, 13)
+    binned = poiseuille.fluid_shear_stress_in_bins(prof, eta, np.array([True]), edges)
+    exact_bins = grad * (0.5 * (edges[1:] + edges[:-1]) - L / 2)
+    assert np.max(np.abs(binned[1:-1] - exact_bins[1:-1])) < 1e-12
+    assert np.max(np.abs(binned - exact_bins)) < 0.05 * abs(grad * L / 2)

@@ -69,10 +69,15 @@ def main(argv: list[str] | None = None) -> dict:
                    "the migration transient by the MSER rule)")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None, help="analyse this run folder as it stands")
+    p.add_argument("--compare", metavar="RUN_DIR", default=None, help="with --analyse: the rms and largest "
+                   "differences of the coarse phi and u_p* profiles from this other run of the same channel (e.g. "
+                   "another dt), both averaged over the same window (from the later steady start, or --from-time)")
     case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
     args = p.parse_args(argv)
     material = sbm.from_couette_results(args.couette) if args.couette else None
 
+    if args.analyse and args.compare:
+        return compare(args.analyse, args.compare, material, args.from_time)
     if args.analyse:
         return report(args.analyse, args.out, material, args.from_time)
 
@@ -128,6 +133,28 @@ def main(argv: list[str] | None = None) -> dict:
             if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
                 shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
     return results
+
+
+def compare(run_a: str, run_b: str, material=None, from_time=None) -> dict:
+    """The differences of the coarse (bins of a1) phi and u_p* profiles of two runs of one channel,
+    averaged over the same window: from from_time, else from the later of their steady starts."""
+    if from_time is None:
+        from_time = max(poiseuille.analyse(r, material)[0]["steady_from"] for r in (run_a, run_b))
+    (ra, fa), (rb, fb) = (poiseuille.analyse(r, material, from_time) for r in (run_a, run_b))
+    if len(fa["coarse"].y) != len(fb["coarse"].y):
+        raise SystemExit("poiseuille --compare: the runs have different channels (%s, %s)" % (ra["L"], rb["L"]))
+    u = [f["coarse"].u_p[:, 0] / (2 * f["scales"].u_c) for f in (fa, fb)]
+    dphi = fa["coarse"].phi - fb["coarse"].phi
+    du = u[0] - u[1]
+    out = dict(from_time=from_time, phi_rms_diff=float(np.sqrt(np.mean(dphi ** 2))), phi_max_diff=float(np.abs(dphi).max()),
+               u_rms_diff=float(np.sqrt(np.mean(du ** 2))), u_max_diff=float(np.abs(du).max()),
+               phi_err_typical=float(np.nanmedian(np.hypot(fa["coarse"].phi_error, fb["coarse"].phi_error))),
+               phi_center=[ra["phi_center"], rb["phi_center"]], u_center_star=[ra["u_center_star"], rb["u_center_star"]],
+               dt=[ra["dt"], rb["dt"]], core_seconds=[ra["core_seconds"], rb["core_seconds"]],
+               inner_iterations_mean=[ra["inner_iterations_mean"], rb["inner_iterations_mean"]])
+    for k, v in out.items():
+        print("%-24s %s" % (k, v))
+    return out
 
 
 def report(run_dir: str, out: str, material=None, from_time=None) -> dict:

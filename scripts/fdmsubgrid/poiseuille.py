@@ -8,7 +8,8 @@ y* = (y - L_y/2)/L_y (Eq. 61).
 
 What `analyse` measures (docs/profiles.md, "Pressure-driven flow"):
 - the migration transient: phi in the central slab |y*| < a1/L_y (2 a1 wide) and in the wall layers
-  (within 2.5 a1 of either wall) at every particle snapshot; the steady part starts where the MSER rule
+  (within 2.5 a1 of either wall) at every particle snapshot, and the time scale tau of an exponential
+  approach fitted to the central series (migration_time); the steady part starts where the MSER rule
   puts the end of the central series' transient (fdmsubgrid.timeseries), or at a given time;
 - the steady profiles, time-averaged with block-averaging errors: fine (planes every 0.02 a1) and coarse
   (bins of width a1, Eq. 60) phi(y) (Eq. 49) and u_p*(y) (Eqs. 59, 61), Sigma^c_yy(y) and Sigma_xy(y);
@@ -126,6 +127,26 @@ def fluid_shear_stress_in_bins(profile: dict, eta: float, selected: NDArray, edg
     return eta * np.diff(at) / np.diff(edges)
 
 
+def migration_time(times: NDArray, phi_center: NDArray) -> tuple[float, float, float]:
+    """(tau, its standard error, phi_inf) of phi_center(t) = phi_inf - (phi_inf - phi_0) exp(-t/tau)
+    fitted to the central series (scipy's curve_fit; nan if the fit fails: no rise, too short)."""
+    from scipy.optimize import curve_fit
+    t = np.asarray(times, dtype=float)
+    y = np.asarray(phi_center, dtype=float)
+    if len(t) < 8 or not y[-len(y) // 4:].mean() > y[0]:
+        return math.nan, math.nan, math.nan
+
+    def model(tt: NDArray, phi_inf: float, tau: float) -> NDArray:
+        return phi_inf - (phi_inf - y[0]) * np.exp(-(tt - t[0]) / tau)
+
+    try:
+        (phi_inf, tau), cov = curve_fit(model, t, y, p0=(y[-len(y) // 4:].mean(), 0.3 * (t[-1] - t[0])),
+                                        bounds=([y[0], 1e-6], [1.0, 1e3 * (t[-1] - t[0] + 1)]))
+    except (RuntimeError, ValueError):
+        return math.nan, math.nan, math.nan
+    return float(tau), float(np.sqrt(cov[1, 1])), float(phi_inf)
+
+
 def _layer_mask(y: NDArray, channel: profiles.Channel) -> NDArray:
     return (y - channel.y_lo < WALL_LAYER - 1e-9) | (channel.y_hi - y < WALL_LAYER - 1e-9)
 
@@ -240,6 +261,8 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
         phi_center=float(np.mean(phi_center[start:])),
         phi_center_err=float(timeseries.block_average(phi_center[start:]).error) if len(kept) >= 2 * timeseries.MIN_BLOCKS else math.nan,
         phi_center_initial=float(phi_center[0]),
+        **dict(zip(("migration_time", "migration_time_err", "phi_center_fit_inf"),
+                   migration_time(times, phi_center))),
         phi_wall_layer=float(np.mean(phi_walls[start:])),
         phi_sbm_region=phi_region,
         jammed_width_over_a1=jammed_width, phi_m=phi_m,
