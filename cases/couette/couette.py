@@ -199,11 +199,7 @@ def main(argv: list[str] | None = None) -> dict:
                                 table8=None if args.table8 is None else table8_row(phi)),
                            wall_seconds=wall, ranks=args.np_fluid + args.np_dem, h_layer=args.h_layer)
     if not args.keep:
-        fluid = os.path.join(run_dir, "fluid")
-        shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
-        for d in os.listdir(fluid):
-            if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
-                shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+        case.delete_fields(run_dir)
     return results
 
 

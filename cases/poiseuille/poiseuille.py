@@ -127,11 +127,7 @@ def main(argv: list[str] | None = None) -> dict:
     case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
     results = report(run_dir, args.out, material, args.from_time)
     if not args.keep:
-        fluid = os.path.join(run_dir, "fluid")
-        shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
-        for d in os.listdir(fluid):
-            if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
-                shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+        case.delete_fields(run_dir)
     return results
 
 

@@ -79,10 +79,7 @@ def run(workdir: str, size=(12.0, 20.0, 12.0), a_over_delta: float = 3.0, offset
     tau = rheology.wall_shear_stresses(loads, channel)["fluid"][-1]
     predicted = ETA * SHEAR_RATE + s_xy / channel.volume
     if not keep:
-        shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
-        for d in os.listdir(fluid):
-            if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
-                shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+        case.delete_fields(run_dir)
     return dict(size=[L, H, Lz], a_over_delta=a_over_delta, offset=list(offset), cells=int(np.prod(box.n)),
                 S_xy=s_xy, S_star=s_xy / (10.0 / 3.0 * math.pi * ETA * A ** 3 * SHEAR_RATE),
                 omega_z_over_minus_half_gamma=float(omega[2] / (-0.5 * SHEAR_RATE)),

@@ -272,6 +272,23 @@ TEST(PositionUpdate, EulerAndNoCorrectionAreTheStraightStep)
   for (size_t k = 0; k < rate.size(); k++) EXPECT_DOUBLE_EQ(rate[k], 1.5 * c.u[k] - 0.5 * c.uPrevious[k]);
 }
 
+// Four spheres of radius a in a ring through a periodic x, surface gaps h, moving along x at +-v
+// alternately (gaps 0-1 and 2-3 closing, the others opening); `extra` more spheres at the origin.
+static motion::Configuration ring(double a, double h, double v, int extra = 0)
+{
+  motion::Configuration c;
+  c.n = 4 + extra;
+  c.radius.assign(size_t(c.n), a);
+  c.period[0] = 4 * (2 * a + h);
+  c.x.assign(size_t(3) * c.n, 0.0);
+  c.u.assign(size_t(6) * c.n, 0.0);
+  for (int i = 0; i < 4; i++) {
+    c.x[3 * i] = i * (2 * a + h);
+    c.u[6 * i] = (i % 2 == 0 ? 1 : -1) * v;
+  }
+  return c;
+}
+
 TEST(PositionUpdate, ContradictoryTargetsFallBackToTheirBounds)
 {
   // four spheres in a ring through a periodic x, gaps alternately closing and opening: the log
@@ -279,19 +296,9 @@ TEST(PositionUpdate, ContradictoryTargetsFallBackToTheirBounds)
   // within 2 % of every target; badly (s = 1): the fallback, flagged. The straight step would close
   // the closing gaps to zero (s h = 2 v dt); the fallback keeps every gap above min(target, h_n):
   // the closing ones at their targets h/e, the opening ones take up the rest of the ring
-  const double a = 1.0, h = 1e-3, dt = 0.1, L = 4 * (2 * a + h);
+  const double a = 1.0, h = 1e-3, dt = 0.1;
   for (double s : {0.1, 1.0}) {
-    const double v = s * h / (2 * dt);
-    motion::Configuration c;
-    c.n = 4;
-    c.radius.assign(4, a);
-    c.period[0] = L;
-    c.x.assign(12, 0.0);
-    c.u.assign(24, 0.0);
-    for (int i = 0; i < 4; i++) {
-      c.x[3 * i] = i * (2 * a + h);
-      c.u[6 * i] = (i % 2 == 0 ? 1 : -1) * v;
-    }
+    const motion::Configuration c = ring(a, h, s * h / (2 * dt));
     std::vector<double> rate;
     motion::Options euler;
     euler.adamsBashforth = false;
@@ -331,17 +338,8 @@ TEST(PositionUpdate, FallbackStopsAFastClosingPairInADenseCluster)
   // and elsewhere a sphere driven at another at 3.7 a1 per unit time through a gap of 0.07 a1.
   // The whole step used to go straight, taking that gap to -0.08 (overlap); the fallback keeps it
   // at its log target, and the ring's closing gaps at theirs
-  const double a = 1.0, h = 1e-3, dt = 0.04, L = 4 * (2 * a + h), v = h / (2 * dt);
-  motion::Configuration c;
-  c.n = 5;
-  c.radius.assign(5, a);
-  c.period[0] = L;
-  c.x.assign(15, 0.0);
-  c.u.assign(30, 0.0);
-  for (int i = 0; i < 4; i++) {
-    c.x[3 * i] = i * (2 * a + h);
-    c.u[6 * i] = (i % 2 == 0 ? 1 : -1) * v;
-  }
+  const double a = 1.0, h = 1e-3, dt = 0.04;
+  motion::Configuration c = ring(a, h, h / (2 * dt), 1);
   const double h4 = 0.07;
   c.x[3 * 4 + 0] = c.x[3 * 2];
   c.x[3 * 4 + 1] = 2 * a + h4;    // above sphere 2

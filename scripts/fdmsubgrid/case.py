@@ -308,11 +308,18 @@ def run_and_read(run_dir, np_fluid=1, keep=False):
     wall = run(run_dir, np_fluid=np_fluid)
     particles, steps = output.particles(fluid), output.steps(fluid)
     if not keep:
-        shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
-        for d in os.listdir(fluid):
-            if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
-                shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+        delete_fields(run_dir)
     return wall, particles, steps
+
+
+def delete_fields(run_dir):
+    """Delete the mesh and the time directories of run_dir/fluid (the fields for ParaView, the bulk
+    of the disk space; the records and the checkpoints stay)."""
+    fluid = os.path.join(run_dir, "fluid")
+    shutil.rmtree(os.path.join(fluid, "constant", "polyMesh"), ignore_errors=True)
+    for d in os.listdir(fluid):
+        if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
+            shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
 
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",
