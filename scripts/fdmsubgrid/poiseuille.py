@@ -151,9 +151,90 @@ def _layer_mask(y: NDArray, channel: profiles.Channel) -> NDArray:
     return (y - channel.y_lo < WALL_LAYER - 1e-9) | (channel.y_hi - y < WALL_LAYER - 1e-9)
 
 
+def momentum_balance(run_dir: str, eta: float, sc: Scales, channel: profiles.Channel,
+                     snapshots: list, coarse: profiles.ProfileAverage, t0: float) -> dict:
+    """The shear stress against the exact line (module docstring), time-averaged from t0: on the cell
+    faces and in the coarse bins, with the walls' stresses; a dict of the results' keys and, under
+    "figure", the profiles."""
+    xy = profiles.component(0, 1)
+    prof = read_channel_profile(run_dir)
+    sel = prof["time"] / sc.time_unit >= t0 - 1e-9
+    faces, fluid = fluid_shear_stress(prof, eta, sel)
+    y_faces = faces + channel.y_lo
+    particle = profiles.average_profiles(snapshots, channel, y=y_faces, errors=False).sigma_p[:, xy]
+    loads = output.read_wall_loads(run_dir)
+    tau = rheology.wall_shear_stresses(loads, channel)["total"]
+    wsel = np.asarray(loads.times, dtype=float) / sc.time_unit >= t0 - 1e-9
+    tau_lo, tau_hi = (float(v) for v in tau[wsel].mean(axis=0))
+
+    def line(y: NDArray) -> NDArray:
+        # the exact balance of the slab between a wall and the plane y: Sigma_xy(y) = tau_lo + G (y - y_lo)
+        # = tau_hi + G (y - y_hi); the mean of the two. It is G (y - y_mid) once the two walls carry
+        # equal loads (a symmetric steady state); their difference is the wall asymmetry
+        return 0.5 * (tau_lo + sc.grad * (y - channel.y_lo) + tau_hi + sc.grad * (y - channel.y_hi))
+
+    total = fluid + particle
+    deviation = np.abs(total - line(y_faces)) / sc.tau_w
+    layer = _layer_mask(y_faces, channel)
+    # the same in the bins of a1 (Eq. 60: the scale of the profiles), each term its exact bin average
+    edges = coarse.edges
+    coarse_total = fluid_shear_stress_in_bins(prof, eta, sel, edges - channel.y_lo) + coarse.sigma_p[:, xy]
+    coarse_deviation = np.abs(coarse_total - line(0.5 * (edges[1:] + edges[:-1]))) / sc.tau_w
+    coarse_layer = (edges[:-1] < channel.y_lo + WALL_LAYER - 1e-9) | (edges[1:] > channel.y_hi - WALL_LAYER + 1e-9)
+    return dict(
+        shear_stress_linearity_rel_error=float(np.max(coarse_deviation[~coarse_layer])),
+        shear_stress_linearity_wall_layer_rel_error=float(np.max(coarse_deviation[coarse_layer])),
+        shear_stress_linearity_fine_rel_error=float(np.max(deviation[~layer])),
+        shear_stress_linearity_fine_wall_layer_rel_error=float(np.max(deviation[layer])),
+        wall_force_balance_rel_error=abs(tau_lo - tau_hi - 2 * sc.tau_w) / (2 * sc.tau_w),
+        wall_shear_stress_asymmetry=abs(tau_lo + tau_hi) / sc.tau_w,
+        figure=dict(faces=y_faces, total=total, fluid=fluid, particle=particle, line=line(y_faces),
+                    coarse_total=coarse_total))
+
+
+def jammed_width(coarse: profiles.ProfileAverage, y_mid: float, phi_m: float) -> float:
+    """The width of the contiguous coarse bins around the centre with phi >= phi_m (0 if none)."""
+    jammed = coarse.phi >= phi_m
+    centre = int(np.argmin(np.abs(coarse.y - y_mid)))
+    if not jammed[centre]:
+        return 0.0
+    lo, hi = centre, centre
+    while lo > 0 and jammed[lo - 1]:
+        lo -= 1
+    while hi < len(jammed) - 1 and jammed[hi + 1]:
+        hi += 1
+    return float(coarse.edges[hi + 1] - coarse.edges[lo])
+
+
+def sbm_comparison(material: sbm.MaterialFunctions, snapshots: list, channel: profiles.Channel, sc: Scales,
+                   coarse: profiles.ProfileAverage, fine: profiles.ProfileAverage
+                   ) -> tuple[sbm.SBMProfile, float, float, float]:
+    """The SBM over the region 2.5 a1 from the walls with the measured mean phi of that region and the
+    measured u_p* at its edge; returns (model, rms difference of phi, of u*, the region's phi), the
+    differences over the coarse bins inside the region (the model averaged over each bin, u* weighted
+    by phi as Eq. 59)."""
+    region = (channel.y_lo + WALL_LAYER, channel.y_hi - WALL_LAYER)
+    phi_region = float(np.mean([profiles.volume_fraction(s, channel, *region) for s in snapshots]))
+    u_fine = fine.u_p[:, 0] / (2 * sc.u_c)
+    edge_u = float(np.nanmean(np.interp(region, fine.y, np.nan_to_num(u_fine))))
+    model = sbm.solve(material, phi_region, y_edge=0.5 - WALL_LAYER / sc.width, u_edge=edge_u)
+    inside = (coarse.edges[:-1] >= region[0] - 1e-9) & (coarse.edges[1:] <= region[1] + 1e-9)
+    if not inside.any():
+        return model, math.nan, math.nan, phi_region
+    model_phi, model_u = [], []
+    for a, b in zip(coarse.edges[:-1][inside], coarse.edges[1:][inside]):
+        phi, u = model.at(np.linspace(a - channel.y_mid, b - channel.y_mid, 201) / sc.width)
+        model_phi.append(np.mean(phi))
+        model_u.append(np.sum(phi * u) / np.sum(phi))
+    dphi = coarse.phi[inside] - np.array(model_phi)
+    du = coarse.u_p[inside, 0] / (2 * sc.u_c) - np.array(model_u)
+    return model, float(np.sqrt(np.mean(dphi ** 2))), float(np.sqrt(np.mean(du ** 2))), phi_region
+
+
 def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None) -> tuple[dict, dict]:
     """The results of a run (a flat dict, the keys of cases/poiseuille/results.json) and what the figure
     needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions)."""
+    material = material or sbm.MaterialFunctions.maron_pierce_power_law()
     run = shear.read_run(run_dir)
     sc = scales(run)
     channel = run.channel
@@ -186,74 +267,14 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
 
     coarse = profiles.average_profiles(kept, channel)
     fine = profiles.average_profiles(kept, channel, y=channel.planes(0.02), errors=False)
-    xy, yy = profiles.component(0, 1), profiles.component(1, 1)
-
-    # momentum balance on the cell faces
-    prof = read_channel_profile(run_dir)
-    sel = prof["time"] / sc.time_unit >= t0 - 1e-9
-    faces, fluid = fluid_shear_stress(prof, run.eta, sel)
-    particle = profiles.average_profiles(kept, channel, y=faces + channel.y_lo, errors=False)
-    total = fluid + particle.sigma_p[:, xy]
-    loads = output.read_wall_loads(run_dir)
-    tau = rheology.wall_shear_stresses(loads, channel)["total"]
-    wsel = np.asarray(loads.times, dtype=float) / sc.time_unit >= t0 - 1e-9
-    tau_lo, tau_hi = (float(v) for v in tau[wsel].mean(axis=0))
-    # the exact balance of the slab between a wall and the plane y: Sigma_xy(y) = tau_lo + G (y - y_lo)
-    # = tau_hi + G (y - y_hi); the mean of the two. It is G (y - y_mid) once the two walls carry equal
-    # loads (a symmetric steady state); their difference is the wall asymmetry
-    y_abs = faces + channel.y_lo
-    line = 0.5 * (tau_lo + sc.grad * (y_abs - channel.y_lo) + tau_hi + sc.grad * (y_abs - channel.y_hi))
-    deviation = np.abs(total - line) / sc.tau_w
-    layer = _layer_mask(y_abs, channel)
-    # the same in the bins of a1 (Eq. 60: the scale of the profiles), each term its exact bin average
-    edges = coarse.edges
-    coarse_total = (fluid_shear_stress_in_bins(prof, run.eta, sel, edges - channel.y_lo)
-                    + coarse.sigma_p[:, xy])
-    centres = 0.5 * (edges[1:] + edges[:-1])
-    coarse_line = 0.5 * (tau_lo + sc.grad * (centres - channel.y_lo) + tau_hi + sc.grad * (centres - channel.y_hi))
-    coarse_deviation = np.abs(coarse_total - coarse_line) / sc.tau_w
-    coarse_layer = (edges[:-1] < channel.y_lo + WALL_LAYER - 1e-9) | (edges[1:] > channel.y_hi - WALL_LAYER + 1e-9)
-
-    # the central coarse bins at phi_m or above
-    phi_m = (material or sbm.MaterialFunctions.maron_pierce_power_law()).phi_m
-    jammed = coarse.phi >= phi_m
-    widths = np.diff(coarse.edges)
-    centre = int(np.argmin(np.abs(coarse.y - mid)))
-    jammed_width = 0.0
-    if jammed[centre]:
-        lo = centre
-        while lo > 0 and jammed[lo - 1]:
-            lo -= 1
-        hi = centre
-        while hi < len(jammed) - 1 and jammed[hi + 1]:
-            hi += 1
-        jammed_width = float(widths[lo:hi + 1].sum())
-
-    # the SBM over the region 2.5 a1 from the walls
-    y_star = lambda y: (np.asarray(y) - mid) / sc.width  # noqa: E731
-    u_star = lambda u: np.asarray(u) / (2 * sc.u_c)  # noqa: E731
-    region = (channel.y_lo + WALL_LAYER, channel.y_hi - WALL_LAYER)
-    phi_region = float(np.mean([profiles.volume_fraction(s, channel, *region) for s in kept]))
-    u_fine = u_star(fine.u_p[:, 0])
-    edge_u = float(np.nanmean(np.interp(region, fine.y, np.nan_to_num(u_fine))))
-    material = material or sbm.MaterialFunctions.maron_pierce_power_law()
-    model = sbm.solve(material, phi_region, y_edge=0.5 - WALL_LAYER / sc.width, u_edge=edge_u)
-    inside = (coarse.edges[:-1] >= region[0] - 1e-9) & (coarse.edges[1:] <= region[1] + 1e-9)
-    # the model averaged over each coarse bin, as the simulation's bins are
-    model_phi, model_u = [], []
-    for a, b in zip(coarse.edges[:-1][inside], coarse.edges[1:][inside]):
-        yy_ = np.linspace(y_star(a), y_star(b), 201)
-        p_, u_ = model.at(yy_)
-        model_phi.append(np.mean(p_))
-        model_u.append(np.sum(p_ * u_) / np.sum(p_))     # phi-weighted, as Eq. 59
-    model_phi, model_u = np.array(model_phi), np.array(model_u)
-    sbm_phi_rms = float(np.sqrt(np.mean((coarse.phi[inside] - model_phi) ** 2))) if inside.any() else math.nan
-    sbm_u_rms = float(np.sqrt(np.mean((u_star(coarse.u_p[inside, 0]) - model_u) ** 2))) if inside.any() else math.nan
+    balance = momentum_balance(run_dir, run.eta, sc, channel, kept, coarse, t0)
+    model, sbm_phi_rms, sbm_u_rms, phi_region = sbm_comparison(material, kept, channel, sc, coarse, fine)
+    phi_m = material.phi_m
 
     wall_seconds, ranks = shear.run_seconds(run_dir, steps)
     inner = steps["innerIterations"]
     pack = run.packing
-    u_center = float(np.interp(mid, coarse.y, u_star(coarse.u_p[:, 0])))
+    u_center = float(np.interp(mid, coarse.y, coarse.u_p[:, 0] / (2 * sc.u_c)))
     results = dict(
         phi_bulk=pack.phi, phi_bulk_integral_max_error=float(np.max(np.abs(phi_integral - pack.phi))),
         L=list(run.box), time=float(times[-1]), steady_from=t0, steady_detected=bool(steady_detected),
@@ -265,14 +286,9 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
                    migration_time(times, phi_center))),
         phi_wall_layer=float(np.mean(phi_walls[start:])),
         phi_sbm_region=phi_region,
-        jammed_width_over_a1=jammed_width, phi_m=phi_m,
+        jammed_width_over_a1=jammed_width(coarse, mid, phi_m), phi_m=phi_m,
         u_center_star=u_center, u_center_star_newtonian=0.5,
-        shear_stress_linearity_rel_error=float(np.max(coarse_deviation[~coarse_layer])),
-        shear_stress_linearity_wall_layer_rel_error=float(np.max(coarse_deviation[coarse_layer])),
-        shear_stress_linearity_fine_rel_error=float(np.max(deviation[~layer])),
-        shear_stress_linearity_fine_wall_layer_rel_error=float(np.max(deviation[layer])),
-        wall_force_balance_rel_error=abs(tau_lo - tau_hi - 2 * sc.tau_w) / (2 * sc.tau_w),
-        wall_shear_stress_asymmetry=abs(tau_lo + tau_hi) / sc.tau_w,
+        **{k: v for k, v in balance.items() if k != "figure"},
         sbm_phi_rms_diff=sbm_phi_rms, sbm_u_rms_diff=sbm_u_rms, sbm_jammed_width_over_a1=2 * model.y_jammed * sc.width,
         sbm_material=material.describe,
         grad_p0=sc.grad, u_c=sc.u_c, tau_w=sc.tau_w, time_unit=sc.time_unit,
@@ -282,9 +298,7 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
         inner_iterations_max=int(inner.max()), unconverged_steps=int(np.sum(steps["converged"] == 0)),
         wall_seconds=wall_seconds, ranks=ranks, core_seconds=wall_seconds * ranks, springs=dict(run.springs))
     figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, times=times, phi_center=phi_center,
-                  phi_walls=phi_walls, model=model, faces=faces + channel.y_lo, total=total, fluid=fluid,
-                  particle=particle.sigma_p[:, xy], line=line, sigma_c_yy=coarse.sigma_c[:, yy], start=t0, phi_m=phi_m,
-                  coarse_total=coarse_total)
+                  phi_walls=phi_walls, model=model, start=t0, phi_m=phi_m, **balance["figure"])
     return results, figure
 
 
@@ -296,8 +310,13 @@ def plot(path: str, fig: dict) -> str:
     from matplotlib.figure import Figure
     sc: Scales = fig["scales"]
     ch: profiles.Channel = fig["channel"]
-    ys = lambda y: (np.asarray(y) - ch.y_mid) / sc.width  # noqa: E731
-    us = lambda u: np.asarray(u) / (2 * sc.u_c)  # noqa: E731
+
+    def ys(y):
+        return (np.asarray(y) - ch.y_mid) / sc.width
+
+    def us(u):
+        return np.asarray(u) / (2 * sc.u_c)
+
     coarse, fine, model = fig["coarse"], fig["fine"], fig["model"]
     f = Figure(figsize=(12, 8.5))
     ax = f.subplots(2, 2)
