@@ -363,12 +363,13 @@ def test_fdmProfiles_command_on_a_run_folder(tiny_run, tmp_path, env):
 
 
 def test_time_step_beyond_the_measured_limit_is_warned(couette):
-    # the stability map's limits (docs/benchmarks.md): phi 0.47 holds at dt 0.02 and stops at 0.05
-    assert couette.time_step_warning(0.47, 0.02) is None
+    # the stability maps' limits (docs/benchmarks.md): phi 0.47 holds up to dt 0.1 (the fourth map)
+    assert couette.time_step_warning(0.47, 0.05) is None
     assert couette.time_step_warning(0.27, 0.1) is None
     assert couette.time_step_warning(0.3032, 0.04) is None     # the run time against error scene
-    message = couette.time_step_warning(0.47, 0.05)
-    assert "dt = 0.05" in message and "phi_bulk 0.47" in message and "0.02" in message
+    message = couette.time_step_warning(0.47, 0.2)
+    assert "dt = 0.2" in message and "phi_bulk 0.47" in message and "0.1" in message
     # between two measured rows the denser row's limit applies; beyond the densest, said so
-    assert "0.02" in couette.time_step_warning(0.37, 0.04)
-    assert "denser than any measured" in couette.time_step_warning(0.54, 0.05)
+    assert "0.08" in couette.time_step_warning(0.29, 0.09)
+    assert couette.time_step_warning(0.37, 0.04) is None
+    assert "denser than any measured" in couette.time_step_warning(0.54, 0.15)
