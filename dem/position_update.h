@@ -15,8 +15,10 @@
    target; gaps inside contact springs (h < h_r) and closed ones are held at the gap the straight
    step gives them. The target is exact for a rigid rotation (h unchanged) and for a lubrication squeeze at
    constant force (hdot/h constant), keeps gaps positive at any dt, and differs from the straight
-   step by O(dt^3): the scheme stays second order. Plain C++ (no LIGGGHTS), tested in
-   dem/tests/test_position_update.cpp. */
+   step by O(dt^3): the scheme stays second order. Where the targets contradict each other (the
+   sweeps stall more than half a target off: dense clusters, large dt), the step falls back to the
+   straight step with every gap kept from closing below min(target, h_n). Plain C++ (no LIGGGHTS),
+   tested in dem/tests/test_position_update.cpp. */
 
 #ifndef FDM_POSITION_UPDATE_H
 #define FDM_POSITION_UPDATE_H
