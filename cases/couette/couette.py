@@ -59,7 +59,8 @@ TABLE8 = {
 # bars. 0.27 from the stability map (2 strain units of the 10 x 12 x 8 a1 scene), 0.30 from the run time
 # against error study (12 strain units of 10 x 16 x 8 a1), 0.47 from the fourth stability map: since
 # the position update's fallback (2026-11-25) the runs hold up to dt 0.1, but over 8 strain units
-# eta_s at dt 0.05 is 16 +- 2 against 36 +- 5 at dt 0.02: accuracy, not stability, sets 0.02 there.
+# eta_s at dt 0.05 is 16 +- 2 against 36 +- 5 at dt 0.02: accuracy, not stability, sets 0.02 there
+# (largely through the rule's k_t = 0.5 zeta_t/dt: with 0.02's k_t at dt 0.05, 24 +- 4).
 # docs/benchmarks.md, "Stability map".
 MEASURED_DT_LIMITS = {0.27: 0.1, 0.30: 0.08, 0.47: 0.02}
 
