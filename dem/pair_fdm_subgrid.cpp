@@ -192,8 +192,8 @@ void PairFdmSubgrid::fluidParameters()
     const std::string path = calibrationFile_.empty() ? res::SqueezeCalibration::defaultPath() : calibrationFile_;
     try {
       calibration_.reset(new res::SqueezeCalibration(res::SqueezeCalibration::read(path)));
-      model_.reset(new res::CalibratedSubgridModel(*calibration_, meshSize_, cutoffCells_, wallCutoffCells_));
-      wallModel_.reset(new res::CalibratedSubgridModel(*calibration_, meshSize_, cutoffCells_, wallCutoffCells_));
+      model_ = std::make_shared<res::CalibratedSubgridModel>(*calibration_, meshSize_, cutoffCells_, wallCutoffCells_);
+      wallModel_ = model_;   // it holds both cut-offs
     } catch (const std::exception &e) {
       session.abandon(std::string("fdmDEM: pair fdm/subgrid: ") + e.what());
       error->all(FLERR, (std::string("pair fdm/subgrid: ") + e.what()).c_str());

@@ -133,7 +133,8 @@ class PairFdmSubgrid : public Pair {
 
   // from the fluid solver at the handshake (coupling session)
   double viscosity_, meshSize_;
-  std::unique_ptr<fdm::resistance::SubgridModel> model_, wallModel_;  // pairs, walls
+  // pairs, walls: two cut-off models (their cut-offs differ); the calibrated model serves both
+  std::shared_ptr<fdm::resistance::SubgridModel> model_, wallModel_;
   std::unique_ptr<fdm::resistance::SqueezeCalibration> calibration_;  // model calibrated
 
   double rangeGap_;            // largest surface gap with any pair interaction (contact or lubrication)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import load_case_module
-from fdmsubgrid import poiseuille, shear
+from fdmsubgrid import output, poiseuille, shear
 
 SMALL = ["--size", "8", "12", "8", "--duration", "2", "--dump-every", "0.1", "--seed", "2"]
 
@@ -59,7 +59,7 @@ def test_channel_profile_record_is_the_mean_velocity(small_run):
     """fdmFoam's channelProfile.dat: one line per step, the plane averages of U; at rest walls and a
     flow along x only: u_y averages to zero on every plane (continuity, to the pressure solver's
     tolerance 1e-3 and the forcing inside the particles: 1.5e-3 of u_x measured), u_x > 0."""
-    prof = poiseuille.read_channel_profile(small_run["run_dir"])
+    prof = output.channel_profile(os.path.join(small_run["run_dir"], "fluid"))
     assert len(prof["step"]) == 40 and prof["u"].shape[1] == 36
     assert np.max(np.abs(prof["u"][:, :, 1])) < 1e-2 * np.max(np.abs(prof["u"][:, :, 0]))
     assert np.all(prof["u"][:, :, 0] > 0)
@@ -99,16 +99,14 @@ def test_fluid_shear_stress_of_the_newtonian_parabola():
     L, n, eta, u_c = 12.0, 36, 1.0, 3.0
     d = L / n
     centres = d * (np.arange(n) + 0.5)
-    u = np.zeros((1, n, 3))
-    u[0, :, 0] = 4 * u_c * centres * (L - centres) / L ** 2
-    prof = dict(step=np.array([1]), time=np.array([0.1]), u=u, delta=d)
+    u = 4 * u_c * centres * (L - centres) / L ** 2
     grad = -8 * eta * u_c / L ** 2
-    faces, tau = poiseuille.fluid_shear_stress(prof, eta, np.array([True]))
+    faces, tau = poiseuille.fluid_shear_stress(u, d, eta)
     exact = grad * (faces - L / 2)
     assert np.max(np.abs(tau[1:-1] - exact[1:-1])) < 1e-12
     assert np.max(np.abs(tau[[0, -1]] - exact[[0, -1]])) < 0.06 * abs(exact[0])
     edges = np.linspace(0, L, 13)
-    binned = poiseuille.fluid_shear_stress_in_bins(prof, eta, np.array([True]), edges)
+    binned = poiseuille.fluid_shear_stress_in_bins(u, d, eta, edges)
     exact_bins = grad * (0.5 * (edges[1:] + edges[:-1]) - L / 2)
     assert np.max(np.abs(binned[1:-1] - exact_bins[1:-1])) < 1e-12
     assert np.max(np.abs(binned - exact_bins)) < 0.05 * abs(grad * L / 2)
@@ -126,8 +124,8 @@ def test_two_fluid_ranks_give_the_serial_profile(case_module, small_run, tmp_pat
     with pytest.raises(ValueError, match="too few"):    # 4 steps: too short for the analysis, run all the same
         case_module.main(args + ["--np-fluid", "2", "--workdir", str(work), "--out", str(work / "r.json")])
     run2 = os.path.join(str(work), os.path.basename(small_run["run_dir"]))
-    serial = poiseuille.read_channel_profile(small_run["run_dir"])
-    parallel = poiseuille.read_channel_profile(run2)
+    serial = output.channel_profile(os.path.join(small_run["run_dir"], "fluid"))
+    parallel = output.channel_profile(os.path.join(run2, "fluid"))
     assert len(parallel["step"]) == 4
     scale = np.max(np.abs(serial["u"][:4, :, 0]))
     difference = np.abs(parallel["u"][:, :, 0] - serial["u"][:4, :, 0])

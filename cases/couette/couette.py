@@ -40,7 +40,6 @@ ETA = suspension.ETA
 SHEAR_RATE = 1.0
 ROUGHNESS = suspension.ROUGHNESS   # h_r (section 6)
 FRICTION = suspension.FRICTION     # mu_s (section 6)
-MARON_PIERCE = suspension.MARON_PIERCE
 
 # Table 8: phi_bulk -> (phi_core, gamma_core/gamma_0, (Lx, Ly, Lz)/a1, N_P, dt)
 TABLE8 = {

@@ -35,7 +35,7 @@ sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 from fdmsubgrid import checkpoint, output, rheology  # noqa: E402
 from fdmsubgrid.shear import steps_planned  # noqa: E402
 
-PAPER_FIT = dict(alpha=0.803, phi_m=0.59)   # paper section 6.1, Eq. (55)
+PAPER_FIT = dict(zip(("alpha", "phi_m"), rheology.PAPER_MARON_PIERCE))   # paper section 6.1, Eq. (55)
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
 
 

@@ -134,9 +134,13 @@ def main(argv: list[str] | None = None) -> dict:
 def compare(run_a: str, run_b: str, material=None, from_time=None) -> dict:
     """The differences of the coarse (bins of a1) phi and u_p* profiles of two runs of one channel,
     averaged over the same window: from from_time, else from the later of their steady starts."""
+    analysed = [poiseuille.analyse(r, material, from_time) for r in (run_a, run_b)]
     if from_time is None:
-        from_time = max(poiseuille.analyse(r, material)[0]["steady_from"] for r in (run_a, run_b))
-    (ra, fa), (rb, fb) = (poiseuille.analyse(r, material, from_time) for r in (run_a, run_b))
+        # the later steady start; the run that set it is already averaged from there
+        from_time = max(res["steady_from"] for res, _ in analysed)
+        analysed = [a if a[0]["steady_from"] == from_time else poiseuille.analyse(r, material, from_time)
+                    for a, r in zip(analysed, (run_a, run_b))]
+    (ra, fa), (rb, fb) = analysed
     if len(fa["coarse"].y) != len(fb["coarse"].y):
         raise SystemExit("poiseuille --compare: the runs have different channels (%s, %s)" % (ra["L"], rb["L"]))
     u = [f["coarse"].u_p[:, 0] / (2 * f["scales"].u_c) for f in (fa, fb)]

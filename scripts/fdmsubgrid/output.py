@@ -46,6 +46,27 @@ def particles(fluid_case):
     return _read(os.path.join(fluid_case, "postProcessing", "fdm", "particles.dat"), PARTICLE_COLUMNS)
 
 
+def channel_profile(fluid_case):
+    """fdmFoam's channelProfile.dat (a channel with the mean-flow correction on, docs/fluid.md): step
+    (T,), time (T,), u (T, n, 3) the plane averages of U over the n cell planes from the low wall up,
+    delta the cell width."""
+    path = os.path.join(fluid_case, "postProcessing", "fdm", "channelProfile.dat")
+    if not os.path.isfile(path):
+        raise FileNotFoundError("%s not found: fdmFoam writes it in a channel with the mean-flow correction on "
+                                "(innerIterations { meanFlowCorrection yes; }, the default)" % path)
+    with open(path) as f:
+        header = f.readline()
+    try:
+        n = int(header.split("over the ")[1].split()[0])
+        delta = float(header.split("cell width ")[1].split()[0])
+    except (IndexError, ValueError):
+        raise ValueError("%s: the header does not give the planes and the cell width" % path) from None
+    columns = ["step", "time"] + ["U%s%d" % (c, j) for j in range(n) for c in "xyz"]
+    data = _read(path, columns)
+    u = np.stack([data[name] for name in columns[2:]], axis=1).reshape(-1, n, 3)
+    return dict(step=data["step"].astype(int), time=data["time"], u=u, delta=delta)
+
+
 # ------------------------------------------------------------------------------------------------
 # Wall loads: the force of the fluid (fdmFoam, postProcessing/fdm/walls.dat) and of the particles
 # (fix fdm/couple ... walls FILE) on each wall, per step -- the momentum balance of a sheared

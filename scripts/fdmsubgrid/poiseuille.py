@@ -15,7 +15,8 @@ What `analyse` measures (docs/profiles.md, "Pressure-driven flow"):
   (bins of width a1, Eq. 60) phi(y) (Eq. 49) and u_p*(y) (Eqs. 59, 61), Sigma^c_yy(y) and Sigma_xy(y);
 - the momentum balance: in steady Stokes flow the total shear stress is exactly Sigma_xy(y) =
   (dP0/dx)(y - L_y/2). Its parts on the cell faces: the fluid term eta d<u>/dy from the plane averages
-  of the whole velocity field (fluid and rigid particle interiors, fdmFoam's channelProfile.dat), and
+  of the whole velocity field (fluid and rigid particle interiors, fdmFoam's channelProfile.dat,
+  output.channel_profile), and
   the particle terms Sigma^h_xy + Sigma^c_xy of Eq. 53; the deviation from the line, over the wall
   stress tau_w = |dP0/dx| L_y/2, in the core and in the wall layers, in the bins of a1 (Eq. 60, each
   term its exact bin average: the reported error) and on the cell faces (the `_fine_` keys: layering
@@ -77,51 +78,24 @@ def scales(run: shear.ShearRun) -> Scales:
     return Scales(grad=float(g[0]), u_c=u_c, tau_w=abs(g[0]) * width / 2, time_unit=width / (2 * u_c), width=width)
 
 
-def read_channel_profile(run_dir: str) -> dict:
-    """fdmFoam's channelProfile.dat: step (T,), time (T,), u (T, n, 3) the plane averages of U over the n
-    cell planes from the low wall up, delta the cell width."""
-    path = os.path.join(run_dir, "fluid", "postProcessing", "fdm", "channelProfile.dat")
-    if not os.path.isfile(path):
-        raise PoiseuilleRunError("%s not found: fdmFoam writes it in a channel with the mean-flow correction on "
-                                 "(innerIterations { meanFlowCorrection yes; }, the default)" % path)
-    with open(path) as f:
-        header = f.readline()
-        text = f.read()
-    try:
-        n = int(header.split("over the ")[1].split()[0])
-        delta = float(header.split("cell width ")[1].split()[0])
-    except (IndexError, ValueError):
-        raise PoiseuilleRunError("%s: the header does not give the planes and the cell width" % path) from None
-    text = text[:text.rfind("\n") + 1] if not text.endswith("\n") else text
-    data = np.loadtxt(text.splitlines(), ndmin=2) if text.strip() else np.zeros((0, 2 + 3 * n))
-    if data.shape[1] != 2 + 3 * n:
-        raise PoiseuilleRunError("%s: %d columns, expected %d (step, time, 3 per plane)" % (path, data.shape[1],
-                                                                                            2 + 3 * n))
-    return dict(step=data[:, 0].astype(int), time=data[:, 1], u=data[:, 2:].reshape(-1, n, 3), delta=delta)
-
-
-def fluid_shear_stress(profile: dict, eta: float, selected: NDArray) -> tuple[NDArray, NDArray]:
-    """(faces y (n+1,), eta d<u_x>/dy on them) averaged over the selected steps (bool (T,)): centred
-    differences between the planes' centres, and from the wall (at rest) to the first centre."""
-    u = profile["u"][selected, :, 0].mean(axis=0)
-    d = profile["delta"]
+def fluid_shear_stress(u: NDArray, delta: float, eta: float) -> tuple[NDArray, NDArray]:
+    """(faces y (n+1,), eta d<u_x>/dy on them) of the mean profile u (n,) of the cell planes (cell width
+    delta, from the low wall at 0): centred differences between the planes' centres, and from the wall
+    (at rest) to the first centre."""
     n = len(u)
-    faces = d * np.arange(n + 1)
+    faces = delta * np.arange(n + 1)
     slope = np.empty(n + 1)
-    slope[1:-1] = np.diff(u) / d
-    slope[0] = u[0] / (0.5 * d)
-    slope[-1] = -u[-1] / (0.5 * d)
+    slope[1:-1] = np.diff(u) / delta
+    slope[0] = u[0] / (0.5 * delta)
+    slope[-1] = -u[-1] / (0.5 * delta)
     return faces, eta * slope
 
 
-def fluid_shear_stress_in_bins(profile: dict, eta: float, selected: NDArray, edges: NDArray) -> NDArray:
-    """eta d<u_x>/dy averaged over each bin [edges[k], edges[k+1]] (edges from the low wall at 0),
-    exactly: eta (<u>(e1) - <u>(e0))/(e1 - e0), <u> on the cell faces the mean of its two cells
-    (the walls' value, at rest, on the walls), linear between faces."""
-    u = profile["u"][selected, :, 0].mean(axis=0)
-    d = profile["delta"]
-    n = len(u)
-    faces = d * np.arange(n + 1)
+def fluid_shear_stress_in_bins(u: NDArray, delta: float, eta: float, edges: NDArray) -> NDArray:
+    """eta d<u_x>/dy averaged over each bin [edges[k], edges[k+1]] (edges from the low wall at 0) of the
+    mean profile u (n,), exactly: eta (<u>(e1) - <u>(e0))/(e1 - e0), <u> on the cell faces the mean of
+    its two cells (the walls' value, at rest, on the walls), linear between faces."""
+    faces = delta * np.arange(len(u) + 1)
     u_faces = np.concatenate([[0.0], 0.5 * (u[1:] + u[:-1]), [0.0]])
     at = np.interp(edges, faces, u_faces)
     return eta * np.diff(at) / np.diff(edges)
@@ -157,9 +131,10 @@ def momentum_balance(run_dir: str, eta: float, sc: Scales, channel: profiles.Cha
     faces and in the coarse bins, with the walls' stresses; a dict of the results' keys and, under
     "figure", the profiles."""
     xy = profiles.component(0, 1)
-    prof = read_channel_profile(run_dir)
-    sel = prof["time"] / sc.time_unit >= t0 - 1e-9
-    faces, fluid = fluid_shear_stress(prof, eta, sel)
+    prof = output.channel_profile(os.path.join(run_dir, "fluid"))
+    # the suspension's mean velocity over the same window as the particles
+    u = prof["u"][prof["time"] / sc.time_unit >= t0 - 1e-9, :, 0].mean(axis=0)
+    faces, fluid = fluid_shear_stress(u, prof["delta"], eta)
     y_faces = faces + channel.y_lo
     particle = profiles.average_profiles(snapshots, channel, y=y_faces, errors=False).sigma_p[:, xy]
     loads = output.read_wall_loads(run_dir)
@@ -178,7 +153,7 @@ def momentum_balance(run_dir: str, eta: float, sc: Scales, channel: profiles.Cha
     layer = _layer_mask(y_faces, channel)
     # the same in the bins of a1 (Eq. 60: the scale of the profiles), each term its exact bin average
     edges = coarse.edges
-    coarse_total = fluid_shear_stress_in_bins(prof, eta, sel, edges - channel.y_lo) + coarse.sigma_p[:, xy]
+    coarse_total = fluid_shear_stress_in_bins(u, prof["delta"], eta, edges - channel.y_lo) + coarse.sigma_p[:, xy]
     coarse_deviation = np.abs(coarse_total - line(0.5 * (edges[1:] + edges[:-1]))) / sc.tau_w
     coarse_layer = (edges[:-1] < channel.y_lo + WALL_LAYER - 1e-9) | (edges[1:] > channel.y_hi - WALL_LAYER + 1e-9)
     return dict(

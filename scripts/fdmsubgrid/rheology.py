@@ -243,6 +243,10 @@ def stress_balance(rheology: ShearRheology, loads, channel: Channel, strain_rate
 
 # ---- Maron-Pierce ------------------------------------------------------------------------------
 
+PAPER_MARON_PIERCE = (0.803, 0.59)
+"""alpha, phi_m of the paper's fit of Eq. 55 (section 6.1, Fig. 21)."""
+
+
 def maron_pierce(phi: ArrayLike, alpha: float, phi_m: float) -> NDArray:
     """Eq. 55: alpha / (1 - phi/phi_m)^2."""
     return alpha / (1.0 - np.asarray(phi, dtype=float) / phi_m) ** 2

@@ -42,9 +42,11 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid, solve_ivp
 from scipy.optimize import brentq, curve_fit
 
+from . import rheology
+
 # The paper's material functions (section 6): Maron-Pierce fit of Fig. 21 (Eq. 55) with the jamming
-# fraction of section 6.2 (phi_m = 0.592)
-PAPER_ALPHA = 0.803
+# fraction of section 6.2 (phi_m = 0.592, where section 6.1's fit rounds to 0.59)
+PAPER_ALPHA = rheology.PAPER_MARON_PIERCE[0]
 PAPER_PHI_M = 0.592
 # The contact normal stress Sigma_hat^c_22 = -K phi_r^n: n = 2 and K = 0.8 give Morris & Boulay's (1999)
 # normal-to-shear viscosity ratio lambda_2 = 0.8 at phi_m with their phi_r^2 growth, and -0.218 at
@@ -87,7 +89,7 @@ class MaterialFunctions:
         def eta_s(r: NDArray) -> NDArray:
             r = np.asarray(r, dtype=float)
             with np.errstate(divide="ignore"):
-                return np.where(r < 1.0, alpha / np.square(1.0 - np.minimum(r, 1.0)), np.inf)
+                return np.where(r < 1.0, rheology.maron_pierce(np.minimum(r, 1.0) * phi_m, alpha, phi_m), np.inf)
 
         return cls(phi_m=phi_m, eta_s=eta_s,
                    sigma22=lambda r: -contact_k * np.power(np.asarray(r, dtype=float), contact_n),
@@ -246,7 +248,6 @@ def from_couette_results(paths: Sequence[str], phi_m: float | None = None) -> Ma
     if not rows:
         raise SBMError("no Couette results files given")
     phi, eta, eta_err, s22, s22_err = (np.array(c) for c in zip(*rows))
-    from . import rheology
     if len(rows) >= 3 and phi_m is None:
         fit = rheology.fit_maron_pierce(phi, eta, eta_err)
         alpha, phi_m = fit.alpha, fit.phi_m

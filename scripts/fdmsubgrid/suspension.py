@@ -27,21 +27,20 @@ import math
 import os
 from dataclasses import dataclass
 
-from . import case, output, packing, theory
+from . import case, output, packing, rheology, theory
 
 A1 = 1.0
 A2 = packing.A2_OVER_A1 * A1
 ETA = 1.0
 ROUGHNESS = 5e-3 * A1         # h_r (section 6)
 FRICTION = 0.5                # mu_s (section 6)
-MARON_PIERCE = (0.803, 0.59)  # alpha, phi_m of the paper's fit (Eq. 55, Fig. 21)
 TANGENTIAL_SAFETY = 0.5       # k_t dt / zeta_t of the rule (docs/contact.md recipe step 4)
 
 
 def maron_pierce_viscosity(phi: float) -> float:
-    """The paper's relative viscosity (Eq. 55), held finite above 0.9 phi_m."""
-    alpha, phi_m = MARON_PIERCE
-    return alpha / (1.0 - min(phi, 0.9 * phi_m) / phi_m) ** 2
+    """The paper's relative viscosity (Eq. 55, rheology.PAPER_MARON_PIERCE), held finite above 0.9 phi_m."""
+    alpha, phi_m = rheology.PAPER_MARON_PIERCE
+    return float(rheology.maron_pierce(min(phi, 0.9 * phi_m), alpha, phi_m))
 
 
 @dataclass(frozen=True)
