@@ -508,23 +508,6 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
   for (const Mode &m : modes)
     if (m.zetaContact / m.k < worst->zetaContact / worst->k) worst = &m;
   const double limit = factor * worst->zetaContact / worst->k;
-  if (implicit_ && comm->me == 0) {
-    // Measured, not derived: a single implicit contact is stable at any dt k_t/zeta_t (docs/contact.md
-    // (d)), but sheared suspensions blew up at 320 and 400 and held at 41 and below (docs/benchmarks.md,
-    // "Stability map"; the cause is not known yet)
-    const double measuredSafe = 50;
-    for (const Mode &m : modes) {
-      if (m.name.compare(0, 10, "tangential") != 0 || dt * m.k / m.zetaContact <= measuredSafe) continue;
-      const std::string line = "WARNING: pair_style fdm/subgrid: time step " + fmt(dt) + " s gives the " + m.name +
-                               " dt k_t/zeta_t = " + fmt(dt * m.k / m.zetaContact) + " at the contact gap h_r: "
-                               "sheared suspensions with implicit tangential springs blew up at 320 and 400 and held "
-                               "at 41 and below (docs/benchmarks.md, 'Stability map'); k_t = " +
-                               fmt(0.5 * m.zetaContact / dt) + " N/m (0.5 zeta_t/dt) is what cases/couette uses\n";
-      if (screen) fputs(line.c_str(), screen);
-      if (logfile) fputs(line.c_str(), logfile);
-      break;
-    }
-  }
   if (dt <= limit) return;
   if (implicit_) {
     // implicit springs (docs/contact.md 2b, Eq. C4): no stability limit from them; say how far
