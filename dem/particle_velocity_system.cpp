@@ -255,36 +255,40 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
   }
   rhs += m.wallRhs;
 
-  Eigen::VectorXd u;
+  // one solve of the linear system for the right-hand side `total`, into u_
+  auto solveLinear = [&](const Eigen::VectorXd &total) {
+    Eigen::VectorXd u;
+    if (settings_.solver == ldlt) {
+      u = m.ldlt.solve(total);  // the factorisation of this step
+      iterations_ = 1;
+    } else {
+      const Eigen::Map<const Eigen::VectorXd> guess(u_.data(), 6 * N);  // warm start: the previous solution
+      u = m.cg.solveWithGuess(total, guess);
+      iterations_ = long(m.cg.iterations());
+      if (m.cg.info() != Eigen::Success && !(m.cg.error() < 1e-6))
+        throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) did not converge: relative residual " +
+                                          number(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
+                                          " conjugate-gradient iterations (" + std::to_string(pairBlocks_) +
+                                          " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
+    }
+    for (int k = 0; k < 6 * N; k++) {
+      if (!std::isfinite(u(k))) {
+        const int p = k / 6;
+        const Particle &q = particles_[p];
+        throw Error(Error::notSolved, p, "the velocity of particle " + particleId(p) + " at " + point(q.x) +
+                                         " is not finite (Eq. 31): its force " + point(q.force) + ", torque " +
+                                         point(q.torque) + ", fluid integrals Vu " + number(Vu_[p]) + " Ju " +
+                                         number(Ju_[p]));
+      }
+      u_[k] = u(k);
+    }
+  };
   // Coulomb's law at the end of the step: solve, let the overloaded sticking contacts slide, solve
-  // again; each round only moves contacts from sticking to sliding, so it ends (docs/contact.md 2c)
+  // again; a round only moves contacts from sticking to sliding or lowers their cap (docs/contact.md 2c)
   const int maxCoulombRounds = 100;  // each round a back-substitution (a factorisation if contacts began to slide)
   for (int round = 0;; round++) {
-  const Eigen::VectorXd total = rhs + m.springRhs + m.frictionRhs;
-  if (settings_.solver == ldlt) {
-    u = m.ldlt.solve(total);  // the factorisation of this step
-    iterations_ = 1;
-  } else {
-    const Eigen::Map<const Eigen::VectorXd> guess(u_.data(), 6 * N);  // warm start: the previous solution
-    u = m.cg.solveWithGuess(total, guess);
-    iterations_ = long(m.cg.iterations());
-    if (m.cg.info() != Eigen::Success && !(m.cg.error() < 1e-6))
-      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) did not converge: relative residual " +
-                                        number(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
-                                        " conjugate-gradient iterations (" + std::to_string(pairBlocks_) +
-                                        " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
-  }
-  for (int k = 0; k < 6 * N; k++) {
-    if (!std::isfinite(u(k))) {
-      const int p = k / 6;
-      const Particle &q = particles_[p];
-      throw Error(Error::notSolved, p, "the velocity of particle " + particleId(p) + " at " + point(q.x) +
-                                       " is not finite (Eq. 31): its force " + point(q.force) + ", torque " +
-                                       point(q.torque) + ", fluid integrals Vu " + number(Vu_[p]) + " Ju " + number(Ju_[p]));
-    }
-    u_[k] = u(k);
-  }
-  if (round == maxCoulombRounds || !slideOverloadedContacts()) break;
+    solveLinear(rhs + m.springRhs + m.frictionRhs);
+    if (round == maxCoulombRounds || !slideOverloadedContacts()) break;
   }
   return u_;
 }
