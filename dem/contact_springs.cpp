@@ -72,5 +72,61 @@ void wallSpringBlock(const double n[3], double lever, double kn, double kt, doub
   for (int r = 0; r < 6; r++) wallTerm[r] = B[r] * f[0] + B[6 + r] * f[1] + B[12 + r] * f[2];
 }
 
+namespace {
+
+// the tangential part (I - n n^T) of v
+void tangential(const double n[3], double v[3])
+{
+  const double vn = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+  for (int a = 0; a < 3; a++) v[a] -= vn * n[a];
+}
+
+}  // namespace
+
+void pairTangentialForceAtEnd(const double n[3], double leverI, double leverJ, double ktc1dt, const double ft[3],
+                              const double uRel[12], double out[3])
+{
+  // B u (Eq. C1): U_i - U_j - (l_i Omega_i + l_j Omega_j) x n
+  double w[3], slip[3];
+  for (int a = 0; a < 3; a++) w[a] = leverI * uRel[3 + a] + leverJ * uRel[9 + a];
+  const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
+  for (int a = 0; a < 3; a++) slip[a] = uRel[a] - uRel[6 + a] - wxn[a];
+  tangential(n, slip);
+  for (int a = 0; a < 3; a++) out[a] = ft[a] - ktc1dt * slip[a];
+}
+
+void wallTangentialForceAtEnd(const double n[3], double lever, double ktc1dt, double ktdt, const double ft[3],
+                              const double wallVelocity[3], const double uRel[6], double out[3])
+{
+  // rho = c1 B u_rel - U_w (c1 + c0 = 1): the wall's displacement in the step is dt U_w
+  const double w[3] = {lever * uRel[3], lever * uRel[4], lever * uRel[5]};
+  const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
+  double slip[3], wall[3] = {wallVelocity[0], wallVelocity[1], wallVelocity[2]};
+  for (int a = 0; a < 3; a++) slip[a] = uRel[a] - wxn[a];
+  tangential(n, slip);
+  tangential(n, wall);
+  for (int a = 0; a < 3; a++) out[a] = ft[a] - ktc1dt * slip[a] + ktdt * wall[a];
+}
+
+void pairGeneralisedForce(const double n[3], double leverI, double leverJ, const double f[3], double out[12])
+{
+  const double nxf[3] = {n[1] * f[2] - n[2] * f[1], n[2] * f[0] - n[0] * f[2], n[0] * f[1] - n[1] * f[0]};
+  for (int a = 0; a < 3; a++) {
+    out[a] = f[a];
+    out[3 + a] = -leverI * nxf[a];
+    out[6 + a] = -f[a];
+    out[9 + a] = -leverJ * nxf[a];
+  }
+}
+
+void wallGeneralisedForce(const double n[3], double lever, const double f[3], double out[6])
+{
+  const double nxf[3] = {n[1] * f[2] - n[2] * f[1], n[2] * f[0] - n[0] * f[2], n[0] * f[1] - n[1] * f[0]};
+  for (int a = 0; a < 3; a++) {
+    out[a] = f[a];
+    out[3 + a] = -lever * nxf[a];
+  }
+}
+
 }  // namespace contact
 }  // namespace fdm

@@ -39,6 +39,19 @@ void pairSpringBlock(const double n[3], double leverI, double leverJ, double kn,
 void wallSpringBlock(const double n[3], double lever, double kn, double kt, double c1dt, double dt,
                      const double wallVelocity[3], double R[36], double wallTerm[6]);
 
+// Coulomb's law inside the step (docs/contact.md 2c). u_rel: the unknowns' part of the contact points'
+// displacement rate, u - gamma U_n, of the pair (12) or the particle (6). The tangential force of a
+// sticking contact at the end of the step, F_t,end = F_t - kt dt (I - n n^T) rho with
+// rho = c1 B u_rel - U_w (Eqs. C1, C2): ktc1dt = kt c1 dt, ktdt = kt dt (the wall term).
+void pairTangentialForceAtEnd(const double n[3], double leverI, double leverJ, double ktc1dt, const double ft[3],
+                              const double uRel[12], double out[3]);
+void wallTangentialForceAtEnd(const double n[3], double lever, double ktc1dt, double ktdt, const double ft[3],
+                              const double wallVelocity[3], const double uRel[6], double out[3]);
+// B^T f: the generalised force on (U_i, Omega_i, U_j, Omega_j) of a force f on i at the contact point
+// (and -f on j): (f, -l_i n x f, -f, -l_j n x f); for a wall (f, -l n x f).
+void pairGeneralisedForce(const double n[3], double leverI, double leverJ, const double f[3], double out[12]);
+void wallGeneralisedForce(const double n[3], double lever, const double f[3], double out[6]);
+
 }  // namespace contact
 }  // namespace fdm
 

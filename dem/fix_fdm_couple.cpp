@@ -627,6 +627,7 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   // rank 0, after the last inner iteration: the sub-grid force and torque (Eq. 21 and D.6) and,
   // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
   subgrid_ = system_->subgridForces();
+  run_.contactSlides += system_->slidingSwitches();
   // the implicit part of the contact forces (Eq. C2) and of their stresslet (Eq. 52)
   std::vector<double> springStress(size_t(6) * natoms_, 0.0);
   springs_ = system_->springForces(stresslets_ ? &springStress : nullptr,
@@ -1020,11 +1021,11 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
                 "%s iterations mean %.1f max %ld; last step %ld sub-grid pair blocks, %ld wall blocks, %ld contacts; "
-                "position update %s%s%s\n",
+                "%ld contacts began to slide within their step; position update %s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
                 directSolver_ ? "LDLT" : "CG", t.solves ? double(t.solverIterations) / t.solves : 0.0,
-                t.solverIterationsMax, pairBlocks_, wallBlocks_, contacts_,
+                t.solverIterationsMax, pairBlocks_, wallBlocks_, contacts_, t.contactSlides,
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");
   if (screen) fputs(line, screen);

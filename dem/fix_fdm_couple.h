@@ -70,8 +70,10 @@ class FixFdmCouple : public Fix {
                                    // straight, every gap kept above its bound)
     int gapSweepsMax;
     double gapBoundWorst;          // largest relative bound violation the fallback left
+    long contactSlides;            // contacts that began to slide within their step (Coulomb's law at its end)
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
-               gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0) {}
+               gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0),
+               contactSlides(0) {}
   };
 
   void gather(std::vector<Particle> &particles);

@@ -508,23 +508,6 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
   for (const Mode &m : modes)
     if (m.zetaContact / m.k < worst->zetaContact / worst->k) worst = &m;
   const double limit = factor * worst->zetaContact / worst->k;
-  if (implicit_ && comm->me == 0) {
-    // Measured, not derived: a single implicit contact is stable at any dt k_t/zeta_t (docs/contact.md
-    // (d)), but sheared suspensions blew up at 320 and 400 and held at 41 and below (docs/benchmarks.md,
-    // "Stability map"; the cause is not known yet)
-    const double measuredSafe = 50;
-    for (const Mode &m : modes) {
-      if (m.name.compare(0, 10, "tangential") != 0 || dt * m.k / m.zetaContact <= measuredSafe) continue;
-      const std::string line = "WARNING: pair_style fdm/subgrid: time step " + fmt(dt) + " s gives the " + m.name +
-                               " dt k_t/zeta_t = " + fmt(dt * m.k / m.zetaContact) + " at the contact gap h_r: "
-                               "sheared suspensions with implicit tangential springs blew up at 320 and 400 and held "
-                               "at 41 and below (docs/benchmarks.md, 'Stability map'); k_t = " +
-                               fmt(0.5 * m.zetaContact / dt) + " N/m (0.5 zeta_t/dt) is what cases/couette uses\n";
-      if (screen) fputs(line.c_str(), screen);
-      if (logfile) fputs(line.c_str(), logfile);
-      break;
-    }
-  }
   if (dt <= limit) return;
   if (implicit_) {
     // implicit springs (docs/contact.md 2b, Eq. C4): no stability limit from them; say how far
@@ -714,7 +697,7 @@ void PairFdmSubgrid::contactForces()
       const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - v[j][d] - wxn[d];
       double force[3], nxft[3];
-      const bool slides = contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
+      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= leverI * nxft[d];
@@ -722,7 +705,8 @@ void PairFdmSubgrid::contactForces()
       const double weightI = radius[i] / (radius[i] + radius[j]);
       if (implicit_ && (j < nlocal || atom->tag[i] < atom->tag[j]))
         contacts_.push_back(Contact{i, j, {n[0], n[1], n[2]}, leverI, leverJ, {-del[0], -del[1], -del[2]}, weightI,
-                                    !slides});
+                                    normalForce, {force[0] - normalForce * n[0],
+                                    force[1] - normalForce * n[1], force[2] - normalForce * n[2]}});
       if (contactStressRequested_) {
         const double branch[3] = {-del[0], -del[1], -del[2]};  // x_j - x_i
         addContactStress(i, force, branch, weightI);
@@ -773,7 +757,7 @@ void PairFdmSubgrid::wallContactForces()
       const double wxn[3] = {aw[1] * n[2] - aw[2] * n[1], aw[2] * n[0] - aw[0] * n[2], aw[0] * n[1] - aw[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - wall.velocity[d] - wxn[d];
       double force[3], nxft[3];
-      const bool slides = contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
+      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];
@@ -783,7 +767,9 @@ void PairFdmSubgrid::wallContactForces()
       if (contactStressRequested_) addContactStress(i, force, branch, 1.0);
       if (implicit_)
         contacts_.push_back(Contact{i, -1 - int(k), {n[0], n[1], n[2]}, radius[i], 0.0,
-                                    {branch[0], branch[1], branch[2]}, 1.0, !slides});
+                                    {branch[0], branch[1], branch[2]}, 1.0, normalForce,
+                                    {force[0] - normalForce * n[0], force[1] - normalForce * n[1],
+                                     force[2] - normalForce * n[2]}});
       contactsLast_++;
     }
   }
@@ -803,7 +789,7 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
   const int *tag = atom->tag;
   double R[144], term[6];
   for (const Contact &c : contacts_) {
-    const double kt = c.sticks && mu_ > 0 ? kt_ : 0.0;
+    const double kt = mu_ > 0 ? kt_ : 0.0;  // every frictional contact: the solve decides whether it slides (2c)
     if (c.j >= 0) {
       fdm::contact::pairSpringBlock(c.n, c.leverI, c.leverJ, kn_, kt, c1 * dt, R);
       pairs.push_back(tag[c.i]);
@@ -811,6 +797,10 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
       pairs.insert(pairs.end(), R, R + 144);
       pairs.insert(pairs.end(), c.branch, c.branch + 3);
       pairs.push_back(c.weight);
+      // the friction tail (fdm::springs): Coulomb's law at the end of the step (docs/contact.md 2c)
+      pairs.insert(pairs.end(), c.n, c.n + 3);
+      pairs.insert(pairs.end(), {c.leverI, c.leverJ, kt * c1 * dt, mu_, c.normalForce, kn_ * c1 * dt});
+      pairs.insert(pairs.end(), c.ft, c.ft + 3);
     } else {
       const Wall &w = walls_[size_t(-1 - c.j)];
       fdm::contact::wallSpringBlock(c.n, c.leverI, kn_, kt, c1 * dt, dt, w.velocity, R, term);
@@ -818,6 +808,10 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
       walls.insert(walls.end(), R, R + 36);
       walls.insert(walls.end(), term, term + 6);
       walls.insert(walls.end(), c.branch, c.branch + 3);
+      walls.insert(walls.end(), c.n, c.n + 3);
+      walls.insert(walls.end(), {c.leverI, kt * c1 * dt, kt * dt, mu_, c.normalForce, kn_ * c1 * dt});
+      walls.insert(walls.end(), c.ft, c.ft + 3);
+      walls.insert(walls.end(), w.velocity, w.velocity + 3);
       if (wallIndex) wallIndex->push_back(double(-1 - c.j));
     }
   }

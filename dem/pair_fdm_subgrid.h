@@ -153,7 +153,7 @@ class PairFdmSubgrid : public Pair {
   struct Contact {
     int i, j;
     double n[3], leverI, leverJ, branch[3], weight;
-    bool sticks;
+    double normalForce, ft[3];  // F_n and the explicit tangential force on i (Coulomb's law in the solve)
   };
   std::vector<Contact> contacts_;
 };

@@ -1,4 +1,5 @@
 // Eq. (31) for the particle velocities: assembly, solution and sub-grid results (see the header).
+#include "contact_springs.h"
 #include "message_text.h"
 #include "particle_velocity_system.h"
 
@@ -24,6 +25,7 @@ struct ParticleVelocitySystem::Matrices {
   std::vector<double> subgridDiagonal;  // R^SG(k, k)
   Eigen::VectorXd wallRhs;              // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
   Eigen::VectorXd springRhs;            // known part of the implicit springs: gamma R_c U_n + dt B^T K U_w (Eq. C2)
+  Eigen::VectorXd frictionRhs;          // B^T (capped force - F_t) of the contacts that slide within the step
   Eigen::VectorXd diagonal;             // (rho_f/rho_p) J/alpha_lambda of this step
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
@@ -33,7 +35,7 @@ struct ParticleVelocitySystem::Matrices {
 };
 
 ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
-  settings_(settings), n_(0), springGamma_(0), pairRecord_(subgrid::pairRecord), wallRecord_(subgrid::wallRecord), pairBlocks_(0),
+  settings_(settings), n_(0), springGamma_(0), slidingSwitches_(0), pairRecord_(subgrid::pairRecord), wallRecord_(subgrid::wallRecord), pairBlocks_(0),
   wallBlocks_(0), iterations_(0), factorisations_(0), m_(new Matrices)
 {
   if (!(settings_.alphaLambda > 0) || !(settings_.rhoFluid > 0) || !(settings_.tolerance > 0))
@@ -126,6 +128,12 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   }
   // the implicit contact springs (Eqs. C2, C3): R_c into the matrix, gamma R_c U_n + wall term into F^tot
   m.springRhs = Eigen::VectorXd::Zero(6 * N);
+  m.frictionRhs = Eigen::VectorXd::Zero(6 * N);
+  const size_t springRecords = springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord;
+  springSlides_.assign(springRecords, 0);
+  slideForce_.assign(3 * springRecords, 0.0);
+  slideDirection_.assign(3 * springRecords, 0.0);
+  slidingSwitches_ = 0;
   for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord) {
     const double *rec = &springPairs_[b];
     const int i1 = tagIndex(rec[0]), i2 = tagIndex(rec[1]);
@@ -245,33 +253,151 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
       rhs(6 * p + 3 + d) = fluidForces[size_t(6) * p + 3 + d] + q.torque[d];
     }
   }
-  rhs += m.wallRhs + m.springRhs;
+  rhs += m.wallRhs;
 
-  Eigen::VectorXd u;
-  if (settings_.solver == ldlt) {
-    u = m.ldlt.solve(rhs);  // the factorisation of this step
-    iterations_ = 1;
-  } else {
-    const Eigen::Map<const Eigen::VectorXd> guess(u_.data(), 6 * N);  // warm start: the previous solution
-    u = m.cg.solveWithGuess(rhs, guess);
-    iterations_ = long(m.cg.iterations());
-    if (m.cg.info() != Eigen::Success && !(m.cg.error() < 1e-6))
-      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) did not converge: relative residual " +
-                                        number(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
-                                        " conjugate-gradient iterations (" + std::to_string(pairBlocks_) +
-                                        " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
-  }
-  for (int k = 0; k < 6 * N; k++) {
-    if (!std::isfinite(u(k))) {
-      const int p = k / 6;
-      const Particle &q = particles_[p];
-      throw Error(Error::notSolved, p, "the velocity of particle " + particleId(p) + " at " + point(q.x) +
-                                       " is not finite (Eq. 31): its force " + point(q.force) + ", torque " +
-                                       point(q.torque) + ", fluid integrals Vu " + number(Vu_[p]) + " Ju " + number(Ju_[p]));
+  // one solve of the linear system for the right-hand side `total`, into u_
+  auto solveLinear = [&](const Eigen::VectorXd &total) {
+    Eigen::VectorXd u;
+    if (settings_.solver == ldlt) {
+      u = m.ldlt.solve(total);  // the factorisation of this step
+      iterations_ = 1;
+    } else {
+      const Eigen::Map<const Eigen::VectorXd> guess(u_.data(), 6 * N);  // warm start: the previous solution
+      u = m.cg.solveWithGuess(total, guess);
+      iterations_ = long(m.cg.iterations());
+      if (m.cg.info() != Eigen::Success && !(m.cg.error() < 1e-6))
+        throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) did not converge: relative residual " +
+                                          number(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
+                                          " conjugate-gradient iterations (" + std::to_string(pairBlocks_) +
+                                          " sub-grid pair blocks, " + std::to_string(wallBlocks_) + " wall blocks)");
     }
-    u_[k] = u(k);
+    for (int k = 0; k < 6 * N; k++) {
+      if (!std::isfinite(u(k))) {
+        const int p = k / 6;
+        const Particle &q = particles_[p];
+        throw Error(Error::notSolved, p, "the velocity of particle " + particleId(p) + " at " + point(q.x) +
+                                         " is not finite (Eq. 31): its force " + point(q.force) + ", torque " +
+                                         point(q.torque) + ", fluid integrals Vu " + number(Vu_[p]) + " Ju " +
+                                         number(Ju_[p]));
+      }
+      u_[k] = u(k);
+    }
+  };
+  // Coulomb's law at the end of the step: solve, let the overloaded sticking contacts slide, solve
+  // again; a round only moves contacts from sticking to sliding or lowers their cap (docs/contact.md 2c)
+  const int maxCoulombRounds = 100;  // each round a back-substitution (a factorisation if contacts began to slide)
+  for (int round = 0;; round++) {
+    solveLinear(rhs + m.springRhs + m.frictionRhs);
+    if (round == maxCoulombRounds || !slideOverloadedContacts()) break;
   }
   return u_;
+}
+
+double ParticleVelocitySystem::springVelocity(int k) const
+{
+  return u_[size_t(k)] - (springGamma_ != 0 ? springGamma_ * springPrevious_[size_t(k)] : 0.0);
+}
+
+bool ParticleVelocitySystem::slideOverloadedContacts()
+{
+  // Coulomb's law at the end of the step (docs/contact.md 2c), a return mapping: a sticking
+  // contact's implicit spring holds whatever tangential force the step needs (in a dense packing
+  // far beyond mu_s F_n once kt dt/zeta_t is large); such a contact slides within the step, with the
+  // cap along the direction of the overloaded force. The cap is mu_s times the smaller of the normal
+  // force at the start and at the end of the step (the implicit normal spring): friction never
+  // exceeds what the contact holds at either end, and a contact that opens within the step loses it.
+  Matrices &m = *m_;
+  bool matrixChanged = false, rhsChanged = false;
+  auto setSlideForce = [&](size_t record, const double target[3], const double *ft, const int *base, int size,
+                           const double *tail, bool wall) {
+    double change[3], f[12];
+    bool differs = false;
+    for (int a = 0; a < 3; a++) {
+      change[a] = target[a] - ft[a] - slideForce_[3 * record + a];
+      differs = differs || std::fabs(change[a]) > 1e-9 * (std::fabs(target[a]) + std::fabs(ft[a])) + 1e-300;
+    }
+    if (!differs) return;
+    for (int a = 0; a < 3; a++) slideForce_[3 * record + a] += change[a];
+    if (wall)
+      contact::wallGeneralisedForce(tail, tail[3], change, f);
+    else
+      contact::pairGeneralisedForce(tail, tail[3], tail[4], change, f);
+    for (int k = 0; k < size; k++) m.frictionRhs(base[k / 6] + k % 6) += f[k];
+    rhsChanged = true;
+  };
+  auto removeBlock = [&](const int *base, int size, const double *R) {
+    // R_t leaves the matrix (its entries exist: R_c had them), and gamma R_t U_n the known part
+    for (int i = 0; i < size; i++) {
+      const int row = base[i / 6] + i % 6;
+      for (int j = 0; j < size; j++) {
+        const int col = base[j / 6] + j % 6;
+        m.matrix.coeffRef(row, col) -= R[size * i + j];
+        if (row == col) m.subgridDiagonal[size_t(row)] -= R[size * i + j];
+        if (springGamma_ != 0) m.springRhs(row) -= springGamma_ * R[size * i + j] * springPrevious_[size_t(col)];
+      }
+    }
+  };
+  // one contact: w = u - gamma U_n of its particles, normalRate = n . (the contact points' approach rate)
+  auto coulomb = [&](size_t record, const double *tail, const int *base, int size, bool wall) {
+    const double ktc1dt = wall ? tail[4] : tail[5];
+    const double mu = tail[6], normalStart = tail[7], knc1dt = tail[8], *ft = tail + 9, *n = tail;
+    if (!(mu > 0)) return;
+    double w[12], end[3];
+    for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
+    const double rel[3] = {w[0] - (wall ? 0.0 : w[6]), w[1] - (wall ? 0.0 : w[7]), w[2] - (wall ? 0.0 : w[8])};
+    const double normalEnd = std::max(0.0, normalStart - knc1dt * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]));
+    const double cap = mu * std::min(normalStart, normalEnd);
+    const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
+    if (ktc1dt > 0 && !springSlides_[record]) {  // sticking: does its implicit force stay under the cap?
+      if (wall)
+        contact::wallTangentialForceAtEnd(n, tail[3], ktc1dt, tail[5], ft, tail + 12, w, end);
+      else
+        contact::pairTangentialForceAtEnd(n, tail[3], tail[4], ktc1dt, ft, w, end);
+      const double norm = std::sqrt(end[0] * end[0] + end[1] * end[1] + end[2] * end[2]);
+      if (!(norm > cap * (1 + 1e-9)) || !(norm > 0)) return;
+      springSlides_[record] = 1;
+      slidingSwitches_++;
+      for (int a = 0; a < 3; a++) slideDirection_[3 * record + a] = end[a] / norm;
+      double Rt[144], term[6];
+      if (wall) {
+        contact::wallSpringBlock(n, tail[3], 0.0, 1.0, ktc1dt, tail[5], tail + 12, Rt, term);
+        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k];  // its wall term leaves F^tot
+      } else {
+        contact::pairSpringBlock(n, tail[3], tail[4], 0.0, 1.0, ktc1dt, Rt);
+      }
+      removeBlock(base, size, Rt);
+      matrixChanged = true;
+    } else if (!springSlides_[record]) {  // sliding from the start: the explicit force along F_t
+      if (!(ftNorm > 0)) return;
+      for (int a = 0; a < 3; a++) slideDirection_[3 * record + a] = ft[a] / ftNorm;
+    }
+    double target[3];
+    for (int a = 0; a < 3; a++) target[a] = cap * slideDirection_[3 * record + a];
+    setSlideForce(record, target, ft, base, size, tail, wall);
+  };
+  size_t record = 0;
+  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
+    const double *rec = &springPairs_[b];
+    const int base[2] = {6 * tagIndex(rec[0]), 6 * tagIndex(rec[1])};
+    coulomb(record, rec + springs::pairFriction, base, 12, false);
+  }
+  for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord, record++) {
+    const double *rec = &springWalls_[b];
+    const int base[1] = {6 * tagIndex(rec[0])};
+    coulomb(record, rec + springs::wallFriction, base, 6, true);
+  }
+  if (matrixChanged) {
+    if (settings_.solver == ldlt) {
+      m.ldlt.factorize(m.matrix);
+      factorisations_++;
+      if (m.ldlt.info() != Eigen::Success)
+        throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (LDLT) after "
+                                          "contacts started to slide");
+    } else {
+      m.cg.compute(m.matrix);
+    }
+  }
+  return matrixChanged || rhsChanged;
 }
 
 double ParticleVelocitySystem::diagonal(int k) const { return m_->diagonal(k); }
@@ -295,7 +421,7 @@ std::vector<double> ParticleVelocitySystem::subgridForces() const
   Eigen::VectorXd forces = m.wallRhs - m.matrix * u + m.diagonal.cwiseProduct(u);
   // less the implicit springs' part of the matrix (contact forces, not sub-grid ones)
   const std::vector<double> springs = springForces();
-  for (int k = 0; k < 6 * n_; k++) forces(k) -= springs[size_t(k)] - m.springRhs(k);
+  for (int k = 0; k < 6 * n_; k++) forces(k) -= springs[size_t(k)] - m.springRhs(k) - m.frictionRhs(k);
   return std::vector<double>(forces.data(), forces.data() + forces.size());
 }
 
@@ -315,18 +441,21 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
       (*stresslets)[size_t(6) * p + c] += 0.5 * weight * (force[a] * branch[b] + branch[a] * force[b]);
     }
   };
-  auto velocity = [&](int k) {
-    return u_[size_t(k)] - (springGamma_ != 0 ? springGamma_ * springPrevious_[size_t(k)] : 0.0);
-  };
-  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord) {
-    const double *rec = &springPairs_[b];
+  size_t record = 0;
+  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
+    const double *rec = &springPairs_[b], *tail = rec + springs::pairFriction;
     const int p[2] = {int(std::lround(rec[0])) - 1, int(std::lround(rec[1])) - 1};
     const double *R = rec + 2, *branch = rec + 146, weight = rec[149];
-    double w[12], f[12];
-    for (int k = 0; k < 12; k++) w[k] = velocity(6 * p[k / 6] + k % 6);
+    double w[12], f[12], Rt[144], slid[12] = {0};
+    const bool slides = !springSlides_.empty() && springSlides_[record];
+    if (slides)  // the tangential spring left the matrix
+      contact::pairSpringBlock(tail, tail[3], tail[4], 0.0, 1.0, tail[5], Rt);
+    if (!slideForce_.empty())  // the capped force in place of F_t
+      contact::pairGeneralisedForce(tail, tail[3], tail[4], &slideForce_[3 * record], slid);
+    for (int k = 0; k < 12; k++) w[k] = springVelocity(6 * p[k / 6] + k % 6);
     for (int i = 0; i < 12; i++) {
-      f[i] = 0;
-      for (int j = 0; j < 12; j++) f[i] -= R[12 * i + j] * w[j];
+      f[i] = slid[i];
+      for (int j = 0; j < 12; j++) f[i] -= (R[12 * i + j] - (slides ? Rt[12 * i + j] : 0.0)) * w[j];
       out[size_t(6) * p[i / 6] + i % 6] += f[i];
     }
     // x_j - x_i from particle 1; from particle 2 the branch and the force both change sign
@@ -334,14 +463,17 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     addStress(p[1], f, branch, 1.0 - weight);
   }
   if (wallBlockForces) wallBlockForces->clear();
-  for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord) {
-    const double *rec = &springWalls_[b];
+  for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord, record++) {
+    const double *rec = &springWalls_[b], *tail = rec + springs::wallFriction;
     const int p = int(std::lround(rec[0])) - 1;
     const double *R = rec + 1, *term = rec + 37, *branch = rec + 43;
-    double f[6];
+    double f[6], Rt[36], termT[6], slid[6] = {0};
+    const bool slides = !springSlides_.empty() && springSlides_[record];
+    if (slides) contact::wallSpringBlock(tail, tail[3], 0.0, 1.0, tail[4], tail[5], tail + 12, Rt, termT);
+    if (!slideForce_.empty()) contact::wallGeneralisedForce(tail, tail[3], &slideForce_[3 * record], slid);
     for (int i = 0; i < 6; i++) {
-      f[i] = term[i];
-      for (int j = 0; j < 6; j++) f[i] -= R[6 * i + j] * velocity(6 * p + j);
+      f[i] = term[i] + slid[i] - (slides ? termT[i] : 0.0);
+      for (int j = 0; j < 6; j++) f[i] -= (R[6 * i + j] - (slides ? Rt[6 * i + j] : 0.0)) * springVelocity(6 * p + j);
       out[size_t(6) * p + i] += f[i];
     }
     if (wallBlockForces) wallBlockForces->insert(wallBlockForces->end(), f, f + 6);

@@ -40,14 +40,21 @@ const int wallRecord = 1 + 36 + 6;
 const int wallStressRecord = 7 * 6 + 7;
 }  // namespace subgrid
 
-// The records of the implicit contact springs (contact_springs.h, docs/contact.md 2b), built by
+// The records of the implicit contact springs (contact_springs.h, docs/contact.md 2b, 2c), built by
 // pair_style fdm/subgrid with contact_integration implicit: R_c of Eq. (C3) enters the matrix, its
-// known part (Eq. C2) the right-hand side; they are kept apart from R^SG in the outputs.
+// known part (Eq. C2) the right-hand side; they are kept apart from R^SG in the outputs. The friction
+// tail lets the solve keep Coulomb's law at the end of the step (2c): a sticking contact (kt c1 dt > 0)
+// whose implicit tangential force exceeds the cap mu_s F_n slides within the step.
 namespace springs {
-// pair: [tag1, tag2, R_c (12 x 12), branch x2 - x1 (3), weight a1/(a1 + a2) of Eq. (52)]
-const int pairRecord = 2 + 144 + 4;
-// wall: [tag, R_c (6 x 6), wall-velocity term dt B^T K U_w (6), branch from the centre to the wall (3)]
-const int wallRecord = 1 + 36 + 6 + 3;
+// pair: [tag1, tag2, R_c (12 x 12), branch x2 - x1 (3), weight a1/(a1 + a2) of Eq. (52),
+//        friction tail: n (3, from 2 to 1), l1, l2, kt c1 dt (0: sliding from the start), mu_s,
+//        F_n (the normal force at the start), kn c1 dt, F_t (3: the explicit tangential force on 1)]
+const int pairFriction = 2 + 144 + 4;
+const int pairRecord = pairFriction + 12;
+// wall: [tag, R_c (6 x 6), wall-velocity term dt B^T K U_w (6), branch from the centre to the wall (3),
+//        friction tail: n (3, into the fluid), l, kt c1 dt, kt dt, mu_s, F_n, kn c1 dt, F_t (3), U_w (3)]
+const int wallFriction = 1 + 36 + 6 + 3;
+const int wallRecord = wallFriction + 15;
 }  // namespace springs
 
 class ParticleVelocitySystem {
@@ -132,10 +139,19 @@ class ParticleVelocitySystem {
   // receives 6 per implicit wall spring, its force and torque on its particle, in block order.
   std::vector<double> springForces(std::vector<double> *stresslets = nullptr,
                                    std::vector<double> *wallBlockForces = nullptr) const;
+  // Contacts that stuck at the start of the step and slide within it (Coulomb's law at the end of
+  // the step, docs/contact.md 2c), counted since the last assemble().
+  long slidingSwitches() const { return slidingSwitches_; }
   long springBlocks() const { return long(springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord); }
 
  private:
   int tagIndex(double tag) const;
+  // Coulomb's law at the end of the step (docs/contact.md 2c): sticking contacts whose implicit
+  // tangential force at u exceeds mu_s F_n slide from now on in this step (their tangential spring
+  // leaves the matrix, the capped force along the trial direction replaces F_t in F^tot); true if
+  // any did (the matrix is then factorised again).
+  bool slideOverloadedContacts();
+  double springVelocity(int k) const;  // u - gamma U_n, the unknowns' part of the contact displacement
 
   struct Matrices;                     // Eigen's, in the .cpp
   Settings settings_;
@@ -144,6 +160,10 @@ class ParticleVelocitySystem {
   std::vector<double> pairs_, walls_;  // the block records of this step
   std::vector<double> springPairs_, springWalls_, springPrevious_;  // implicit contact springs of this step
   double springGamma_;
+  std::vector<char> springSlides_;     // per spring record (pairs, then walls): slides since this step's start
+  std::vector<double> slideForce_;     // per spring record: capped force - F_t (3) of a contact that slides
+  std::vector<double> slideDirection_; // per spring record: the direction of its sliding force (3)
+  long slidingSwitches_;
   int pairRecord_, wallRecord_;
   long pairBlocks_, wallBlocks_;
   std::vector<double> Vu_, Ju_;        // of this step, for the messages

@@ -314,18 +314,6 @@ def test_time_step_beyond_contact_stability_at_the_contact_gap(tmp_path, env):
     assert m and 0.01 < float(m.group(1)) < 0.1, dem[-3000:]
 
 
-def test_stiff_implicit_tangential_spring_is_warned(tmp_path, env):
-    """Implicit springs with k_t = 1e6 N/m at dt = 1 s: dt k_t/zeta_t far beyond the 41 that sheared
-    suspensions held (they blew up at 320 and 400): a warning with the ratio and the k_t that
-    cases/couette uses; the run goes on."""
-    dem = pair_scene_log(tmp_path, env, "fdm/subgrid contact 1e6 1e6 0.5 0.01")
-    m = re.search(r"WARNING: pair_style fdm/subgrid: time step 1 s gives the tangential spring of two spheres "
-                  r"dt k_t/zeta_t = (\S+) at the contact gap h_r: sheared suspensions .* k_t = (\S+) N/m "
-                  r"\(0.5 zeta_t/dt\)", dem)
-    assert m and float(m.group(1)) > 50, dem[-3000:]
-    assert float(m.group(2)) == pytest.approx(0.5e6 / float(m.group(1)), rel=1e-3)
-
-
 def test_spheres_pressed_through_each_other_stop_the_run(tmp_path, env):
     """Two free spheres pushed together (1 N each) against a spring far too soft for the load
     (k_n = 1 N/m) and no lubrication: once they overlap by more than 0.05 of a radius (what the fluid

@@ -139,3 +139,27 @@ def test_dense_sheared_packing_keeps_contacts_shallow(tmp_path, env):
     assert hold["min_pair_gap"] > -0.02 and hold["min_wall_gap"] > 0, hold
     assert "held contact gaps per step" in hold["position_update"]
     assert free["min_pair_gap"] < 2 * hold["min_pair_gap"], (hold, free)
+
+
+def test_stiff_friction_in_a_dense_sheared_packing_holds(tmp_path, env):
+    # phi 0.47 between walls without the fluid, k_t = k_n (k_t dt/zeta_t ~ 320 at dt 0.02), with and
+    # without the log-gap correction: Coulomb's law at the end of the step (docs/contact.md 2c)
+    # keeps every particle slow and every overlap shallow. Before it, the run without the correction
+    # reached 896 a1 gamma_dot_0 and overlaps of 2 a1 at step 150, and mu_s = 5 blew up within 25
+    # steps (docs/benchmarks.md, "Coulomb's law at the end of the step")
+    import json
+    import subprocess
+    import sys
+    project = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    script = os.path.join(project, "cases", "couette", "demShear.py")
+    out = tmp_path / "dem.json"
+    proc = subprocess.run([sys.executable, script, "--variant", "stiff:kt=kn", "stiff_no_gap_update:kt=kn:fix=gap_update+none",
+                           "--steps", "200", "--workdir", str(tmp_path), "--out", str(out)], env=env, text=True,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)
+    assert proc.returncode == 0, proc.stdout[-3000:]
+    rows = {r["variant"]: r for r in json.loads(out.read_text())["rows"]}
+    for name, deepest in (("stiff", -0.02), ("stiff_no_gap_update", -0.1)):
+        row = rows[name]
+        assert row["completed"] and row["steps"] >= 200, row
+        assert row["max_speed"] < 20, row          # the walls move at 6 a1 gamma_dot_0 (L_y = 12)
+        assert row["min_pair_gap"] > deepest, row

@@ -196,6 +196,7 @@ std::vector<double> pressedPair(double dt, double kn, double hr, double F, doubl
       s.pairs = {1, 2};
       s.pairs.insert(s.pairs.end(), R, R + 144);
       s.pairs.insert(s.pairs.end(), {x[1] - x[0], 0, 0, 0.5});
+      s.pairs.insert(s.pairs.end(), springs::pairRecord - springs::pairFriction, 0.0);  // frictionless
       if (nextMultistep) {
         s.gamma = 1.0 / 3.0;
         s.previous = U;
@@ -257,6 +258,7 @@ TEST(ContactSprings, SpringForcesAndStressletInEq31)
   s.pairs = {1, 2};
   s.pairs.insert(s.pairs.end(), R.data(), R.data() + 144);
   s.pairs.insert(s.pairs.end(), {branch(0), branch(1), branch(2), 0.5});
+  s.pairs.insert(s.pairs.end(), springs::pairRecord - springs::pairFriction, 0.0);  // no friction tail
   s.gamma = 1.0 / 3.0;
   for (int k = 0; k < 12; k++) s.previous.push_back(r(rng));
   const std::vector<double> previous = s.previous;
@@ -284,4 +286,145 @@ TEST(ContactSprings, SpringForcesAndStressletInEq31)
     EXPECT_NEAR(stress[c] + stress[6 + c], 0.5 * (f(a) * branch(b) + branch(a) * f(b)), 1e-12);
     EXPECT_NEAR(stress[c], stress[6 + c], 1e-12);  // equal spheres
   }
+}
+
+namespace {
+
+// Two spheres touching along x (sphere 2 at +x), pulled apart along y by +F (on 1) and -F (on 2),
+// their contact sticking at the start of the step with a stiff tangential spring (kt c1 dt / zeta =
+// 1000), no explicit tangential force yet; Stokes drag zeta, rotational drag zetaR. Returns the
+// system after one solve.
+struct PulledPair {
+  double zeta = 2, zetaR = 3, cap = 4, normal = 8, ktc1dt = 2000, lever = 1.0025;  // kn c1 dt 0: F_n constant
+  ParticleVelocitySystem system;
+  std::vector<double> u;
+  PulledPair(double F, bool ab2, double ftStart = 0) : system(settings())
+  {
+    std::vector<ParticleVelocitySystem::Particle> particles(2);
+    for (int p = 0; p < 2; p++) {
+      particles[p].radius = 1;
+      particles[p].mass = particles[p].density = 1;
+    }
+    particles[0].force[1] = F;
+    particles[1].force[1] = -F;
+    const double n[3] = {-1, 0, 0};  // from 2 to 1
+    double R[144];
+    contact::pairSpringBlock(n, lever, lever, 1e4, ktc1dt, 1.0, R);  // kn c1 dt = 1e4, kt c1 dt = 2000
+    ParticleVelocitySystem::Springs s;
+    s.pairs = {1, 2};
+    s.pairs.insert(s.pairs.end(), R, R + 144);
+    s.pairs.insert(s.pairs.end(), {2 * lever, 0, 0, 0.5});
+    s.pairs.insert(s.pairs.end(), {n[0], n[1], n[2], lever, lever, ktc1dt, cap / normal, normal, 0, 0, ftStart, 0});
+    // F_t (start) and its moments are in the particles' loads, as the pair style adds them:
+    // T = -l n x F_t on both spheres, (0, 0, l F_t,y) here
+    particles[0].force[1] += ftStart;
+    particles[1].force[1] -= ftStart;
+    particles[0].torque[2] += lever * ftStart;
+    particles[1].torque[2] += lever * ftStart;
+    if (ab2) {
+      s.gamma = 1.0 / 3.0;
+      s.previous.assign(12, 0.0);
+      s.previous[1] = 0.3;  // U_n of sphere 1 along y: the known part of the step's slip
+    }
+    system.assemble(particles, {}, {}, s);
+    system.setVolumes({zeta, zeta}, {zetaR, zetaR});
+    u = system.solve(std::vector<double>(12, 0.0));
+  }
+  static ParticleVelocitySystem::Settings settings()
+  {
+    ParticleVelocitySystem::Settings s;
+    s.alphaLambda = 1;
+    s.rhoFluid = 1;
+    return s;
+  }
+};
+
+}  // namespace
+
+TEST(ContactSprings, CoulombLawHoldsAtTheEndOfTheStep)
+{
+  // docs/contact.md 2c: below the cap the stiff spring holds the pair (almost no slip, |F_t| < mu_s F_n);
+  // beyond it the contact slides within the step with exactly mu_s F_n against the slip, the
+  // spheres drift at (F - mu_s F_n)/zeta and turn under the moment of the friction force
+  for (bool ab2 : {false, true}) {
+    PulledPair held(3.0, ab2);
+    EXPECT_EQ(held.system.slidingSwitches(), 0) << ab2;
+    const std::vector<double> heldForce = held.system.springForces();
+    EXPECT_LE(std::fabs(heldForce[1]), held.cap) << ab2;
+    // the contact points hardly move apart in the step: rho_y = c1 [B (u - gamma U_n)]_y ~ F/(kt c1 dt)
+    const double gamma = ab2 ? 1.0 / 3.0 : 0.0, Un1y = ab2 ? 0.3 : 0.0;
+    const double slipY = (held.u[1] - gamma * Un1y) - held.u[7] + held.lever * (held.u[5] + held.u[11]);
+    EXPECT_LT(std::fabs(slipY), 2 * 3.0 / held.ktc1dt) << ab2;
+
+    PulledPair pulled(10.0, ab2);
+    EXPECT_EQ(pulled.system.slidingSwitches(), 1) << ab2;
+    const double F = 10.0, cap = pulled.cap;
+    EXPECT_NEAR(pulled.u[1], (F - cap) / pulled.zeta, 1e-12) << ab2;
+    EXPECT_NEAR(pulled.u[7], -(F - cap) / pulled.zeta, 1e-12) << ab2;
+    // the friction force -cap e_y on 1 at the contact point (lever l along -n = +x): torque l x (-cap e_y)
+    EXPECT_NEAR(pulled.u[5], -pulled.lever * cap / pulled.zetaR, 1e-12) << ab2;
+    const std::vector<double> force = pulled.system.springForces();
+    EXPECT_NEAR(force[1], -cap, 1e-12) << ab2;
+    EXPECT_NEAR(force[7], cap, 1e-12) << ab2;
+    // the sub-grid force holds none of it (no sub-grid blocks here)
+    for (double f : pulled.system.subgridForces()) EXPECT_NEAR(f, 0.0, 1e-12) << ab2;
+  }
+}
+
+TEST(ContactSprings, CoulombLawOnAWall)
+{
+  // a sphere on the wall y = 0 (n = +y) moving at U_w along x, pushed along x by F: it slides on
+  // the wall, carried by mu_s F_n of friction toward the wall's velocity
+  const double zeta = 2, zetaR = 3, cap = 1.5, ktc1dt = 5000, ktdt = ktc1dt, dt = 1.0, lever = 1;
+  for (double F : {3.0, -6.0}) {  // sticking needs 0.6 of friction at F = 3, 6 at F = -6
+    ParticleVelocitySystem system(PulledPair::settings());
+    std::vector<ParticleVelocitySystem::Particle> particles(1);
+    particles[0].radius = particles[0].mass = particles[0].density = 1;
+    particles[0].force[0] = F;
+    const double n[3] = {0, 1, 0}, Uw[3] = {2, 0, 0};
+    double R[36], term[6];
+    contact::wallSpringBlock(n, lever, 1e4, ktc1dt / dt, dt, dt, Uw, R, term);
+    ParticleVelocitySystem::Springs s;
+    s.walls = {1};
+    s.walls.insert(s.walls.end(), R, R + 36);
+    s.walls.insert(s.walls.end(), term, term + 6);
+    s.walls.insert(s.walls.end(), {0, -1, 0});
+    s.walls.insert(s.walls.end(), {n[0], n[1], n[2], lever, ktc1dt, ktdt, 0.5, 2 * cap, 0, 0, 0, 0, Uw[0], Uw[1], Uw[2]});
+    system.assemble(particles, {}, {}, s);
+    system.setVolumes({zeta}, {zetaR});
+    const std::vector<double> u = system.solve(std::vector<double>(6, 0.0));
+    // held: the contact point moves with the wall, U_x - l Omega_z... stuck or sliding, the friction
+    // on the sphere is at most cap, along +x (the wall is faster than the sphere in both cases)
+    const std::vector<double> force = system.springForces();
+    EXPECT_LE(force[0], cap * (1 + 1e-9)) << F;
+    if (F == -6.0) {
+      EXPECT_EQ(system.slidingSwitches(), 1);
+      EXPECT_NEAR(force[0], cap, 1e-12);
+      EXPECT_NEAR(u[0], (F + cap) / zeta, 1e-12);
+    } else {
+      EXPECT_EQ(system.slidingSwitches(), 0);
+    }
+  }
+}
+
+TEST(ContactSprings, FrictionResistsAndNeverDrives)
+{
+  // a contact that slid in the last step (its spring at the cap: F_t = -cap e_y on 1) while the load
+  // on it reverses to F = -2 e_y on 1 (below the cap): friction must not keep pushing along -y with
+  // the full cap (that would drive sphere 1 at (-2 - cap)/zeta); it sticks, the pair hardly slips
+  PulledPair reversed(-2.0, false, -4.0);
+  EXPECT_EQ(reversed.system.slidingSwitches(), 0);
+  const double slipY = reversed.u[1] - reversed.u[7] + reversed.lever * (reversed.u[5] + reversed.u[11]);
+  EXPECT_LT(std::fabs(slipY), 2 * 4.0 / reversed.ktc1dt);
+  const std::vector<double> force = reversed.system.springForces();
+  // the tangential force f on 1 at the end, F_t(start) + the implicit part: under the cap, and what
+  // rolling without slip needs: 2(-2 + f)/zeta + 2 l^2 f/zeta_R = 0
+  const double l = reversed.lever, rolling = 2.0 / reversed.zeta / (1 / reversed.zeta + l * l / reversed.zetaR);
+  EXPECT_LE(std::fabs(-4.0 + force[1]), 4.0 * (1 + 1e-9));
+  EXPECT_NEAR(-4.0 + force[1], rolling, 0.01);
+  // a contact whose F_t(start) points the wrong way (+cap along the pull) and whose load exceeds the
+  // cap: it slides with the cap against the slip, the start direction forgotten
+  PulledPair pulled(10.0, false, 4.0);
+  EXPECT_EQ(pulled.system.slidingSwitches(), 1);
+  EXPECT_NEAR(pulled.u[1], (10.0 - 4.0) / pulled.zeta, 1e-12);
 }

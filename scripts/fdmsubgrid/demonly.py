@@ -129,7 +129,7 @@ def fdmdem() -> str:
 TIMING = re.compile(r"fdm/couple timing of this run \((\d+) runs?, (\d+) steps, ([0-9.eE+-]+) s\): particle solve "
                     r"([0-9.eE+-]+) s .*?gather/scatter ([0-9.eE+-]+) s.*?Eq\. 31: (\d+) solves, (\w+) iterations "
                     r"mean ([0-9.eE+-]+|nan) max (\d+); last step (\d+) sub-grid pair blocks, (\d+) wall blocks, "
-                    r"(\d+) contacts")
+                    r"(\d+) contacts(?:; (\d+) contacts began to slide within their step)?")
 
 
 def parse_timing(text):
@@ -140,7 +140,8 @@ def parse_timing(text):
     g = found[-1]
     return dict(steps=int(g[1]), wall=float(g[2]), particle_solve=float(g[3]), gather_scatter=float(g[4]),
                 solves=int(g[5]), solver=g[6], iterations_mean=float(g[7]), iterations_max=int(g[8]),
-                pair_blocks=int(g[9]), wall_blocks=int(g[10]), contacts=int(g[11]))
+                pair_blocks=int(g[9]), wall_blocks=int(g[10]), contacts=int(g[11]),
+                contact_slides=int(g[12]) if g[12] else None)
 
 
 def parse_thermo(text):

@@ -14,10 +14,10 @@ The contact springs (docs/contact.md, "A recipe"):
                                                      viscosity from the paper's Maron-Pierce fit, Eq. 55;
                                                      Poiseuille: the wall shear stress |dP0/dx| L_y/2)
   k_n   = 2 F_max / h_r                              a contact under F_max sits at h = h_r/2 (recipe step 2)
-  k_t   = min(k_n, 0.5 zeta_t / dt)                  the tangential spring within half its explicit ab2
-                                                     limit: the implicit tangential springs are not stable
-                                                     at k_t dt/zeta_t of 100 or more in a suspension
-                                                     (docs/benchmarks.md, "Stability map")
+  k_t   = k_n                                        recipe step 3, whatever dt: the implicit springs with
+                                                     Coulomb's law at the end of the step (docs/contact.md
+                                                     2c) hold at any k_t dt/zeta_t (docs/benchmarks.md,
+                                                     "Coulomb's law at the end of the step")
 with zeta_n, zeta_t the normal and slip resistances of a free a1-a1 pair at the gap h_r/2 (Stokes drag
 plus the sub-grid block at this a1/Delta, fdmResistance).
 """
@@ -34,7 +34,6 @@ A2 = packing.A2_OVER_A1 * A1
 ETA = 1.0
 ROUGHNESS = 5e-3 * A1         # h_r (section 6)
 FRICTION = 0.5                # mu_s (section 6)
-TANGENTIAL_SAFETY = 0.5       # k_t dt / zeta_t of the rule (docs/contact.md recipe step 4)
 
 
 def maron_pierce_viscosity(phi: float) -> float:
@@ -60,8 +59,8 @@ class Springs:
     def describe(self, dt: float) -> str:
         return ("contact springs (docs/contact.md recipe): design load F_max = %.4g N, kn = 2 F_max/h_r = %.4g N/m, "
                 "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a1-a1 pair at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
-                "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential (the springs are implicit; "
-                "k_t is kept at half its limit), dt = %g is %.2f of the smaller"
+                "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential (the springs are implicit, "
+                "with Coulomb's law at the end of the step), dt = %g is %.2f of the smaller"
                 % (self.design_load, self.kn, self.kt, self.mu_s, self.h_r / A1, self.zeta_n, self.zeta_t,
                    self.dt_limit_normal, self.dt_limit_tangential, dt,
                    dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
@@ -74,9 +73,9 @@ def choose_springs(stress: float, dt: float, delta: float, kn: float | None = No
     design_load = 6 * math.pi * A2 ** 2 * stress
     zeta_n, zeta_t = theory.pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta, ETA)
     kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
-    # k_t dt/zeta_t <= 0.5: stiffer implicit tangential springs blew up dense suspensions (growth x10
-    # per step at k_t dt/zeta_t ~ 300-400, docs/benchmarks.md "Stability map")
-    kt = min(kn, TANGENTIAL_SAFETY * zeta_t / dt) if kt is None else kt
+    # k_t independent of dt: until the return mapping of docs/contact.md 2c the rule was
+    # min(k_n, 0.5 zeta_t/dt), which softened friction as dt grew (eta_s at phi 0.47 fell with dt)
+    kt = kn if kt is None else kt
     return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
 
 
