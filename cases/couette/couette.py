@@ -60,7 +60,10 @@ TABLE8 = {
 # the position update's fallback (2026-11-25) the runs hold up to dt 0.1, but over 8 strain units
 # eta_s at dt 0.05 is 16 +- 2 against 36 +- 5 at dt 0.02: accuracy, not stability, sets 0.02 there
 # (largely through the rule's k_t = 0.5 zeta_t/dt: with 0.02's k_t at dt 0.05, 24 +- 4).
-# docs/benchmarks.md, "Stability map".
+# docs/benchmarks.md, "Stability map". 0.27 and 0.30 were measured with that former rule; since the
+# rule is k_t = k_n (Coulomb's law at the end of the step, docs/contact.md 2c) 0.47 was measured
+# again: dt 0.05 gives eta_s 28.7 +- 4.0 against 43.0 +- 6.4 at 0.02, and dt 0.1 stopped at step 6
+# with two spheres overlapping (docs/benchmarks.md, "Coulomb's law at the end of the step").
 MEASURED_DT_LIMITS = {0.27: 0.1, 0.30: 0.08, 0.47: 0.02}
 
 
