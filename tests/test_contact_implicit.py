@@ -117,23 +117,29 @@ def test_fluid_stops_a_sphere_escaping_through_a_wall(tmp_path, env):
     assert m and float(m.group(2)) > 0.05, text[-3000:]
 
 
-def test_dense_sheared_packing_keeps_contacts_shallow(tmp_path, env):
-    # phi 0.47 between walls at -U and +U without the fluid (cases/couette/demShear.py, the case's
-    # springs at dt 0.02): with the contact gaps held during the log-gap correction (the default)
-    # no pair overlaps by more than 0.02 a1 and no sphere reaches into a wall; left free, the
-    # corrections of the particles' lubrication gaps pushed them into their contacts (0.09 a1 and
-    # walls crossed by 0.07 a1 in 200 steps, docs/benchmarks.md "Stability map")
+def _dem_shear(tmp_path, env, *variants):
+    """cases/couette/demShear.py (phi 0.47 between walls, no fluid, 200 steps) for the named variants;
+    its rows by variant name."""
     import json
     import subprocess
     import sys
     project = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     script = os.path.join(project, "cases", "couette", "demShear.py")
     out = tmp_path / "dem.json"
-    proc = subprocess.run([sys.executable, script, "--variant", "hold:kt=485.1", "free:kt=485.1:fix=contact_gaps+free",
-                           "--steps", "200", "--workdir", str(tmp_path), "--out", str(out)], env=env, text=True,
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)
+    proc = subprocess.run([sys.executable, script, "--variant", *variants, "--steps", "200", "--workdir", str(tmp_path),
+                           "--out", str(out)], env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          timeout=900)
     assert proc.returncode == 0, proc.stdout[-3000:]
-    rows = {r["variant"]: r for r in json.loads(out.read_text())["rows"]}
+    return {r["variant"]: r for r in json.loads(out.read_text())["rows"]}
+
+
+def test_dense_sheared_packing_keeps_contacts_shallow(tmp_path, env):
+    # phi 0.47 between walls at -U and +U without the fluid (cases/couette/demShear.py, the case's
+    # springs at dt 0.02): with the contact gaps held during the log-gap correction (the default)
+    # no pair overlaps by more than 0.02 a1 and no sphere reaches into a wall; left free, the
+    # corrections of the particles' lubrication gaps pushed them into their contacts (0.09 a1 and
+    # walls crossed by 0.07 a1 in 200 steps, docs/benchmarks.md "Stability map")
+    rows = _dem_shear(tmp_path, env, "hold:kt=485.1", "free:kt=485.1:fix=contact_gaps+free")
     hold, free = rows["hold"], rows["free"]
     assert hold["completed"] and free["completed"]
     assert hold["min_pair_gap"] > -0.02 and hold["min_wall_gap"] > 0, hold
@@ -147,17 +153,7 @@ def test_stiff_friction_in_a_dense_sheared_packing_holds(tmp_path, env):
     # keeps every particle slow and every overlap shallow. Before it, the run without the correction
     # reached 896 a1 gamma_dot_0 and overlaps of 2 a1 at step 150, and mu_s = 5 blew up within 25
     # steps (docs/benchmarks.md, "Coulomb's law at the end of the step")
-    import json
-    import subprocess
-    import sys
-    project = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    script = os.path.join(project, "cases", "couette", "demShear.py")
-    out = tmp_path / "dem.json"
-    proc = subprocess.run([sys.executable, script, "--variant", "stiff:kt=kn", "stiff_no_gap_update:kt=kn:fix=gap_update+none",
-                           "--steps", "200", "--workdir", str(tmp_path), "--out", str(out)], env=env, text=True,
-                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=900)
-    assert proc.returncode == 0, proc.stdout[-3000:]
-    rows = {r["variant"]: r for r in json.loads(out.read_text())["rows"]}
+    rows = _dem_shear(tmp_path, env, "stiff:kt=kn", "stiff_no_gap_update:kt=kn:fix=gap_update+none")
     for name, deepest in (("stiff", -0.02), ("stiff_no_gap_update", -0.1)):
         row = rows[name]
         assert row["completed"] and row["steps"] >= 200, row
