@@ -264,7 +264,7 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
     } else {
       const Eigen::Map<const Eigen::VectorXd> guess(u_.data(), 6 * N);  // warm start: the previous solution
       u = m.cg.solveWithGuess(total, guess);
-      iterations_ = long(m.cg.iterations());
+      iterations_ = std::max(iterations_, long(m.cg.iterations()));  // the hardest of the Coulomb rounds
       if (m.cg.info() != Eigen::Success && !(m.cg.error() < 1e-6))
         throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) did not converge: relative residual " +
                                           number(m.cg.error()) + " after " + std::to_string(m.cg.iterations()) +
@@ -285,6 +285,7 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
   };
   // Coulomb's law at the end of the step: solve, let the overloaded sticking contacts slide, solve
   // again; a round only moves contacts from sticking to sliding or lowers their cap (docs/contact.md 2c)
+  iterations_ = 0;
   const int maxCoulombRounds = 100;  // each round a back-substitution (a factorisation if contacts began to slide)
   for (int round = 0;; round++) {
     solveLinear(rhs + m.springRhs + m.frictionRhs);

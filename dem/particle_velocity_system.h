@@ -121,7 +121,7 @@ class ParticleVelocitySystem {
   long wallBlocks() const { return wallBlocks_; }
   // Index pairs (2 per pair) that have a sub-grid block this step.
   std::vector<int> closePairs() const;
-  long lastIterations() const { return iterations_; }   // of the last solve (1 for LDLT)
+  long lastIterations() const { return iterations_; }   // CG's, of the last solve (the most of its Coulomb rounds; 1 for LDLT)
   long factorisations() const { return factorisations_; }
 
   // After the last solve: F^SG, T^SG = -(R^SG u - wall term) (Eqs. 21, D.6), 6 per particle.
