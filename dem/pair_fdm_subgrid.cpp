@@ -779,9 +779,10 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
                                          std::vector<double> &walls, std::vector<double> *wallIndex) const
 {
   // Eqs. (C1)-(C3) of docs/contact.md: the springs at the end of the step, for the contacts the last
-  // compute found (the neighbour lists and local indices have not changed since). A sliding
-  // contact, or one without friction (kt = 0 or mu_s = 0), has only its normal spring implicit: its
-  // tangential force stays the explicit Coulomb force of the compute.
+  // compute found (the neighbour lists and local indices have not changed since). Every contact
+  // with friction enters with both springs, and with the friction tail the solve needs to let it
+  // slide within the step (docs/contact.md 2c); one without friction (mu_s = 0) has only its normal
+  // spring.
   pairs.clear();
   walls.clear();
   if (wallIndex) wallIndex->clear();
