@@ -143,7 +143,7 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
                                 [r["eta_s_err"] for r in done], fit=fit,
                                 phi_core_error=[r.get("phi_core_err") or 0.0 for r in done],
                                 label="this project (a1/Δ = %g, Δt = %g)" % (args.a_over_delta, args.dt),
-                                title="Fig. 21: η_s(φ_core); paper: α = 0.803, φ_m = 0.59")
+                                title="Fig. 21: η_s(φ_core)", reference=rheology.PAPER_MARON_PIERCE)
         summary["figure"] = os.path.basename(figure)
     return summary
 

@@ -298,9 +298,11 @@ def fit_maron_pierce(phi: ArrayLike, eta_s: ArrayLike, eta_s_error: ArrayLike,
 
 def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error: ArrayLike | None = None,
                    fit: MaronPierceFit | None = None, phi_core_error: ArrayLike | None = None,
-                   label: str = "simulations", title: str | None = None) -> str:
-    """PNG of eta_s against phi_core with error bars and, if given, the Maron-Pierce curve
-    (Fig. 21). Returns path."""
+                   label: str = "simulations", title: str | None = None,
+                   reference: tuple[float, float] | None = None, reference_label: str = "paper") -> str:
+    """PNG of eta_s against phi_core with error bars and, if given, the Maron-Pierce curve of `fit`
+    and a reference curve Eq. 55 with reference = (alpha, phi_m), e.g. PAPER_MARON_PIERCE (Fig. 21).
+    Returns path."""
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(5.5, 4.2))
@@ -311,6 +313,11 @@ def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error
         grid = np.linspace(0.0, 0.998 * fit.phi_m, 400)
         ax.plot(grid, fit(grid), "--", label=r"Maron-Pierce $\alpha$ = %.3f $\pm$ %.3f, $\phi_m$ = %.3f $\pm$ %.3f"
                 % (fit.alpha, fit.alpha_error, fit.phi_m, fit.phi_m_error))
+    if reference is not None:
+        alpha, phi_m = reference
+        grid = np.linspace(0.0, 0.998 * phi_m, 400)
+        ax.plot(grid, maron_pierce(grid, alpha, phi_m), ":", color="k",
+                label=r"%s: $\alpha$ = %.3f, $\phi_m$ = %.3f" % (reference_label, alpha, phi_m))
     ax.set_yscale("log")
     low = min(eta_data.min(), fit.alpha if fit is not None else eta_data.min())
     ax.set_ylim(0.7 * low, 3.0 * eta_data.max())
