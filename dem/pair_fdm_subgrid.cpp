@@ -613,7 +613,7 @@ FixContactHistoryFdm *PairFdmSubgrid::contactHistory() const
   return dynamic_cast<FixContactHistoryFdm *>(history_);
 }
 
-bool PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
+void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
                                 double force[3], double nxft[3]) const
 {
   // The tangential spring and the Coulomb cap shared by pair and wall contacts: the elongation
@@ -628,8 +628,7 @@ bool PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const dou
   double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
   const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
   const double ftMax = mu_ * normalForce;
-  const bool slides = ftNorm > ftMax;
-  if (slides) {
+  if (ftNorm > ftMax) {
     const double scale = ftMax / ftNorm;
     for (int d = 0; d < 3; d++) {
       ft[d] *= scale;
@@ -640,7 +639,6 @@ bool PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const dou
   nxft[0] = n[1] * ft[2] - n[2] * ft[1];
   nxft[1] = n[2] * ft[0] - n[0] * ft[2];
   nxft[2] = n[0] * ft[1] - n[1] * ft[0];
-  return slides;
 }
 
 void PairFdmSubgrid::contactForces()

@@ -110,8 +110,7 @@ class PairFdmSubgrid : public Pair {
   void checkCalibration();
   void contactForces();
   void wallContactForces();
-  // returns true if the contact slides (its tangential force at the Coulomb cap)
-  bool contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
+  void contactLaw(const double n[3], double normalForce, const double vr[3], double dt, double shear[3],
                   double force[3], double nxft[3]) const;
   void addContactStress(int i, const double force[3], const double branch[3], double weight);
   std::string wallName(const Wall &w) const;

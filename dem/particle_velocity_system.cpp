@@ -25,7 +25,8 @@ struct ParticleVelocitySystem::Matrices {
   std::vector<double> subgridDiagonal;  // R^SG(k, k)
   Eigen::VectorXd wallRhs;              // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
   Eigen::VectorXd springRhs;            // known part of the implicit springs: gamma R_c U_n + dt B^T K U_w (Eq. C2)
-  Eigen::VectorXd frictionRhs;          // B^T (capped force - F_t) of the contacts that slide within the step
+  Eigen::VectorXd frictionRhs;          // what the contacts that slide within the step change in F^tot:
+                                        // B^T (capped force - F_t), less a wall spring's tangential wall term
   Eigen::VectorXd diagonal;             // (rho_f/rho_p) J/alpha_lambda of this step
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
@@ -212,6 +213,13 @@ void ParticleVelocitySystem::setVolumes(const std::vector<double> &Vu, const std
   m.diagonal = diagonal;
   double *values = m.matrix.valuePtr();
   for (int k = 0; k < 6 * N; k++) values[m.diagonalIndex[k]] = m.subgridDiagonal[k] + diagonal(k);
+  factorise(": is the sub-grid matrix indefinite?");
+  m.ready = true;
+}
+
+void ParticleVelocitySystem::factorise(const std::string &when)
+{
+  Matrices &m = *m_;
   if (settings_.solver == ldlt) {
     if (!m.analysed) {
       m.ldlt.analyzePattern(m.matrix);
@@ -220,14 +228,12 @@ void ParticleVelocitySystem::setVolumes(const std::vector<double> &Vu, const std
     m.ldlt.factorize(m.matrix);
     factorisations_++;
     if (m.ldlt.info() != Eigen::Success)
-      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (LDLT): is "
-                                        "the sub-grid matrix indefinite?");
+      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (LDLT)" + when);
   } else {
     m.cg.setTolerance(settings_.tolerance);
-    m.cg.setMaxIterations(std::max(1000, 6 * N));
+    m.cg.setMaxIterations(std::max(1000, 6 * n_));
     m.cg.compute(m.matrix);
   }
-  m.ready = true;
 }
 
 const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<double> &fluidForces)
@@ -342,14 +348,13 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   auto coulomb = [&](size_t record, const double *tail, const int *base, int size, bool wall) {
     const double ktc1dt = wall ? tail[4] : tail[5];
     const double mu = tail[6], normalStart = tail[7], knc1dt = tail[8], *ft = tail + 9, *n = tail;
-    if (!(mu > 0)) return;
+    if (!(mu > 0) || !(ktc1dt > 0)) return;  // no tangential spring: no friction (F_t = 0)
     double w[12], end[3];
     for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
     const double rel[3] = {w[0] - (wall ? 0.0 : w[6]), w[1] - (wall ? 0.0 : w[7]), w[2] - (wall ? 0.0 : w[8])};
     const double normalEnd = std::max(0.0, normalStart - knc1dt * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]));
     const double cap = mu * std::min(normalStart, normalEnd);
-    const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
-    if (ktc1dt > 0 && !springSlides_[record]) {  // sticking: does its implicit force stay under the cap?
+    if (!springSlides_[record]) {  // sticking: does its implicit force stay under the cap?
       if (wall)
         contact::wallTangentialForceAtEnd(n, tail[3], ktc1dt, tail[5], ft, tail + 12, w, end);
       else
@@ -368,9 +373,6 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
       }
       removeBlock(base, size, Rt);
       matrixChanged = true;
-    } else if (!springSlides_[record]) {  // sliding from the start: the explicit force along F_t
-      if (!(ftNorm > 0)) return;
-      for (int a = 0; a < 3; a++) slideDirection_[3 * record + a] = ft[a] / ftNorm;
     }
     double target[3];
     for (int a = 0; a < 3; a++) target[a] = cap * slideDirection_[3 * record + a];
@@ -387,17 +389,7 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     const int base[1] = {6 * tagIndex(rec[0])};
     coulomb(record, rec + springs::wallFriction, base, 6, true);
   }
-  if (matrixChanged) {
-    if (settings_.solver == ldlt) {
-      m.ldlt.factorize(m.matrix);
-      factorisations_++;
-      if (m.ldlt.info() != Eigen::Success)
-        throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (LDLT) after "
-                                          "contacts started to slide");
-    } else {
-      m.cg.compute(m.matrix);
-    }
-  }
+  if (matrixChanged) factorise(" after contacts started to slide");
   return matrixChanged || rhsChanged;
 }
 
@@ -448,11 +440,11 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     const int p[2] = {int(std::lround(rec[0])) - 1, int(std::lround(rec[1])) - 1};
     const double *R = rec + 2, *branch = rec + 146, weight = rec[149];
     double w[12], f[12], Rt[144], slid[12] = {0};
-    const bool slides = !springSlides_.empty() && springSlides_[record];
-    if (slides)  // the tangential spring left the matrix
+    const bool slides = springSlides_[record];
+    if (slides) {  // the tangential spring left the matrix, the capped force replaced F_t
       contact::pairSpringBlock(tail, tail[3], tail[4], 0.0, 1.0, tail[5], Rt);
-    if (!slideForce_.empty())  // the capped force in place of F_t
       contact::pairGeneralisedForce(tail, tail[3], tail[4], &slideForce_[3 * record], slid);
+    }
     for (int k = 0; k < 12; k++) w[k] = springVelocity(6 * p[k / 6] + k % 6);
     for (int i = 0; i < 12; i++) {
       f[i] = slid[i];
@@ -469,9 +461,11 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     const int p = int(std::lround(rec[0])) - 1;
     const double *R = rec + 1, *term = rec + 37, *branch = rec + 43;
     double f[6], Rt[36], termT[6], slid[6] = {0};
-    const bool slides = !springSlides_.empty() && springSlides_[record];
-    if (slides) contact::wallSpringBlock(tail, tail[3], 0.0, 1.0, tail[4], tail[5], tail + 12, Rt, termT);
-    if (!slideForce_.empty()) contact::wallGeneralisedForce(tail, tail[3], &slideForce_[3 * record], slid);
+    const bool slides = springSlides_[record];
+    if (slides) {
+      contact::wallSpringBlock(tail, tail[3], 0.0, 1.0, tail[4], tail[5], tail + 12, Rt, termT);
+      contact::wallGeneralisedForce(tail, tail[3], &slideForce_[3 * record], slid);
+    }
     for (int i = 0; i < 6; i++) {
       f[i] = term[i] + slid[i] - (slides ? termT[i] : 0.0);
       for (int j = 0; j < 6; j++) f[i] -= (R[6 * i + j] - (slides ? Rt[6 * i + j] : 0.0)) * springVelocity(6 * p + j);

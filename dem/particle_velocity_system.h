@@ -47,7 +47,7 @@ const int wallStressRecord = 7 * 6 + 7;
 // whose implicit tangential force exceeds the cap mu_s F_n slides within the step.
 namespace springs {
 // pair: [tag1, tag2, R_c (12 x 12), branch x2 - x1 (3), weight a1/(a1 + a2) of Eq. (52),
-//        friction tail: n (3, from 2 to 1), l1, l2, kt c1 dt (0: sliding from the start), mu_s,
+//        friction tail: n (3, from 2 to 1), l1, l2, kt c1 dt (0: no tangential spring), mu_s,
 //        F_n (the normal force at the start), kn c1 dt, F_t (3: the explicit tangential force on 1)]
 const int pairFriction = 2 + 144 + 4;
 const int pairRecord = pairFriction + 12;
@@ -146,6 +146,9 @@ class ParticleVelocitySystem {
 
  private:
   int tagIndex(double tag) const;
+  // LDLT's factorisation (its pattern analysed once per step) or CG's preconditioner of the current
+  // matrix; `when` ends the error message if LDLT fails.
+  void factorise(const std::string &when);
   // Coulomb's law at the end of the step (docs/contact.md 2c): sticking contacts whose implicit
   // tangential force at u exceeds mu_s F_n slide from now on in this step (their tangential spring
   // leaves the matrix, the capped force along the trial direction replaces F_t in F^tot); true if

@@ -135,7 +135,7 @@ def _dem_shear(tmp_path, env, *variants):
 
 def test_dense_sheared_packing_keeps_contacts_shallow(tmp_path, env):
     # phi 0.47 between walls at -U and +U without the fluid (cases/couette/demShear.py, the case's
-    # springs at dt 0.02): with the contact gaps held during the log-gap correction (the default)
+    # former springs at dt 0.02, k_t = 485 N/m): with the contact gaps held during the log-gap correction (the default)
     # no pair overlaps by more than 0.02 a1 and no sphere reaches into a wall; left free, the
     # corrections of the particles' lubrication gaps pushed them into their contacts (0.09 a1 and
     # walls crossed by 0.07 a1 in 200 steps, docs/benchmarks.md "Stability map")
