@@ -187,12 +187,12 @@ int pairCommand(const Arguments& args)
         std::printf("  \"kind\": \"sub-grid (%s)\",\n", model.describe());
         std::printf("  \"delta\": %s, \"cutoff_cells\": %s, \"xi_cut\": %s, \"r\": %s,\n", number(delta).c_str(),
                     number(model.cutoffCells()).c_str(), number(model.pairRange(a1, a2)).c_str(), number(r).c_str());
-        std::printf("  \"normalisation\": \"dimensional_over_eta: dimensional sub-grid function divided by the viscosity. base: the 10 independent functions of paper Appendix C.2; all: every function from the C.2 relations (YB: torque from translation; force from rotation uses YBtilde_ab = -YB_ba, Eq. A.3).\",\n");
+        std::printf("  \"normalisation\": \"dimensional_over_eta: dimensional sub-grid function divided by the viscosity. base: the 10 independent functions of paper Appendix C.2 in this labelling; dimensional_over_eta: every function from the C.2 relations, averaged over the two labellings of the pair as the blocks use them (YB: torque from translation; force from rotation uses YBtilde_ab = -YB_ba, Eq. A.3).\",\n");
         std::printf("  \"base\": {");
         for (int i = 0; i < NumSubgridBase; ++i)
             std::printf("%s\n    \"%s\": %s", i ? "," : "", subgridBaseName(SubgridBaseFunction(i)), number(base.f[i]).c_str());
         std::printf("\n  },\n");
-        printPairValues("dimensional_over_eta", expandAppendixC2(base, r), nullptr, false, true);
+        printPairValues("dimensional_over_eta", subgridPairFunctions(model, a1, a2, xi, r), nullptr, false, true);
     }
     std::printf("}\n");
     return 0;

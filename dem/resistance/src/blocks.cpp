@@ -114,7 +114,7 @@ bool subgridPairBlock(const SubgridModel& model, const double x1[3], const doubl
 {
     const PairGeometry g = pairGeometry(x1, x2, a1, a2);
     if (!(g.xi < model.pairRange(a1, a2))) return false;
-    buildPairBlock(expandAppendixC2(model.pair(a1, a2, g.xi), g.r), g.d, eta, out);
+    buildPairBlock(subgridPairFunctions(model, a1, a2, g.xi, g.r), g.d, eta, out);
     return true;
 }
 

@@ -51,6 +51,23 @@ PairFunctionValues expandAppendixC2(const PairSubgridBase& b, double r)
     return v;
 }
 
+PairFunctionValues subgridPairFunctions(const SubgridModel& model, double a1, double a2, double xi, double r)
+{
+    const PairFunctionValues mine = expandAppendixC2(model.pair(a1, a2, xi), r);
+    const PairFunctionValues relabelled = expandAppendixC2(model.pair(a2, a1, xi), r);
+    // sign of each tensor form of Eq. (A.1) under d -> -d: A, C (d d, I), H (d eps.d) even; B (eps.d),
+    // G (three d's or d delta), P (d) odd. M and Q are not sub-grid functions (zero in both).
+    double parity[NumPairFunctions];
+    for (int f = 0; f < NumPairFunctions; ++f) parity[f] = 1;
+    parity[YB] = parity[XG] = parity[YG] = parity[XP] = -1;
+    PairFunctionValues v;
+    for (int f = 0; f < NumPairFunctions; ++f)
+        for (int i = 0; i < 2; ++i)
+            for (int j = 0; j < 2; ++j)
+                v.f[f][i][j] = 0.5 * (mine.f[f][i][j] + parity[f] * relabelled.f[f][1 - i][1 - j]);
+    return v;
+}
+
 bool makeDissipative(PairSubgridBase& b, double r)
 {
     bool changed = false;

@@ -108,6 +108,46 @@ TEST(SubgridPairBlock, FrameInvariantUnderRigidMotions)
     std::printf("[worst] frame invariance, |R u_rigid| / (|R| |u|) over 2000 random pairs: %.2e\n", worst);
 }
 
+// The block of a pair does not depend on which sphere is called 1: the pair given as (x2, x1, a2, a1)
+// gives the same matrix with the two particles' rows and columns exchanged. Appendix C.2's expansion
+// alone does not (it derives Y^C_22 from Y^C_11, ...): subgridPairFunctions averages the two labellings.
+TEST(SubgridPairBlock, IndependentOfLabelling)
+{
+    std::mt19937 rng(29);
+    double worst = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        const RandomPair p = randomPair(rng);
+        const CutoffSubgridModel model(p.delta, 1.0);
+        PairBlock block, swapped;
+        ASSERT_TRUE(subgridPairBlock(model, p.x1, p.x2, p.a1, p.a2, 1.0, block));
+        ASSERT_TRUE(subgridPairBlock(model, p.x2, p.x1, p.a2, p.a1, 1.0, swapped));
+        const double scale = toEigen(block).norm() + stressToEigen(block).norm();
+        double difference = 0;
+        for (int i = 0; i < 12; ++i)
+            for (int j = 0; j < 12; ++j)
+                difference = std::max(difference, std::fabs(block.R[i][j] - swapped.R[(i + 6) % 12][(j + 6) % 12]));
+        for (int row = 0; row < 14; ++row) {
+            const int other = row < 12 ? (row + 6) % 12 : 25 - row;  // S1 <-> S2, s1 <-> s2
+            for (int j = 0; j < 12; ++j)
+                difference = std::max(difference, std::fabs(block.stress[row][j] - swapped.stress[other][(j + 6) % 12]));
+        }
+        worst = std::max(worst, difference / scale);
+        EXPECT_LT(difference / scale, 1e-13) << "trial " << trial << " a1 " << p.a1 << " a2 " << p.a2;
+    }
+    std::printf("[worst] relabelled pair block, largest difference / norm over 2000 random pairs: %.2e\n", worst);
+
+    // what the averaging removes: equal spheres at xi 0.1, a/Delta 3 (Y^C_11 5.41 against Y^C_22 3.72 from
+    // the C.2 expansion of one labelling)
+    const CutoffSubgridModel model(1.0 / 3, 1.0);
+    const double r = 2.1;
+    const PairFunctionValues oneLabelling = expandAppendixC2(model.pair(1, 1, 0.1), r);
+    EXPECT_GT(oneLabelling.f[YC][0][0] - oneLabelling.f[YC][1][1], 0.3 * oneLabelling.f[YC][1][1]);
+    const PairFunctionValues both = subgridPairFunctions(model, 1, 1, 0.1, r);
+    EXPECT_NEAR(both.f[YC][0][0], both.f[YC][1][1], 1e-12 * both.f[YC][0][0]);
+    EXPECT_NEAR(both.f[YB][0][0], -both.f[YB][1][1], 1e-12 * std::fabs(both.f[YB][0][0]));
+    EXPECT_NEAR(both.f[XG][0][0], -both.f[XG][1][1], 1e-12 * std::fabs(both.f[XG][0][0]));
+}
+
 // Lorentz reciprocity (A.2): symmetric; dissipation never negative: positive semi-definite.
 TEST(SubgridPairBlock, SymmetricAndPositiveSemiDefinite)
 {

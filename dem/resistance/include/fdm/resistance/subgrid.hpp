@@ -49,6 +49,18 @@ public:
     virtual const char* describe() const = 0;
 };
 
+// Every sub-grid function of a pair as the blocks use it: Appendix C.2's expansion averaged over the two
+// labellings of the pair. C.2 takes Y^C_11 (not Y^C_22), Y^B_21, X^G_11, Y^G_11, ... as independent and
+// derives the rest through the rigid-body relations, so with any model that is not exact the derived
+// functions differ from their mirror images (cut-off model, equal spheres, xi 0.1, a/Delta 3: Y^C_11
+// 5.41 against Y^C_22 3.72) and a pair's block depended on which sphere LIGGGHTS calls i. The functions
+// of the relabelled pair (radii a2, a1, d -> -d: model.pair(a2, a1, xi)) are put back in this pair's
+// labels with the parity of each tensor form of Eq. (A.1) under d -> -d (A, C, H even; B, G, P odd) and
+// averaged with this labelling's. The C.2 relations are linear and the same for both labellings, so the
+// average keeps them (frame invariance, Eq. 24), and a mean of positive semi-definite blocks is one.
+// r = |x2 - x1|.
+PairFunctionValues subgridPairFunctions(const SubgridModel& model, double a1, double a2, double xi, double r);
+
 // Placeholder for the calibration of Appendix B: the solver is assumed to resolve the theory down to a
 // cut-off gap of k mesh cells, xi_c = k Delta / a_mean (a_mean = (a1 + a2)/2), eps_c = k Delta / a,
 // and nothing below:
