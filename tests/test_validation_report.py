@@ -1,0 +1,84 @@
+"""scripts/validationReport (issue 15 item 6): one command runs the validation cases and writes the
+report beside the paper's values. Here on the cheapest case, run for real (cases/shearedSphere: one free
+sphere in a wide channel, about 30 s): the report carries the case's physics (S* and the rotation of
+the dilute limit), reading the results again gives the same rows, and what cannot be read is reported
+by name, never silently skipped."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from conftest import PROJECT
+
+REPORT = os.path.join(PROJECT, "scripts", "validationReport")
+
+
+def report(args, env):
+    return subprocess.run([sys.executable, REPORT] + args, env=env, cwd=PROJECT, capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def sheared_report(tmp_path_factory, env):
+    tmp = tmp_path_factory.mktemp("report")
+    out, work = tmp / "report.md", tmp / "work"
+    done = report(["--only", "shearedSphere", "--out", str(out), "--workdir", str(work)], env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with open(tmp / "report.json") as f:
+        return tmp, out, work, json.load(f)
+
+
+def rows_by_quantity(summary):
+    return {row["quantity"]: row for case in summary["cases"] for row in case["rows"]}
+
+
+def test_report_carries_the_case_physics(sheared_report):
+    tmp, out, work, summary = sheared_report
+    (case,) = summary["cases"]
+    assert case["key"] == "shearedSphere" and case["status"] == "ran" and case["wall_seconds"] > 0
+    rows = rows_by_quantity(summary)
+    # the dilute limit in a 12 x 20 x 12 a box at a/Delta 3 (measured: S* -1.41 %, rotation -0.30 %)
+    s_star = rows["S* (unbounded: 1)"]
+    assert s_star["reference"] == 1.0 and abs(s_star["error"]) < 0.03
+    assert abs(s_star["value"] - 1.0) == pytest.approx(abs(s_star["error"]))
+    assert abs(rows["Ω_z/(−γ̇/2)"]["error"]) < 0.01
+    assert rows["momentum balance on the walls (largest)"]["value"] < 0.03
+    text = out.read_text()
+    assert "## 5.2.2" in text and "cases/shearedSphere" in text and "| S* (unbounded: 1) |" in text
+    assert (work / "shearedSphere" / "results.json").exists() and (work / "shearedSphere" / "log").exists()
+
+
+def test_report_only_reads_the_same_rows(sheared_report, env):
+    tmp, out, work, summary = sheared_report
+    again = tmp / "again.md"
+    done = report(["--only", "shearedSphere", "--report-only", "--out", str(again), "--workdir", str(work)], env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with open(tmp / "again.json") as f:
+        read = json.load(f)
+    assert read["cases"][0]["status"] == "read"
+    assert read["cases"][0]["rows"] == summary["cases"][0]["rows"]
+
+
+def test_unreadable_and_missing_results_are_reported(tmp_path, env):
+    work = tmp_path / "work"
+    (work / "threeSpheres").mkdir(parents=True)
+    (work / "threeSpheres" / "results.json").write_text("{ not json")
+    done = report(["--only", "threeSpheres", "periodicArray", "--report-only", "--out", str(tmp_path / "r.md"),
+                   "--workdir", str(work)], env)
+    assert done.returncode == 1
+    with open(tmp_path / "r.json") as f:
+        cases = {c["key"]: c for c in json.load(f)["cases"]}
+    assert cases["threeSpheres"]["status"] == "failed"
+    assert str(work / "threeSpheres" / "results.json") in cases["threeSpheres"]["message"]
+    assert cases["periodicArray"]["status"] == "missing"
+    assert "failed or missing: threeSpheres, periodicArray" in done.stdout
+
+
+def test_bad_options_are_refused_by_name(tmp_path, env):
+    done = report(["--only", "pairSqeeze", "--report-only", "--out", str(tmp_path / "r.md")], env)
+    assert done.returncode == 2 and "unknown case(s) pairSqeeze" in done.stderr and "pairSqueeze" in done.stderr
+    missing = tmp_path / "table8.json"
+    done = report(["--only", "shearedSphere", "--report-only", "--table8", str(missing), "--out",
+                   str(tmp_path / "r.md")], env)
+    assert done.returncode == 2 and str(missing) in done.stderr
