@@ -160,6 +160,31 @@ def three_spheres_rows(r: dict) -> List[Row]:
     return rows
 
 
+def poiseuille_sphere_rows(r: dict) -> List[Row]:
+    """U_x/U_c against Staben et al. (2003) where it applies, else against Faxen's laws with the leading wall
+    reflections (meaningful at h >~ 1.5 a: none beside the wall), Omega_z a/U_c and S* likewise."""
+    rows = []
+    for row in r["rows"]:
+        config = "a %g, 2a/H %g, d/a %s, a/Δ %.3g, box %s a, %d positions" % (
+            row["radius"], row["two_a_over_H"], "%.4g (centre)" % row["d_over_a"] if row["centre_plane"] else
+            "%g" % row["d_over_a"], row["a_over_delta"], "×".join("%g" % v for v in row["box"]), row["n_positions"])
+        near_wall = row["d_over_a"] < 1.5
+        faxen = {} if near_wall else row["faxen_wall"]
+        if row.get("staben_Ux_norm") is not None:
+            rows.append(Row("U_x/U_c (Staben)", config, row["Ux_norm"], row["staben_Ux_norm"],
+                            "%g (Staben et al. 2003; Fig. 12: very good agreement)" % row["staben_Ux_norm"],
+                            relative(row["Ux_norm"], row["staben_Ux_norm"]), spread=row["Ux_norm_std"] or None))
+        else:
+            rows.append(Row("U_x/U_c (Faxén + walls)", config, row["Ux_norm"], faxen.get("Ux_norm"), "Fig. 12",
+                            relative(row["Ux_norm"], faxen.get("Ux_norm")), spread=row["Ux_norm_std"] or None))
+        if not row["centre_plane"]:
+            rows.append(Row("Ω_z a/U_c (Faxén + walls)", config, row["Wz_norm"], faxen.get("Wz_norm"), "Fig. 12",
+                            relative(row["Wz_norm"], faxen.get("Wz_norm")), spread=row["Wz_norm_std"] or None))
+            rows.append(Row("S* (Faxén + walls)", config, row["S_star"], faxen.get("S_star"), "Fig. 13 (2a/H 0.4)",
+                            relative(row["S_star"], faxen.get("S_star")), spread=row["S_star_std"] or None))
+    return rows
+
+
 # Every case of the report, in the paper's order; pairShear runs twice (smooth, contact), keyed apart
 CASES: Dict[str, Case] = {}
 for _c in [
@@ -175,6 +200,9 @@ for _c in [
          "the paper's Fig. 14", pair_shear_rows, default_args=["--contact"], full_args=["--contact", "--full"]),
     Case("shearedSphere", "5.2.2 (wide channel): the dilute stresslet and the momentum balance",
          "the unbounded sphere: S* = 1, Ω_z = −γ̇/2", sheared_sphere_rows, full_args=["--sweep", "--positions", "2"]),
+    Case("poiseuilleSphere", "5.2.3 a free sphere in plane Poiseuille flow",
+         "Staben et al. (2003) on the centre plane at 2a/H 0.6; elsewhere Faxén's laws with the leading wall "
+         "reflections (none within 1.5 a of a wall)", poiseuille_sphere_rows),
     Case("threeSpheres", "5.5 three spheres, one pushed toward the centroid",
          "far-field reflections with exact pairs in unbounded fluid (r/a ≥ 4)", three_spheres_rows),
 ]:

@@ -151,7 +151,11 @@ void Foam::particleForcing::setParticles(const List<fdmParticle>& particles)
             const point centre = origin + delta*vector(i + 0.5, j + 0.5, k + 0.5);
             const vector r = centre - part.x;
             const scalar dist = mag(r);
-            if (dist > reach)
+            // A cell centre exactly at the reach (a sphere on a lattice
+            // point of the cell, as in mirror-symmetric scenes) must fall on
+            // the same side at every mirror image: not the distance's last
+            // bit but a margin of 1e-9 cells decides, and such cells are out.
+            if (dist > reach - 1e-9*delta)
             {
                 continue;
             }
