@@ -160,6 +160,22 @@ def three_spheres_rows(r: dict) -> List[Row]:
     return rows
 
 
+def wall_shear_rows(r: dict) -> List[Row]:
+    """U_x/(gamma d), Omega_z/(gamma/2) against the free sphere of the wall resistance functions, S* against
+    Sangani's fit (Eq. 46), with and without the sub-grid wall correction."""
+    rows = []
+    for row in r["rows"]:
+        config = "a %g, ε %g, %s, box %s a1, a1/Δ %g, %d positions" % (
+            row["radius"], row["eps"], "sub-grid on" if row["subgrid"] else "FDM alone",
+            "×".join("%g" % v for v in row["box"]), row["a_over_delta"], row["n_positions"])
+        for q, key, paper in (("U_x/(γ̇d)", "Ux_norm", "Fig. 7: very good agreement"),
+                              ("Ω_z/(γ̇/2)", "Wz_norm", "Fig. 7: very good agreement"),
+                              ("S* (Eq. 46)", "S_star", "Fig. 8: very good agreement")):
+            rows.append(Row(q, config, row[key], row[key + "_ref"], paper, row[key + "_rel_error"],
+                            spread=row[key + "_std"] or None))
+    return rows
+
+
 def poiseuille_sphere_rows(r: dict) -> List[Row]:
     """U_x/U_c against Staben et al. (2003) where it applies, else against Faxen's laws with the leading wall
     reflections (meaningful at h >~ 1.5 a: none beside the wall), Omega_z a/U_c and S* likewise."""
@@ -200,6 +216,9 @@ for _c in [
          "the paper's Fig. 14", pair_shear_rows, default_args=["--contact"], full_args=["--contact", "--full"]),
     Case("shearedSphere", "5.2.2 (wide channel): the dilute stresslet and the momentum balance",
          "the unbounded sphere: S* = 1, Ω_z = −γ̇/2", sheared_sphere_rows, full_args=["--sweep", "--positions", "2"]),
+    Case("wallShear", "5.2.1 a free sphere in simple shear next to one wall",
+         "the free sphere from the exact wall resistance functions and Goldman, Cox & Brenner's fixed sphere "
+         "(U, Ω); Sangani et al.'s fit, Eq. (46) (S*)", wall_shear_rows),
     Case("poiseuilleSphere", "5.2.3 a free sphere in plane Poiseuille flow",
          "Staben et al. (2003) on the centre plane at 2a/H 0.6; elsewhere Faxén's laws with the leading wall "
          "reflections (none within 1.5 a of a wall)", poiseuille_sphere_rows),
