@@ -176,6 +176,22 @@ def wall_shear_rows(r: dict) -> List[Row]:
     return rows
 
 
+def channel_shear_rows(r: dict) -> List[Row]:
+    """Omega_z/(-gamma/2) and S* at the centre of a channel against H/a; no tabulated reference (Sangani et
+    al.'s numbers are not available): the unbounded limit 1 is the reference from H/a = 10 on."""
+    rows = []
+    for row in r["rows"]:
+        config = "a %g, H/a %.4g, %s, box %s a, a/Δ %g, %d positions" % (
+            row["radius"], row["H_over_a"], "sub-grid on" if row["subgrid"] else "FDM alone",
+            "×".join("%g" % v for v in row["box"]), row["a_over_delta_sphere"], row["n_positions"])
+        wide = row["H_over_a"] >= 10
+        for q, key in (("Ω_z/(−γ̇/2)", "Wz_norm"), ("S*", "S_star")):
+            rows.append(Row(q + (" (unbounded: 1)" if wide else ""), config, row[key], 1.0 if wide else None,
+                            "Fig. 10 (Sangani et al. 2011); Ω oscillates ≤ 3 % over positions",
+                            relative(row[key], 1.0) if wide else None, spread=row[key + "_std"] or None))
+    return rows
+
+
 def poiseuille_sphere_rows(r: dict) -> List[Row]:
     """U_x/U_c against Staben et al. (2003) where it applies, else against Faxen's laws with the leading wall
     reflections (meaningful at h >~ 1.5 a: none beside the wall), Omega_z a/U_c and S* likewise."""
@@ -219,6 +235,8 @@ for _c in [
     Case("wallShear", "5.2.1 a free sphere in simple shear next to one wall",
          "the free sphere from the exact wall resistance functions and Goldman, Cox & Brenner's fixed sphere "
          "(U, Ω); Sangani et al.'s fit, Eq. (46) (S*)", wall_shear_rows),
+    Case("channelShear", "5.2.2 a free sphere at the centre of a sheared channel, H/a from 2.2 to 20",
+         "the unbounded limits Ω_z = −γ̇/2, S* = 1 (wide channels); no tabulated values", channel_shear_rows),
     Case("poiseuilleSphere", "5.2.3 a free sphere in plane Poiseuille flow",
          "Staben et al. (2003) on the centre plane at 2a/H 0.6; elsewhere Faxén's laws with the leading wall "
          "reflections (none within 1.5 a of a wall)", poiseuille_sphere_rows),
