@@ -311,15 +311,7 @@ def cell_offsets(n_positions: int) -> tuple[list[tuple[float, float]], int]:
         g = [(i + 0.5) / m for i in range(m // 2)]
         return [(x, z) for z in g for x in g], n_positions
 
-    def halton(index: int, base: int) -> float:
-        fraction, value = 1.0, 0.0
-        while index > 0:
-            fraction /= base
-            value += fraction * (index % base)
-            index //= base
-        return value
-
-    return [(0.5 * halton(k, 2), 0.5 * halton(k, 3)) for k in range(1, n_positions + 1)], n_positions
+    return [(0.5 * float(x), 0.5 * float(z)) for x, z in case.halton_points(n_positions, 2)], n_positions
 
 
 def pair_style(subgrid: bool, model: str, cutoff: float | None, wall_cutoff: float | None) -> str:

@@ -104,15 +104,8 @@ def cell_offsets(n_positions: int) -> tuple[list[tuple[float, float, float]], in
         g = [(i + 0.5) / m for i in range(m)]
         return [(x, y, z) for z in g[:m // 2] for y in g[:m // 2] for x in g], n_positions
 
-    def halton(index: int, base: int) -> float:
-        fraction, value = 1.0, 0.0
-        while index > 0:
-            fraction /= base
-            value += fraction * (index % base)
-            index //= base
-        return value
-
-    return [(halton(k, 2), 0.5 * halton(k, 3), 0.5 * halton(k, 5)) for k in range(1, n_positions + 1)], n_positions
+    h = case.halton_points(n_positions, 3)
+    return [(float(x), 0.5 * float(y), 0.5 * float(z)) for x, y, z in h], n_positions
 
 
 def check_scene(r_values: Sequence[float], size: Sequence[float], a_over_delta: float) -> None:
@@ -453,25 +446,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
             if not r > 2 * RADIUS:
                 p.error("r/a = %g: the spheres overlap or touch (r/a must exceed 2)" % r)
         return dict(case="threeSpheres", reference=print_reference(args.r, args.size))
-    if args.boxes is None:
-        boxes = [tuple(args.size)]
-    elif not args.boxes:
-        boxes = list(BOXES_DEFAULT)
-    else:
-        if len(args.boxes) % 3 or len(args.boxes) < 6:
-            p.error("--boxes takes LX LY LZ per box, for two boxes or more (got %d numbers)" % len(args.boxes))
-        boxes = [tuple(args.boxes[k:k + 3]) for k in range(0, len(args.boxes), 3)]
-    if args.offset:
-        for offset in args.offset:
-            if not all(0.0 <= o < 1.0 for o in offset):
-                p.error("--offset %s: each offset must be in [0, 1) cells" % " ".join("%g" % o for o in offset))
-        offsets = [tuple(o) for o in args.offset]
-        represented = len(offsets)
-    else:
-        try:
-            offsets, represented = cell_offsets(args.positions)
-        except ValueError as e:
-            p.error(str(e))
+    boxes, offsets, represented = case.boxes_and_offsets(p, args, BOXES_DEFAULT, cell_offsets)
     if args.n_max < 1:
         p.error("--n-max must be at least 1")
     try:

@@ -105,15 +105,7 @@ def cell_offsets(n_positions: int) -> tuple[list[tuple[float, float]], int]:
     if n_positions == 1:
         return [(0.25, 0.25)], 1
 
-    def halton(index: int, base: int) -> float:
-        fraction, value = 1.0, 0.0
-        while index > 0:
-            fraction /= base
-            value += fraction * (index % base)
-            index //= base
-        return value
-
-    return [(0.5 * halton(k, 2), 0.5 * halton(k, 3)) for k in range(1, n_positions + 1)], n_positions
+    return [(0.5 * float(x), 0.5 * float(z)) for x, z in case.halton_points(n_positions, 2)], n_positions
 
 
 def check_scene(eps_values: Sequence[float], radii: Sequence[float], size: Sequence[float], a_over_delta: float) -> None:
@@ -424,25 +416,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
         rows = [freeSphereWall.reference(e) for e in args.eps]
         freeSphereWall.main(["--eps"] + ["%r" % e for e in args.eps])
         return dict(case="wallShear", reference=rows)
-    if args.boxes is None:
-        boxes = [tuple(args.size)]
-    elif not args.boxes:
-        boxes = list(BOXES_DEFAULT)
-    else:
-        if len(args.boxes) % 3 or len(args.boxes) < 6:
-            p.error("--boxes takes LX LY LZ per box, for two boxes or more (got %d numbers)" % len(args.boxes))
-        boxes = [tuple(args.boxes[k:k + 3]) for k in range(0, len(args.boxes), 3)]
-    if args.offset:
-        for offset in args.offset:
-            if not all(0.0 <= o < 1.0 for o in offset):
-                p.error("--offset %s: each offset must be in [0, 1) cells" % " ".join("%g" % o for o in offset))
-        offsets = [tuple(o) for o in args.offset]
-        represented = len(offsets)
-    else:
-        try:
-            offsets, represented = cell_offsets(args.positions)
-        except ValueError as e:
-            p.error(str(e))
+    boxes, offsets, represented = case.boxes_and_offsets(p, args, BOXES_DEFAULT, cell_offsets)
     if args.n_max < 1:
         p.error("--n-max must be at least 1, got %d" % args.n_max)
     if args.wall_cutoff is not None and not args.wall_cutoff > 0:

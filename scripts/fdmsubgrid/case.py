@@ -278,6 +278,37 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     return wall
 
 
+def halton_points(n: int, dims: int) -> np.ndarray:
+    """The first n points of the Halton sequence in [0, 1)^dims (bases 2, 3, 5, ...; unscrambled, the
+    origin left out): positions spread evenly over a mesh cell for any count, the cases' --positions."""
+    from scipy.stats import qmc
+    return qmc.Halton(d=dims, scramble=False).random(n + 1)[1:]
+
+
+def boxes_and_offsets(parser, args, default_boxes, cell_offsets):
+    """The box and cell-offset options two cases share (--size, --boxes [LX LY LZ ...], --offset ...,
+    --positions N): returns (boxes, offsets, positions represented); a bad value is a parser error naming it.
+    cell_offsets(N) gives a case's own offsets for N positions (ValueError if N is not allowed)."""
+    if args.boxes is None:
+        boxes = [tuple(args.size)]
+    elif not args.boxes:
+        boxes = list(default_boxes)
+    else:
+        if len(args.boxes) % 3 or len(args.boxes) < 6:
+            parser.error("--boxes takes LX LY LZ per box, for two boxes or more (got %d numbers)" % len(args.boxes))
+        boxes = [tuple(args.boxes[k:k + 3]) for k in range(0, len(args.boxes), 3)]
+    if args.offset:
+        for offset in args.offset:
+            if not all(0.0 <= o < 1.0 for o in offset):
+                parser.error("--offset %s: each offset must be in [0, 1) cells" % " ".join("%g" % o for o in offset))
+        return boxes, [tuple(o) for o in args.offset], len(args.offset)
+    try:
+        offsets, represented = cell_offsets(args.positions)
+    except ValueError as e:
+        parser.error(str(e))
+    return boxes, offsets, represented
+
+
 def add_run_options(parser, case_dir, tol_lambda, cutoff=False, model=False):
     """The options every coupled case's script shares: --tol-lambda, --acceleration, --np-fluid,
     --workdir, --out, --keep; with cutoff, --cutoff and --model (pair_style fdm/subgrid's cut-off and
