@@ -571,14 +571,17 @@ std::string FixFdmCouple::systemProblem(const fdm::ParticleVelocitySystem::Error
 
 void FixFdmCouple::setVolumes(const cpl::Volumes &volumes)
 {
-  // Eq. (31)'s diagonal and its factorisation, once per time step (Vu, Ju depend only on the positions)
-  std::vector<double> Vu(natoms_), Ju(natoms_);
+  // Eq. (31)'s rigid-body blocks and their factorisation, once per time step (they depend only on the
+  // positions)
+  std::vector<fdm::ParticleVelocitySystem::RigidVolume> rigid(natoms_);
   for (int p = 0; p < natoms_; p++) {
-    Vu[p] = volumes.particles[p].Vu;
-    Ju[p] = volumes.particles[p].Ju;
+    const cpl::ParticleVolume &v = volumes.particles[p];
+    rigid[p].Vu = v.Vu;
+    std::copy(v.m1, v.m1 + 3, rigid[p].m1);
+    std::copy(v.J, v.J + 6, rigid[p].J);
   }
   try {
-    system_->setVolumes(Vu, Ju);
+    system_->setVolumes(rigid);
   } catch (const fdm::ParticleVelocitySystem::Error &e) {
     fail(systemProblem(e, volumes.step, 0));
   }
@@ -617,7 +620,7 @@ cpl::Volumes FixFdmCouple::noFluidVolumes(const std::vector<Particle> &particles
   for (int p = 0; p < natoms_; p++) {
     const double a = particles[p].radius;
     m.particles[p].Vu = 6 * pi * eta * a * alpha / rho;
-    m.particles[p].Ju = 8 * pi * eta * a * a * a * alpha / rho;
+    m.particles[p].J[0] = m.particles[p].J[3] = m.particles[p].J[5] = 8 * pi * eta * a * a * a * alpha / rho;
   }
   return m;
 }
@@ -681,8 +684,9 @@ void FixFdmCouple::final_integrate()
     atRest.iteration = 1;
     atRest.particles.assign(natoms_, cpl::ForceTorque());
     solveVelocities(atRest);
+    const std::vector<double> drag = system_->rigidBlocksTimes(solution_);
     for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
-      hydro_[k] = -system_->diagonal(k) * solution_[k];
+      hydro_[k] = -drag[k];
     subgridResults(particles);
     lastIterations_ = 1;
     run_.solve += MPI_Wtime() - t0;
@@ -707,7 +711,7 @@ void FixFdmCouple::final_integrate()
     try {
       t0 = MPI_Wtime();
       connection->send(makeStep(particles).toMessage());
-      // Protocol 3: Vu and Ju once per step, before the first Integrals
+      // Protocol 3: the volumes (Vu, m1, J since protocol 4) once per step, before the first Integrals
       const cpl::Message volumes = receive(true);
       double t1 = MPI_Wtime();
       run_.exchange += t1 - t0;

@@ -3,6 +3,7 @@
 #include "message_text.h"
 #include "particle_velocity_system.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -21,18 +22,18 @@ using fdm::text::point;
 
 struct ParticleVelocitySystem::Matrices {
   Eigen::SparseMatrix<double> matrix;   // (rho_f/rho_p) J/alpha_lambda + R^SG
-  std::vector<int> diagonalIndex;       // position of entry (k, k) in matrix.valuePtr()
-  std::vector<double> subgridDiagonal;  // R^SG(k, k)
+  std::vector<int> blockIndex;          // per particle, 36: position of entry (6p + i, 6p + j) in matrix.valuePtr()
+  std::vector<double> subgridBlock;     // per particle, 36: those entries of R^SG (and the springs)
   Eigen::VectorXd wallRhs;              // sum over walls of R_w[:, 0:3] U_w (Eq. D.6)
   Eigen::VectorXd springRhs;            // known part of the implicit springs: gamma R_c U_n + dt B^T K U_w (Eq. C2)
   Eigen::VectorXd frictionRhs;          // what the contacts that slide within the step change in F^tot:
                                         // B^T (capped force - F_t), less a wall spring's tangential wall term
-  Eigen::VectorXd diagonal;             // (rho_f/rho_p) J/alpha_lambda of this step
+  std::vector<double> rigidBlock;       // per particle, 36: (rho_f/rho_p) J/alpha_lambda of this step
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double> > ldlt;
   bool analysed = false;                // LDLT's symbolic analysis of this step's pattern
-  bool ready = false;                   // factorised (or preconditioned) for this step's diagonal
+  bool ready = false;                   // factorised (or preconditioned) for this step's rigid-body blocks
 };
 
 ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
@@ -92,13 +93,14 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
                                      std::to_string(pairRecord_) + " and " + std::to_string(wallRecord_));
   pairBlocks_ = long(pairs_.size() / pairRecord_);
   wallBlocks_ = long(walls_.size() / wallRecord_);
-  Vu_.clear();
-  Ju_.clear();
+  volumes_.clear();
 
   Matrices &m = *m_;
   std::vector<Eigen::Triplet<double> > triplets;
-  triplets.reserve(size_t(6) * N + size_t(144) * pairBlocks_ + size_t(36) * wallBlocks_);
-  for (int k = 0; k < 6 * N; k++) triplets.push_back(Eigen::Triplet<double>(k, k, 0.0));  // the diagonal, always
+  triplets.reserve(size_t(36) * N + size_t(144) * pairBlocks_ + size_t(36) * wallBlocks_);
+  for (int p = 0; p < N; p++)  // every particle's rigid-body block, always
+    for (int i = 0; i < 6; i++)
+      for (int j = 0; j < 6; j++) triplets.push_back(Eigen::Triplet<double>(6 * p + i, 6 * p + j, 0.0));
   m.wallRhs = Eigen::VectorXd::Zero(6 * N);
   for (long b = 0; b < pairBlocks_; b++) {
     const double *rec = &pairs_[size_t(b) * pairRecord_];
@@ -172,47 +174,80 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   m.matrix.resize(6 * N, 6 * N);
   m.matrix.setFromTriplets(triplets.begin(), triplets.end());
   m.matrix.makeCompressed();
-  m.diagonalIndex.assign(size_t(6) * N, -1);
-  m.subgridDiagonal.assign(size_t(6) * N, 0.0);
-  for (int k = 0; k < 6 * N; k++)
+  m.blockIndex.assign(size_t(36) * N, -1);
+  m.subgridBlock.assign(size_t(36) * N, 0.0);
+  for (int k = 0; k < 6 * N; k++)  // column k
     for (Eigen::SparseMatrix<double>::InnerIterator it(m.matrix, k); it; ++it)
-      if (it.row() == k) {
-        m.diagonalIndex[k] = int(&it.valueRef() - m.matrix.valuePtr());
-        m.subgridDiagonal[k] = it.value();
+      if (it.row() / 6 == k / 6) {
+        const size_t e = size_t(36) * (k / 6) + 6 * (it.row() % 6) + k % 6;
+        m.blockIndex[e] = int(&it.valueRef() - m.matrix.valuePtr());
+        m.subgridBlock[e] = it.value();
       }
-  m.diagonal = Eigen::VectorXd::Zero(6 * N);
+  m.rigidBlock.assign(size_t(36) * N, 0.0);
   m.analysed = false;
   m.ready = false;
 }
 
 void ParticleVelocitySystem::setVolumes(const std::vector<double> &Vu, const std::vector<double> &Ju)
 {
-  const int N = n_;
-  if (Vu.size() != size_t(N) || Ju.size() != size_t(N))
+  if (Vu.size() != Ju.size())
     throw Error(Error::fluidValue, -1, "Eq. (31) got the volumes of " + std::to_string(Vu.size()) + " and " +
-                                       std::to_string(Ju.size()) + " particles for " + std::to_string(N));
+                                       std::to_string(Ju.size()) + " particles");
+  std::vector<RigidVolume> volumes(Vu.size());
+  for (size_t p = 0; p < Vu.size(); p++) {
+    volumes[p].Vu = Vu[p];
+    volumes[p].J[0] = volumes[p].J[3] = volumes[p].J[5] = Ju[p];
+  }
+  setVolumes(volumes);
+}
+
+void ParticleVelocitySystem::setVolumes(const std::vector<RigidVolume> &volumes)
+{
+  const int N = n_;
+  if (volumes.size() != size_t(N))
+    throw Error(Error::fluidValue, -1, "Eq. (31) got the volumes of " + std::to_string(volumes.size()) +
+                                       " particles for " + std::to_string(N));
   Matrices &m = *m_;
-  Eigen::VectorXd diagonal(6 * N);
+  const double scale = settings_.rhoFluid / settings_.alphaLambda;
+  std::vector<double> blocks(size_t(36) * N, 0.0);
   for (int p = 0; p < N; p++) {
     const Particle &q = particles_[p];
-    if (!std::isfinite(Vu[p]) || !std::isfinite(Ju[p]))
+    const RigidVolume &v = volumes[size_t(p)];
+    bool finite = std::isfinite(v.Vu);
+    for (int k = 0; k < 3; k++) finite = finite && std::isfinite(v.m1[k]);
+    for (int k = 0; k < 6; k++) finite = finite && std::isfinite(v.J[k]);
+    const std::string values = "Vu " + number(v.Vu) + ", m1 " + point(v.m1) + ", J " + number(v.J[0]) + " " +
+                               number(v.J[1]) + " " + number(v.J[2]) + " " + number(v.J[3]) + " " + number(v.J[4]) +
+                               " " + number(v.J[5]);
+    if (!finite)
       throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite volume for particle " + particleId(p) +
-                                        " at " + point(q.x) + " (Vu " + number(Vu[p]) + ", Ju " + number(Ju[p]) + ")");
-    if (!(Vu[p] > 0) || !(Ju[p] > 0))
+                                        " at " + point(q.x) + " (" + values + ")");
+    // r x (Omega x r) summed: J = [[xx xy xz], [xy yy yz], [xz yz zz]] of the record
+    const double J[3][3] = {{v.J[0], v.J[1], v.J[2]}, {v.J[1], v.J[3], v.J[4]}, {v.J[2], v.J[4], v.J[5]}};
+    // [m1]x w = m1 x w
+    const double c[3][3] = {{0, -v.m1[2], v.m1[1]}, {v.m1[2], 0, -v.m1[0]}, {-v.m1[1], v.m1[0], 0}};
+    // sum over the stencil of I_u [1, -[r]x]^T [1, -[r]x]: symmetric, positive definite for a real sphere
+    Eigen::Matrix<double, 6, 6> B;
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        B(i, j) = i == j ? v.Vu : 0.0;
+        B(i, 3 + j) = -c[i][j];      // force from Omega: sum I_u Omega x r = -m1 x Omega
+        B(3 + i, j) = c[i][j];       // torque from U: sum I_u r x U = m1 x U
+        B(3 + i, 3 + j) = J[i][j];   // torque from Omega: sum I_u r x (Omega x r) = J Omega
+      }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6> > eig(B, Eigen::EigenvaluesOnly);
+    if (!(v.Vu > 0) || !(eig.eigenvalues().minCoeff() > 0))
       throw Error(Error::noVolume, p, "particle " + particleId(p) + " at " + point(q.x) + " with radius " +
-                                      number(q.radius) + ": the fluid's indicator function gives it no volume (Vu " +
-                                      number(Vu[p]) + ", Ju " + number(Ju[p]) + ")");
-    for (int d = 0; d < 3; d++) {
-      diagonal(6 * p + d) = settings_.rhoFluid * Vu[p] / settings_.alphaLambda;
-      diagonal(6 * p + 3 + d) = settings_.rhoFluid * Ju[p] / settings_.alphaLambda;
-    }
+                                      number(q.radius) + ": the fluid's indicator function gives it no volume (" +
+                                      values + ")");
+    for (int i = 0; i < 6; i++)
+      for (int j = 0; j < 6; j++) blocks[size_t(36) * p + 6 * i + j] = scale * B(i, j);
   }
-  Vu_ = Vu;
-  Ju_ = Ju;
-  if (m.ready && diagonal == m.diagonal) return;  // the same volumes again: keep the factorisation
-  m.diagonal = diagonal;
-  double *values = m.matrix.valuePtr();
-  for (int k = 0; k < 6 * N; k++) values[m.diagonalIndex[k]] = m.subgridDiagonal[k] + diagonal(k);
+  volumes_ = volumes;
+  if (m.ready && blocks == m.rigidBlock) return;  // the same volumes again: keep the factorisation
+  m.rigidBlock = blocks;
+  double *entries = m.matrix.valuePtr();
+  for (size_t e = 0; e < blocks.size(); e++) entries[m.blockIndex[e]] = m.subgridBlock[e] + blocks[e];
   factorise(": is the sub-grid matrix indefinite?");
   m.ready = true;
 }
@@ -283,8 +318,8 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
         const Particle &q = particles_[p];
         throw Error(Error::notSolved, p, "the velocity of particle " + particleId(p) + " at " + point(q.x) +
                                          " is not finite (Eq. 31): its force " + point(q.force) + ", torque " +
-                                         point(q.torque) + ", fluid integrals Vu " + number(Vu_[p]) + " Ju " +
-                                         number(Ju_[p]));
+                                         point(q.torque) + ", fluid integrals Vu " + number(volumes_[size_t(p)].Vu) +
+                                         ", m1 " + point(volumes_[size_t(p)].m1));
       }
       u_[k] = u(k);
     }
@@ -339,7 +374,7 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
       for (int j = 0; j < size; j++) {
         const int col = base[j / 6] + j % 6;
         m.matrix.coeffRef(row, col) -= R[size * i + j];
-        if (row == col) m.subgridDiagonal[size_t(row)] -= R[size * i + j];
+        if (row / 6 == col / 6) m.subgridBlock[size_t(36) * (row / 6) + 6 * (row % 6) + col % 6] -= R[size * i + j];
         if (springGamma_ != 0) m.springRhs(row) -= springGamma_ * R[size * i + j] * springPrevious_[size_t(col)];
       }
     }
@@ -393,7 +428,17 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   return matrixChanged || rhsChanged;
 }
 
-double ParticleVelocitySystem::diagonal(int k) const { return m_->diagonal(k); }
+double ParticleVelocitySystem::diagonal(int k) const { return m_->rigidBlock[size_t(36) * (k / 6) + 7 * (k % 6)]; }
+
+std::vector<double> ParticleVelocitySystem::rigidBlocksTimes(const std::vector<double> &u) const
+{
+  const Matrices &m = *m_;
+  std::vector<double> y(size_t(6) * n_, 0.0);
+  for (int p = 0; p < n_; p++)
+    for (int i = 0; i < 6; i++)
+      for (int j = 0; j < 6; j++) y[size_t(6) * p + i] += m.rigidBlock[size_t(36) * p + 6 * i + j] * u[size_t(6) * p + j];
+  return y;
+}
 
 std::vector<int> ParticleVelocitySystem::closePairs() const
 {
@@ -408,10 +453,11 @@ std::vector<int> ParticleVelocitySystem::closePairs() const
 
 std::vector<double> ParticleVelocitySystem::subgridForces() const
 {
-  // -(R^SG u - wall term): the whole matrix times u, less its fluid diagonal
+  // -(R^SG u - wall term): the whole matrix times u, less its rigid-body blocks
   const Matrices &m = *m_;
   const Eigen::Map<const Eigen::VectorXd> u(u_.data(), 6 * n_);
-  Eigen::VectorXd forces = m.wallRhs - m.matrix * u + m.diagonal.cwiseProduct(u);
+  const std::vector<double> rigid = rigidBlocksTimes(u_);
+  Eigen::VectorXd forces = m.wallRhs - m.matrix * u + Eigen::Map<const Eigen::VectorXd>(rigid.data(), 6 * n_);
   // less the implicit springs' part of the matrix (contact forces, not sub-grid ones)
   const std::vector<double> springs = springForces();
   for (int k = 0; k < 6 * n_; k++) forces(k) -= springs[size_t(k)] - m.springRhs(k) - m.frictionRhs(k);

@@ -3,14 +3,15 @@
 
        [ (rho_f/rho_p) J / alpha_lambda + R^SG ] u = F^tot,
 
-   with (rho_f/rho_p) M_p = rho_f Vu and (rho_f/rho_p) J_p = rho_f Ju from the fluid's indicator
-   function, R^SG the frame-invariant sub-grid matrix of the close pairs and wall gaps (Eq. 21,
+   with (rho_f/rho_p) J/alpha_lambda the rigid-body block of each particle from the fluid's indicator
+   function, (rho_f/alpha_lambda) [[Vu 1, -[m1]x], [[m1]x, J]] (RigidVolume: the discrete sphere's volume,
+   first moment and inertia tensor; the paper's diagonal when m1 = 0 and J = Ju 1), R^SG the frame-invariant sub-grid matrix of the close pairs and wall gaps (Eq. 21,
    Appendices C.2, D; built by pair_style fdm/subgrid) and F^tot of Eq. (32): the fluid integral +
    the buoyant weight (rho_p - rho_f)/rho_p m g + every other force on the particle (contacts,
    external) + the moving walls' term R_w[:, 0:3] U_w of Eq. (D.6).
 
    Per time step: assemble() once (R^SG; the positions do not move during the inner iterations),
-   setVolumes() once (Vu, Ju depend only on the positions: the diagonal, and the LDLT factorisation),
+   setVolumes() once (they depend only on the positions: the rigid-body blocks, and the LDLT factorisation),
    then solve() every inner iteration (a back-substitution, or conjugate gradients warm-started from
    the previous solution); after the last one, the sub-grid force, torque and stresslets.
 
@@ -107,8 +108,21 @@ class ParticleVelocitySystem {
   void assemble(std::vector<Particle> particles, std::vector<double> pairs, std::vector<double> walls,
                 Springs springs);
   void assemble(std::vector<Particle> particles, std::vector<double> pairs, std::vector<double> walls);
-  // Once per time step, after assemble(): Vu and Ju of every particle (Eq. 31's diagonal). Factorises
-  // (ldlt) or sets up the preconditioner (cg) if the diagonal changed since the last call.
+  // What the fluid's indicator function gives a particle, r = x - x_p: Vu = int I_u dV, m1 = int I_u r dV,
+  // J = int I_u (|r|^2 1 - r r) dV (xx xy xz yy yz zz). Eq. (30) integrated over the stencil: the
+  // rigid motion U + Omega x r contributes Vu U - m1 x Omega to the force and m1 x U + J Omega to the
+  // torque. With all of it in Eq. (31), a converged free particle carries no force and no torque of
+  // lambda whatever its position in the mesh and its velocity (with the paper's diagonal, m1 = 0 and
+  // J = Ju 1, it turns in a uniform flow: docs/validation.md).
+  struct RigidVolume {
+    double Vu = 0;
+    double m1[3] = {0, 0, 0};
+    double J[6] = {0, 0, 0, 0, 0, 0};
+  };
+  // Once per time step, after assemble(): every particle's rigid-body block. Factorises (ldlt) or sets
+  // up the preconditioner (cg) if the blocks changed since the last call.
+  void setVolumes(const std::vector<RigidVolume> &volumes);
+  // The paper's diagonal: m1 = 0, J = Ju 1 (a sphere on a symmetry point of the mesh; tests, no fluid).
   void setVolumes(const std::vector<double> &Vu, const std::vector<double> &Ju);
   // Every inner iteration: the fluid part of F^tot (6 per particle: F, T; Eq. 32) -> u (6 per
   // particle: U, Omega). Throws Error if an input or the solution is not finite or CG does not converge.
@@ -116,7 +130,9 @@ class ParticleVelocitySystem {
 
   int particles() const { return n_; }
   const std::vector<double> &velocities() const { return u_; }      // the last solution, 6N
-  double diagonal(int k) const;                                      // (rho_f/rho_p) {M, J}/alpha_lambda
+  double diagonal(int k) const;                                      // of the rigid-body blocks
+  // The rigid-body blocks times u (6N): the part (rho_f/alpha) int I_u (U + Omega x r) of Eq. (31)
+  std::vector<double> rigidBlocksTimes(const std::vector<double> &u) const;
   long pairBlocks() const { return pairBlocks_; }
   long wallBlocks() const { return wallBlocks_; }
   // Index pairs (2 per pair) that have a sub-grid block this step.
@@ -169,7 +185,7 @@ class ParticleVelocitySystem {
   long slidingSwitches_;
   int pairRecord_, wallRecord_;
   long pairBlocks_, wallBlocks_;
-  std::vector<double> Vu_, Ju_;        // of this step, for the messages
+  std::vector<RigidVolume> volumes_;   // of this step, for the messages
   std::vector<double> u_;              // the last solution: warm start of the next solve
   long iterations_, factorisations_;
   std::unique_ptr<Matrices> m_;

@@ -1,4 +1,4 @@
-"""fdmFoam's side of the coupling protocol (version 3: Volumes once per step; version 2's viscosity,
+"""fdmFoam's side of the coupling protocol (version 4: Volumes once per step with the rigid-body block; version 2's viscosity,
 box faces, stresslets of Eq. 12), checked by fluid/fdmFoam/tests/checkProtocol2.py: it plays the
 particle code over the socket against the real fdmFoam, serial and on 2 ranks (see its docstring
 for every check)."""

@@ -277,8 +277,10 @@ Message Volumes::toMessage() const
     using namespace layout;
     Message m = makeMessage(MessageType::Volumes, step, 0, uint32_t(particles.size()), volumesWidth);
     for (size_t p = 0; p < particles.size(); ++p) {
-        m.data[p * volumesWidth + volVu] = particles[p].Vu;
-        m.data[p * volumesWidth + volJu] = particles[p].Ju;
+        double* rec = &m.data[p * volumesWidth];
+        rec[volVu] = particles[p].Vu;
+        for (int d = 0; d < 3; ++d) rec[volM1x + d] = particles[p].m1[d];
+        for (int k = 0; k < 6; ++k) rec[volJxx + k] = particles[p].J[k];
     }
     return m;
 }
@@ -291,8 +293,10 @@ Volumes Volumes::fromMessage(const Message& m, long expectedCount)
     v.step = m.step;
     v.particles.resize(m.count);
     for (size_t p = 0; p < v.particles.size(); ++p) {
-        v.particles[p].Vu = m.data[p * volumesWidth + volVu];
-        v.particles[p].Ju = m.data[p * volumesWidth + volJu];
+        const double* rec = &m.data[p * volumesWidth];
+        v.particles[p].Vu = rec[volVu];
+        for (int d = 0; d < 3; ++d) v.particles[p].m1[d] = rec[volM1x + d];
+        for (int k = 0; k < 6; ++k) v.particles[p].J[k] = rec[volJxx + k];
     }
     return v;
 }

@@ -145,10 +145,10 @@ TEST(Message, TextValues)
     expectCouplerError([&] { bad.textNumber("dt"); }, {"dt=abc", "not a number"});
 }
 
-TEST(Message, LayoutOfProtocol3)
+TEST(Message, LayoutOfProtocol4)
 {
-    EXPECT_EQ(protocolVersion, 3);
-    EXPECT_EQ(layout::volumesWidth, 2);  // protocol 3: Vu, Ju once per step ...
+    EXPECT_EQ(protocolVersion, 4);
+    EXPECT_EQ(layout::volumesWidth, 10);  // protocol 4: Vu, m1, J once per step ...
     EXPECT_EQ(layout::integralsWidth, 6);  // ... F, T every inner iteration
     EXPECT_EQ(uint16_t(MessageType::Volumes), 8);
     EXPECT_EQ(layout::helloDemWidth, 10u);
@@ -420,21 +420,25 @@ TEST(TypedMessages, VolumesRoundTrip)
     v.step = 7;
     for (int p = 0; p < 3; ++p) {
         ParticleVolume q;
-        q.Vu = value(2 * p);
-        q.Ju = value(2 * p + 1);
+        q.Vu = value(10 * p);
+        for (int d = 0; d < 3; ++d) q.m1[d] = value(10 * p + 1 + d);
+        for (int k = 0; k < 6; ++k) q.J[k] = value(10 * p + 4 + k);
         v.particles.push_back(q);
     }
     const Message m = overTheWire(v);
     EXPECT_EQ(m.type, MessageType::Volumes);
     EXPECT_EQ(m.width, uint32_t(layout::volumesWidth));
-    EXPECT_EQ(m.at(2, layout::volJu), value(5));
+    EXPECT_EQ(m.at(2, layout::volM1y), value(22));
+    EXPECT_EQ(m.at(2, layout::volJzz), value(29));
     const Volumes b = Volumes::fromMessage(m, 3);
     EXPECT_EQ(b.step, 7u);
     for (int p = 0; p < 3; ++p) {
         EXPECT_EQ(b.particles[p].Vu, v.particles[p].Vu);
-        EXPECT_EQ(b.particles[p].Ju, v.particles[p].Ju);
+        for (int d = 0; d < 3; ++d) EXPECT_EQ(b.particles[p].m1[d], v.particles[p].m1[d]);
+        for (int k = 0; k < 6; ++k) EXPECT_EQ(b.particles[p].J[k], v.particles[p].J[k]);
+        EXPECT_EQ(b.particles[p].isotropicJ(), (v.particles[p].J[0] + v.particles[p].J[3] + v.particles[p].J[5]) / 3);
     }
-    expectCouplerError([&] { Volumes::fromMessage(m, 4); }, {"Volumes (step 7)", "3 records of 2 values", "4 records of 2"});
+    expectCouplerError([&] { Volumes::fromMessage(m, 4); }, {"Volumes (step 7)", "3 records of 10 values", "4 records of 10"});
 }
 
 TEST(TypedMessages, IntegralsRoundTrip)
@@ -1005,7 +1009,7 @@ TEST(Dump, PrintsARecordAndRejectsACorruptOne)
     EXPECT_NE(out.find("dem -> fluid Hello"), std::string::npos) << out;
     EXPECT_NE(out.find("fluid -> dem   Integrals  step 12 iteration 3"), std::string::npos) << out;
     EXPECT_NE(out.find("0.75"), std::string::npos) << out;  // 1/1 - 0.25, first value
-    EXPECT_NE(out.find("fluid -> dem   Volumes    step 12 iteration 0  2 x 2"), std::string::npos) << out;
+    EXPECT_NE(out.find("fluid -> dem   Volumes    step 12 iteration 0  2 x 10"), std::string::npos) << out;
     EXPECT_NE(out.find("3 messages"), std::string::npos) << out;
 
     {

@@ -7,6 +7,7 @@
 #include "fdm/coupler.h"
 #include "scratch.h"
 
+#include <Eigen/Dense>
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -41,6 +42,23 @@ std::string workDir(const std::string& name)
 }
 
 // ---- the LIGGGHTS input ---------------------------------------------------------------------------
+
+// Eq. (31)'s rigid-body block of a particle, (rho_f/alpha) [[Vu 1, -[m1]x], [[m1]x, J]]
+// (particle_velocity_system.h, RigidVolume)
+inline Eigen::Matrix<double, 6, 6> rigidBlock(const cpl::ParticleVolume& v, double rhoFluid, double alpha)
+{
+    const double J[3][3] = {{v.J[0], v.J[1], v.J[2]}, {v.J[1], v.J[3], v.J[4]}, {v.J[2], v.J[4], v.J[5]}};
+    const double c[3][3] = {{0, -v.m1[2], v.m1[1]}, {v.m1[2], 0, -v.m1[0]}, {-v.m1[1], v.m1[0], 0}};
+    Eigen::Matrix<double, 6, 6> B;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            B(i, j) = i == j ? v.Vu : 0.0;
+            B(i, 3 + j) = -c[i][j];
+            B(3 + i, j) = c[i][j];
+            B(3 + i, 3 + j) = J[i][j];
+        }
+    return rhoFluid / alpha * B;
+}
 
 struct Sphere {
     double x, y, z, radius, density;
@@ -171,8 +189,13 @@ struct FakeFluid {
         m.particles.resize(step.particles.size());
         for (size_t p = 0; p < step.particles.size(); ++p) {
             const double a = step.particles[p].radius;
-            m.particles[p].Vu = volume(a) * (1.0 + 0.01 * double(step.step));
-            m.particles[p].Ju = 0.4 * a * a * m.particles[p].Vu;
+            // a discrete sphere off the mesh's symmetry points: a small first moment and an anisotropic
+            // inertia tensor, so that Eq. (31)'s whole rigid-body block is exercised
+            cpl::ParticleVolume& v = m.particles[p];
+            v.Vu = volume(a) * (1.0 + 0.01 * double(step.step));
+            const double m1[3] = {0.02, -0.01, 0.005}, J[6] = {0.41, 0.004, -0.002, 0.39, 0.003, 0.40};
+            for (int d = 0; d < 3; ++d) v.m1[d] = m1[d] * a * v.Vu;
+            for (int k = 0; k < 6; ++k) v.J[k] = J[k] * a * a * v.Vu;
         }
         if (mode == ZeroVolume) m.particles[1].Vu = 0.0;
         if (mode == ShortVolumes) m.particles.pop_back();

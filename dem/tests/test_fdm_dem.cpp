@@ -50,9 +50,15 @@ void expectAnalyticVelocities(const FakeFluid& fluid, const Scene& scene, const 
             const cpl::ForceTorque& q = in.particles[p];
             const cpl::ParticleVolume& v = fluid.volumeOf(in.step, p);
             const cpl::RigidVelocity& u = out.particles[p];
+            // Eq. (31) of a free particle: its rigid-body block times (U, Omega) = F^tot
+            Eigen::Matrix<double, 6, 1> load;
             for (int d = 0; d < 3; ++d) {
-                const double U = fluid.alphaLambda * (q.F[d] + buoyant * g[d] + fext[d]) / (fluid.rhoFluid * v.Vu);
-                const double W = fluid.alphaLambda * q.T[d] / (fluid.rhoFluid * v.Ju);
+                load(d) = q.F[d] + buoyant * g[d] + fext[d];
+                load(3 + d) = q.T[d];
+            }
+            const Eigen::Matrix<double, 6, 1> expected = rigidBlock(v, fluid.rhoFluid, fluid.alphaLambda).ldlt().solve(load);
+            for (int d = 0; d < 3; ++d) {
+                const double U = expected(d), W = expected(3 + d);
                 EXPECT_LT(relativeDifference(u.U[d], U), 1e-12)
                     << "particle " << p + 1 << " U" << "xyz"[d] << " step " << out.step << " iteration " << out.iteration
                     << ": " << u.U[d] << " vs " << U;
@@ -366,7 +372,7 @@ TEST(FdmDEMErrors, VolumesOfTheWrongSize)
 {
     Scene scene;
     expectFailure("shortVolumes", scene, [](FakeFluid& f) { f.mode = FakeFluid::ShortVolumes; },
-                  "Volumes (step 1) has 2 records of 2 values (4 in all) where 3 records of 2 were expected");
+                  "Volumes (step 1) has 2 records of 10 values (20 in all) where 3 records of 10 were expected");
 }
 
 TEST(FdmDEMErrors, NonFiniteIntegral)

@@ -68,13 +68,13 @@ void expectSolution(const FakeFluid& fluid, const Scene& scene, const Expected& 
         const cpl::Velocities& out = fluid.velocities[m];
         Eigen::MatrixXd A = e.R;
         Eigen::VectorXd F = e.wallRhs;
-        for (int p = 0; p < n; ++p)
+        for (int p = 0; p < n; ++p) {
+            A.block<6, 6>(6 * p, 6 * p) += rigidBlock(fluid.volumeOf(in.step, p), fluid.rhoFluid, fluid.alphaLambda);
             for (int d = 0; d < 3; ++d) {
-                A(6 * p + d, 6 * p + d) += fluid.rhoFluid * fluid.volumeOf(in.step, p).Vu / fluid.alphaLambda;
-                A(6 * p + 3 + d, 6 * p + 3 + d) += fluid.rhoFluid * fluid.volumeOf(in.step, p).Ju / fluid.alphaLambda;
                 F(6 * p + d) += in.particles[p].F[d];
                 F(6 * p + 3 + d) += in.particles[p].T[d];
             }
+        }
         const Eigen::VectorXd u = A.ldlt().solve(F);
         const std::vector<double> got = flat(out);
         for (int k = 0; k < 6 * n; ++k)
@@ -300,15 +300,20 @@ TEST(PairFdmSubgrid, ContactForcesAreEqualOppositeAndEnterEq31)
         EXPECT_NEAR(rows[1][1 + d], Fn * n[d], 1e-9);
         EXPECT_EQ(rows[2][1 + d], 0.0);
     }
-    // Eq. (31) with R^SG = 0: U = alpha (F_fluid + F_c)/(rho_f Vu)
+    // Eq. (31) with R^SG = 0: each particle's rigid-body block times (U, Omega) = (F_fluid + F_c, T_fluid)
     const cpl::Integrals& in = fluid.integrals.back();
     const cpl::Velocities& out = fluid.velocities.back();
-    for (int p = 0; p < 2; ++p)
+    for (int p = 0; p < 2; ++p) {
+        Eigen::Matrix<double, 6, 1> load;
         for (int d = 0; d < 3; ++d) {
-            const double U = fluid.alphaLambda * (in.particles[p].F[d] + rows[p][1 + d]) /
-                             (fluid.rhoFluid * fluid.volumeOf(in.step, p).Vu);
-            EXPECT_NEAR(out.particles[p].U[d], U, 1e-10 * std::fabs(U) + 1e-14);
+            load(d) = in.particles[p].F[d] + rows[p][1 + d];
+            load(3 + d) = in.particles[p].T[d];
         }
+        const Eigen::Matrix<double, 6, 1> expected =
+            rigidBlock(fluid.volumeOf(in.step, p), fluid.rhoFluid, fluid.alphaLambda).ldlt().solve(load);
+        for (int d = 0; d < 3; ++d)
+            EXPECT_NEAR(out.particles[p].U[d], expected(d), 1e-10 * std::fabs(expected(d)) + 1e-14);
+    }
     // contact stresslet, Eq. (52): S^c_p = 1/2 a_p/(a_1+a_2) (F ⊗ x + x ⊗ F), x = x_p' - x_p
     const double r = 1.2 * 1.01, weight[2] = {0.5 / 1.2, 0.7 / 1.2};
     const int comp[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};

@@ -387,3 +387,75 @@ TEST(ParticleVelocitySystem, NonFiniteValuesAreNamed)
   expectError([&] { ParticleVelocitySystem bad(settings); }, ParticleVelocitySystem::Error::notSolved, -1,
               {"positive alpha_lambda (0 s)"});
 }
+
+// Eq. (30) integrated over a discrete sphere: the fluid integrals of a rigid motion U0 + Omega0 x r
+// sampled on any stencil (weights I_u V, offsets r; lambda = 0) give back exactly U0, Omega0 when
+// the rigid-body block carries the stencil's own first moment and inertia tensor. With the paper's
+// diagonal (m1 = 0, J = Ju 1) they do not: the particle turns in a uniform flow (docs/validation.md).
+TEST(ParticleVelocitySystem, RigidBlockReturnsTheRigidMotionOfAnyStencil)
+{
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-1, 1), w(0.05, 1);
+  Scene s = randomScene(37, 1, 0, 0, false);
+  s.particles[0].density = s.settings.rhoFluid;  // neutrally buoyant, no other force
+  for (int d = 0; d < 3; d++) s.particles[0].force[d] = s.particles[0].torque[d] = 0;
+  const double scale = s.settings.rhoFluid / s.settings.alphaLambda;
+  for (int trial = 0; trial < 20; trial++) {
+    const Eigen::Vector3d U0(u(rng), u(rng), u(rng)), W0(u(rng), u(rng), u(rng)), shift(0.3 * u(rng), 0.3 * u(rng), 0);
+    ParticleVelocitySystem::RigidVolume v;
+    Eigen::Vector3d F = Eigen::Vector3d::Zero(), T = Eigen::Vector3d::Zero(), m1 = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+    double Vu = 0;
+    for (int i = -2; i <= 2; i++)  // a lumpy sphere of cells, off-centre by `shift`, random weights
+      for (int j = -2; j <= 2; j++)
+        for (int k = -2; k <= 2; k++) {
+          const Eigen::Vector3d r = Eigen::Vector3d(i, j, k) + shift;
+          if (r.norm() > 2.2) continue;
+          const double weight = w(rng);
+          const Eigen::Vector3d ustar = U0 + W0.cross(r);
+          Vu += weight;
+          m1 += weight * r;
+          J += weight * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+          F += scale * weight * ustar;
+          T += scale * weight * r.cross(ustar);
+        }
+    v.Vu = Vu;
+    for (int d = 0; d < 3; d++) v.m1[d] = m1(d);
+    const double Jr[6] = {J(0, 0), J(0, 1), J(0, 2), J(1, 1), J(1, 2), J(2, 2)};
+    std::copy(Jr, Jr + 6, v.J);
+    const std::vector<double> fluid = {F(0), F(1), F(2), T(0), T(1), T(2)};
+    ParticleVelocitySystem system(s.settings);
+    system.assemble(s.particles, {}, {});
+    system.setVolumes(std::vector<ParticleVelocitySystem::RigidVolume>{v});
+    const std::vector<double> got = system.solve(fluid);
+    for (int d = 0; d < 3; d++) {
+      EXPECT_NEAR(got[d], U0(d), 1e-12) << "trial " << trial;
+      EXPECT_NEAR(got[3 + d], W0(d), 1e-12) << "trial " << trial;
+    }
+    // the rigid-body blocks times u give the fluid integrals back (the hydrodynamic force is zero)
+    const std::vector<double> back = system.rigidBlocksTimes(got);
+    for (int k = 0; k < 6; k++) EXPECT_NEAR(back[k], fluid[k], 1e-10 * (1 + std::fabs(fluid[k])));
+    // the paper's diagonal with the same volume and trace: the rotation is off when m1 != 0
+    if (trial == 0) {
+      ParticleVelocitySystem paper(s.settings);
+      paper.assemble(s.particles, {}, {});
+      paper.setVolumes({Vu}, {J.trace() / 3});
+      const std::vector<double> off = paper.solve(fluid);
+      EXPECT_GT(std::fabs(off[5] - W0(2)) + std::fabs(off[3] - W0(0)) + std::fabs(off[4] - W0(1)), 1e-3);
+    }
+  }
+  // a block that is not positive definite is no volume, named
+  ParticleVelocitySystem system(s.settings);
+  system.assemble(s.particles, {}, {});
+  ParticleVelocitySystem::RigidVolume bad;
+  bad.Vu = 1;
+  bad.m1[0] = 2;  // the first moment of a unit weight at distance 2 would need J >= 4
+  bad.J[0] = bad.J[3] = bad.J[5] = 1;
+  try {
+    system.setVolumes(std::vector<ParticleVelocitySystem::RigidVolume>{bad});
+    ADD_FAILURE() << "a block that is not positive definite was taken";
+  } catch (const ParticleVelocitySystem::Error &e) {
+    EXPECT_EQ(e.kind, ParticleVelocitySystem::Error::noVolume);
+    EXPECT_NE(std::string(e.what()).find("m1 (2, 0, 0)"), std::string::npos) << e.what();
+  }
+}

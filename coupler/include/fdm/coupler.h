@@ -23,12 +23,14 @@ namespace coupler {
 //    stresslets; StepDone may carry them (for the sub-grid lubrication pair style).
 // 3: Vu and Ju (they depend only on the positions) go once per time step in the new Volumes
 //    message, before the first Integrals; Integrals keep F and T only (6 values per particle).
-const uint16_t protocolVersion = 3;
+// 4: Volumes carry the first moment m1 and the inertia tensor J of the discrete sphere instead
+//    of the isotropic Ju (Eq. 31's rigid-body block, Galilean invariant).
+const uint16_t protocolVersion = 4;
 
 enum class MessageType : uint16_t {
     Hello      = 1,  // handshake, once per connection, each side sends one
     Step       = 2,  // DEM -> fluid: particle positions/radii/velocities, once per time step
-    Volumes    = 8,  // fluid -> DEM: Vu, Ju of every particle, once per time step (protocol 3)
+    Volumes    = 8,  // fluid -> DEM: Vu, m1, J of every particle, once per time step (protocol 4)
     Integrals  = 3,  // fluid -> DEM: per-particle integrals of Eq. (38), every inner iteration
     Velocities = 4,  // DEM -> fluid: rigid velocities (U_p, Omega_p), every inner iteration
     StepDone   = 5,  // fluid -> DEM: inner iterations converged, hydrodynamic force/torque
@@ -108,10 +110,14 @@ namespace layout {
     enum StepField { sTag, sX, sY, sZ, sRadius, sUx, sUy, sUz, sWx, sWy, sWz, stepWidth };
 
     // Volumes: once per time step, after Step and before the first Integrals; one record per
-    // particle (same order as Step), from the fluid's indicator function I_u:
-    //   Vu = int I_u dV                               -> (rho_f/rho_p) M_p = rho_f Vu
-    //   Ju = int I_u (2/3)|x-x_p|^2 dV                -> (rho_f/rho_p) J_p = rho_f Ju
-    enum VolumeField { volVu, volJu, volumesWidth };
+    // particle (same order as Step), from the fluid's indicator function I_u, r = x - x_p:
+    //   Vu = int I_u dV                               (rigid translation)
+    //   m1 = int I_u r dV                             (first moment: zero only on the mesh's
+    //                                                  symmetry points)
+    //   J  = int I_u (|r|^2 1 - r r) dV               (inertia tensor: xx xy xz yy yz zz)
+    // Eq. (31)'s block of the particle is (rho_f/alpha) [[Vu 1, -[m1]x], [[m1]x, J]].
+    enum VolumeField { volVu, volM1x, volM1y, volM1z, volJxx, volJxy, volJxz, volJyy, volJyz, volJzz,
+                       volumesWidth };
 
     // Integrals: every inner iteration, one record per particle, all in SI units:
     //   F  = rho_f int (I_u u*/alpha - I_lambda lambda^n) dV               (Eq. 32)
@@ -225,9 +231,13 @@ struct Step {
     static Step fromMessage(const Message& m, long expectedCount = -1);
 };
 
-// Volumes of the time step `step` (they depend only on the positions): Eq. (31)'s diagonal.
+// Volumes of the time step `step` (they depend only on the positions): Eq. (31)'s rigid-body block.
 struct ParticleVolume {
-    double Vu, Ju;
+    double Vu = 0;
+    double m1[3] = {0, 0, 0};
+    double J[6] = {0, 0, 0, 0, 0, 0};   // xx xy xz yy yz zz
+    // the isotropic part, trace(J)/3 = int I_u (2/3)|r|^2 dV (protocol 3's Ju)
+    double isotropicJ() const { return (J[0] + J[3] + J[5]) / 3; }
 };
 struct Volumes {
     uint64_t step = 0;

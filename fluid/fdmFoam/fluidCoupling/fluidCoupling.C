@@ -538,8 +538,16 @@ void Foam::fluidCoupling::sendIntegrals
         volumes.particles.resize(n);
         for (label p = 0; p < n; ++p)
         {
-            volumes.particles[p].Vu = integrals[width*p + layout::volVu];
-            volumes.particles[p].Ju = integrals[width*p + layout::volJu];
+            const scalar* rec = &integrals[width*p];
+            volumes.particles[p].Vu = rec[layout::volVu];
+            for (label d = 0; d < 3; ++d)
+            {
+                volumes.particles[p].m1[d] = rec[layout::volM1x + d];
+            }
+            for (label k = 0; k < 6; ++k)
+            {
+                volumes.particles[p].J[k] = rec[layout::volJxx + k];
+            }
         }
         send(volumes.toMessage());
         volumesSent_ = true;

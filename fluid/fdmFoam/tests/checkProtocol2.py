@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Standalone check of fdmFoam's side of the coupling protocol (docs/coupling.md): written for the
-additions of version 2 (viscosity, box faces, stresslets), it speaks version 3 (Volumes once per
-step). It plays the particle code over the socket (wire format of coupler/include/fdm/coupler.h,
+additions of version 2 (viscosity, box faces, stresslets), it speaks version 4 (Volumes once per
+step, with the rigid-body block: Vu, m1, J). It plays the particle code over the socket (wire format of coupler/include/fdm/coupler.h,
 re-implemented here in a few lines) and runs the real fdmFoam.
 
     . etc/bashrc && python3 fluid/fdmFoam/tests/checkProtocol2.py [--keep DIR]
@@ -9,10 +9,11 @@ re-implemented here in a few lines) and runs the real fdmFoam.
 A free sphere (radius a, a/Delta = 4) at the centre of a wall-driven shear cell (walls at ylo and
 yhi moving along -x and +x, cyclic in x and z), the set-up of tests/test_walls.py and paper 5.2.2.
 The emulated particle code solves Eq. (31) for one free particle without sub-grid terms:
-U = alpha F/(rho_f Vu), Omega = alpha T/(rho_f Ju). Checked:
+(rho_f/alpha) [[Vu 1, -[m1]x], [[m1]x, J]] (U, Omega) = (F, T). Checked:
 
-* protocol 3: after each Step one Volumes [Vu, Ju] (Vu within 10 % of the sphere's volume, Ju of
-  (2/5) a^2 Vu), then Integrals of 6 values [F, T], one per inner iteration, and no other Volumes;
+* protocol 4: after each Step one Volumes [Vu, m1 (3), J (6)] (Vu within 10 % of the sphere's volume,
+  J of (2/5) a^2 Vu on the diagonal, m1 = 0 and J isotropic for this sphere on a symmetry point of
+  the mesh), then Integrals of 6 values [F, T], one per inner iteration, and no other Volumes;
 
 * the fluid Hello: 38 values, the first 13 as in protocol 1, eta = rho_f nu, the six box faces
   (kind, wall velocity), identical in serial and on 2 ranks split across the cyclic direction
@@ -44,7 +45,7 @@ PROJECT = os.path.dirname(os.path.dirname(os.path.dirname(HERE)))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 from fdmsubgrid import case  # noqa: E402
 
-VERSION = 3
+VERSION = 4
 HELLO, STEP, INTEGRALS, VELOCITIES, STEPDONE, FINISH, ERROR, VOLUMES = range(1, 9)
 TYPE_NAMES = {1: "Hello", 2: "Step", 3: "Integrals", 4: "Velocities", 5: "StepDone", 6: "Finish", 7: "Error",
               8: "Volumes"}
@@ -202,7 +203,7 @@ def dem_hello(box, stresslets_text):
 
 def run_coupled(root, fluid, box, np_fluid, stresslets_text, n_steps=1):
     """One coupled run of a free sphere; returns (fluid Hello, last StepDone). Checks the order of
-    protocol 3: Volumes once per step, before the first Integrals."""
+    protocol 4: Volumes once per step, before the first Integrals."""
     proc, peer, log = start_fluid(root, fluid, np_fluid)
     try:
         peer.send(dem_hello(box, stresslets_text))
@@ -216,12 +217,17 @@ def run_coupled(root, fluid, box, np_fluid, stresslets_text, n_steps=1):
             peer.send(Message(STEP, step, 0, 11, "dt=1 lastStep=%d" % n_steps, [[1, x, y, z, a] + v]))
             m = peer.receive()
             assert m.type == VOLUMES, "expected Volumes, got %s: %s" % (TYPE_NAMES[m.type], m.text)
-            check(m.step == step and m.width == 2 and len(m.records) == 1,
-                  "np %d step %d: Volumes [Vu, Ju] of the step first" % (np_fluid, step))
-            vu, ju = m.records[0]
+            check(m.step == step and m.width == 10 and len(m.records) == 1,
+                  "np %d step %d: Volumes [Vu, m1, J] of the step first" % (np_fluid, step))
+            vu, m1x, m1y, m1z, jxx, jxy, jxz, jyy, jyz, jzz = m.records[0]
+            ju = (jxx + jyy + jzz) / 3
             sphere = 4.0 / 3.0 * math.pi * a ** 3
             check(abs(vu / sphere - 1) < 0.1 and abs(ju / (0.4 * a * a * vu) - 1) < 0.15,
-                  "np %d: Vu %.6g ~ the sphere's volume %.6g, Ju %.6g ~ (2/5) a^2 Vu" % (np_fluid, vu, sphere, ju))
+                  "np %d: Vu %.6g ~ the sphere's volume %.6g, J %.6g ~ (2/5) a^2 Vu" % (np_fluid, vu, sphere, ju))
+            # the sphere sits on a mesh vertex: the discrete sphere has the mesh's symmetries
+            check(max(abs(m1x), abs(m1y), abs(m1z)) < 1e-12 * vu * a and
+                  max(abs(jxy), abs(jxz), abs(jyz), abs(jxx - ju), abs(jyy - ju), abs(jzz - ju)) < 1e-12 * ju,
+                  "np %d: m1 = 0 and J isotropic on a symmetry point of the mesh" % np_fluid)
             iterations = 0
             while True:
                 m = peer.receive()
@@ -229,7 +235,7 @@ def run_coupled(root, fluid, box, np_fluid, stresslets_text, n_steps=1):
                     done = m
                     break
                 assert m.type == INTEGRALS, "expected Integrals, got %s: %s" % (TYPE_NAMES[m.type], m.text)
-                assert m.width == 6, "Integrals of %d values (protocol 3: 6)" % m.width
+                assert m.width == 6, "Integrals of %d values (protocol 4: 6)" % m.width
                 iterations += 1
                 fx, fy, fz, tx, ty, tz = m.records[0]
                 # Eq. (31) for one free particle, no sub-grid terms
