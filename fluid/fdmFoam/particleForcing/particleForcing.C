@@ -190,6 +190,39 @@ void Foam::particleForcing::setParticles(const List<fdmParticle>& particles)
         covered_[celli] = count[celli] > 0;
         IuScale_[celli] = 1.0/max(scalar(1), IuSum[celli]);
     }
+
+    // The rigid-body block of Eq. (31) (fdm/coupler.h, Volumes): the discrete
+    // sphere's volume, first moment and inertia tensor, so that U + Omega x r
+    // integrates exactly as the fluid's u* does
+    namespace layout = fdm::coupler::layout;
+    const label nv = layout::volumesWidth;
+    volumes_.setSize(nv*particles_.size());
+    forAll(particles_, p)
+    {
+        scalar Vu = 0;
+        vector m1(Zero);
+        symmTensor J(Zero);
+        for (label e = offset_[p]; e < offset_[p+1]; ++e)
+        {
+            const vector& r = r_[e];
+            const scalar w = Iu_[e]*V[cell_[e]];
+            Vu += w;
+            m1 += w*r;
+            J += w*(magSqr(r)*symmTensor::I - sqr(r));
+        }
+        scalar* rec = &volumes_[nv*p];
+        rec[layout::volVu] = Vu;
+        for (direction d = 0; d < 3; ++d)
+        {
+            rec[layout::volM1x + d] = m1[d];
+        }
+        rec[layout::volJxx] = J.xx();
+        rec[layout::volJxy] = J.xy();
+        rec[layout::volJxz] = J.xz();
+        rec[layout::volJyy] = J.yy();
+        rec[layout::volJyz] = J.yz();
+        rec[layout::volJzz] = J.zz();
+    }
 }
 
 
@@ -225,38 +258,21 @@ Foam::List<Foam::scalar> Foam::particleForcing::integrals
 
     forAll(particles_, p)
     {
-        // The rigid-body block of Eq. (31) (fdm/coupler.h, Volumes): the
-        // discrete sphere's volume, first moment and inertia tensor, so that
-        // U + Omega x r integrates exactly as the fluid's u* does
-        scalar Vu = 0;
-        vector m1(Zero);
-        symmTensor J(Zero);
         vector F(Zero), T(Zero);
         for (label e = offset_[p]; e < offset_[p+1]; ++e)
         {
             const label celli = cell_[e];
             const vector& r = r_[e];
-            const scalar w = Iu_[e]*V[celli];
             // Integrand of Eq. (32): I_u u*/alpha - I_lambda lambda^n
             const vector g = Iu_[e]*u[celli]/alpha_ - Ilambda_[e]*l[celli];
-            Vu += w;
-            m1 += w*r;
-            J += w*(magSqr(r)*symmTensor::I - sqr(r));
             F += g*V[celli];
             T += (r ^ g)*V[celli];
         }
         scalar* rec = &result[width*p];
-        rec[layout::volVu] = Vu;
-        for (direction d = 0; d < 3; ++d)
+        for (label k = 0; k < nv; ++k)
         {
-            rec[layout::volM1x + d] = m1[d];
+            rec[k] = volumes_[nv*p + k];   // summed over processors below
         }
-        rec[layout::volJxx] = J.xx();
-        rec[layout::volJxy] = J.xy();
-        rec[layout::volJxz] = J.xz();
-        rec[layout::volJyy] = J.yy();
-        rec[layout::volJyz] = J.yz();
-        rec[layout::volJzz] = J.zz();
         for (direction d = 0; d < 3; ++d)
         {
             rec[nv + layout::iFx + d] = rhoFluid_*F[d];
