@@ -3,7 +3,7 @@
 #include "message_text.h"
 #include "particle_velocity_system.h"
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Cholesky>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -235,8 +235,7 @@ void ParticleVelocitySystem::setVolumes(const std::vector<RigidVolume> &volumes)
         B(3 + i, j) = c[i][j];       // torque from U: sum I_u r x U = m1 x U
         B(3 + i, 3 + j) = J[i][j];   // torque from Omega: sum I_u r x (Omega x r) = J Omega
       }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6> > eig(B, Eigen::EigenvaluesOnly);
-    if (!(v.Vu > 0) || !(eig.eigenvalues().minCoeff() > 0))
+    if (!(v.Vu > 0) || Eigen::LLT<Eigen::Matrix<double, 6, 6> >(B).info() != Eigen::Success)
       throw Error(Error::noVolume, p, "particle " + particleId(p) + " at " + point(q.x) + " with radius " +
                                       number(q.radius) + ": the fluid's indicator function gives it no volume (" +
                                       values + ")");

@@ -53,8 +53,10 @@ PairFunctionValues expandAppendixC2(const PairSubgridBase& b, double r)
 
 PairFunctionValues subgridPairFunctions(const SubgridModel& model, double a1, double a2, double xi, double r)
 {
-    const PairFunctionValues mine = expandAppendixC2(model.pair(a1, a2, xi), r);
-    const PairFunctionValues relabelled = expandAppendixC2(model.pair(a2, a1, xi), r);
+    const PairSubgridBase base = model.pair(a1, a2, xi);
+    const PairFunctionValues mine = expandAppendixC2(base, r);
+    // equal radii: the relabelled pair has the same independent functions
+    const PairFunctionValues relabelled = expandAppendixC2(a1 == a2 ? base : model.pair(a2, a1, xi), r);
     // sign of each tensor form of Eq. (A.1) under d -> -d: A, C (d d, I), H (d eps.d) even; B (eps.d),
     // G (three d's or d delta), P (d) odd. M and Q are not sub-grid functions (zero in both).
     double parity[NumPairFunctions];
