@@ -129,15 +129,6 @@ def cell_offsets(n_positions: int) -> list[tuple[float, float]]:
     return [(float(x), float(z)) for x in g for z in g]
 
 
-def _pair_style(U: float, subgrid: bool) -> str:
-    """pair_style fdm/subgrid with both no-slip walls declared at the fluid case's velocities (the
-    pair style checks they agree with 0/U; docs/dem.md)."""
-    words = ["fdm/subgrid", "wall ylo %r 0 0" % (-U), "wall yhi %r 0 0" % U]
-    if not subgrid:
-        words.append("lubrication no")
-    return " ".join(words)
-
-
 def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float], a_over_delta: float,
             offsets: Sequence[tuple[float, float]], subgrid: bool = True, tol_lambda: float = 1e-5,
             np_fluid: int = 1, keep: bool = False) -> dict:
@@ -175,7 +166,10 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
             runs.append("set             atom 1 x %r y %r z %r" % centre(o))
         runs.append("run             1")
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [centre(offsets[0]) + (a,)], dt=0.01,
-                         fix_options="move no stresslets yes", pair_style=_pair_style(U, subgrid), runs=runs,
+                         fix_options="move no stresslets yes", runs=runs,
+                         # both no-slip walls at the fluid case's velocities (the pair style checks they agree
+                         # with 0/U; docs/dem.md)
+                         pair_style=case.subgrid_pair_style((("ylo", (-U, 0, 0)), ("yhi", (U, 0, 0))), subgrid),
                          name="in.channelShear")
     wall = case.run(run_dir, np_fluid=np_fluid)
     rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"))

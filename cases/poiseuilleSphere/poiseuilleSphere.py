@@ -314,19 +314,6 @@ def cell_offsets(n_positions: int) -> tuple[list[tuple[float, float]], int]:
     return [(0.5 * float(x), 0.5 * float(z)) for x, z in case.halton_points(n_positions, 2)], n_positions
 
 
-def pair_style(subgrid: bool, model: str, cutoff: float | None, wall_cutoff: float | None) -> str:
-    """pair_style fdm/subgrid with the sub-grid model, its cut-offs (pairs, walls) and the two walls at rest."""
-    words = ["fdm/subgrid", "model %s" % model]
-    if cutoff is not None:
-        words.append("cutoff %g" % cutoff)
-    if wall_cutoff is not None:
-        words.append("wall_cutoff %g" % wall_cutoff)
-    if not subgrid:
-        words.append("lubrication no")
-    words.append("wall ylo 0 0 0 wall yhi 0 0 0")
-    return " ".join(words)
-
-
 # ------------------------------------------------------------------------------------------------
 # Running
 # ------------------------------------------------------------------------------------------------
@@ -358,7 +345,8 @@ def run_channel(workdir: str, scene: Scene, d_list: Sequence[float], offsets: Se
     first = scene.centre(*configurations[0])
     case.write_dem_input(os.path.join(run_dir, "dem"), scene.box, [first + (scene.radius,)], dt=1.0,
                          fix_options="move no stresslets yes",
-                         pair_style=pair_style(options.subgrid, options.model, options.cutoff, options.wall_cutoff),
+                         pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), options.subgrid,
+                                                            options.model, options.cutoff, options.wall_cutoff),
                          before_run="fix             output all fdm/output records 1 particles.records",
                          runs=runs, name="in.poiseuilleSphere")
     wall = case.run(run_dir, np_fluid=options.np_fluid)

@@ -145,17 +145,6 @@ def _fresh(run_dir: str) -> str:
     return run_dir
 
 
-def _pair_style(subgrid: bool, model: str, cutoff: float | None) -> str:
-    """pair_style fdm/subgrid with the sub-grid model, its cut-off, and the two walls at rest."""
-    words = ["fdm/subgrid", "model %s" % model]
-    if cutoff is not None:
-        words.append("cutoff %g" % cutoff)
-    if not subgrid:
-        words.append("lubrication no")
-    words.append("wall ylo 0 0 0 wall yhi 0 0 0")
-    return " ".join(words)
-
-
 def _write_and_run(run_dir: str, box: case.Box, configurations: list[np.ndarray], pushed: int, options) -> tuple[
         float, dict, dict]:
     """One coupled run: the spheres at each configuration (n, 3) in turn, one step each, the sphere
@@ -172,7 +161,8 @@ def _write_and_run(run_dir: str, box: case.Box, configurations: list[np.ndarray]
         runs.append("run             1")
     spheres = [tuple(map(float, p)) + (RADIUS,) for p in configurations[0]]
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=1.0,
-                         pair_style=_pair_style(options.subgrid, options.model, options.cutoff),
+                         pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))),
+                                                            options.subgrid, options.model, options.cutoff),
                          before_run="group           pushed id %d\n"
                                     "fix             push pushed addforce %r 0 0" % (pushed + 1, FORCE),
                          runs=runs, name="in.threeSpheres")

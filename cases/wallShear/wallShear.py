@@ -149,20 +149,6 @@ def check_scene(eps_values: Sequence[float], radii: Sequence[float], size: Seque
                              "(at least %g a1)" % (name, length, a_max, length - 2 * a_max - delta, MIN_IMAGE_GAP))
 
 
-def _pair_style(subgrid: bool, model: str, cutoff: float | None, wall_cutoff: float | None, size: Sequence[float]) -> str:
-    """pair_style fdm/subgrid: the model, its cut-offs, the walls y = 0 at rest and y = L_y at gamma_dot L_y
-    along x (declared as in the fluid case); lubrication no without the correction."""
-    words = ["fdm/subgrid", "model %s" % model]
-    if cutoff is not None:
-        words.append("cutoff %g" % cutoff)
-    if wall_cutoff is not None:
-        words.append("wall_cutoff %g" % wall_cutoff)
-    if not subgrid:
-        words.append("lubrication no")
-    words.append("wall ylo 0 0 0 wall yhi %r 0 0" % (SHEAR_RATE * size[1]))
-    return " ".join(words)
-
-
 def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool, eps_values: Sequence[float],
               offsets: Sequence[Sequence[float]], options) -> dict:
     """One coupled run: the sphere of `radius` at every eps (largest first) and every offset, one step each.
@@ -194,7 +180,9 @@ def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool,
         runs.append("run             1")
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [positions[0] + (radius,)], dt=1.0,
                          fix_options="move no stresslets yes",
-                         pair_style=_pair_style(subgrid, options.model, options.cutoff, options.wall_cutoff, size),
+                         # the walls as in the fluid case: y = 0 at rest, y = L_y at gamma_dot L_y along x
+                         pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (SHEAR_RATE * size[1], 0, 0))),
+                                                            subgrid, options.model, options.cutoff, options.wall_cutoff),
                          before_run="fix             output all fdm/output records 1 particles.records",
                          runs=runs, name="in.wallShear")
     wall = case.run(run_dir, np_fluid=options.np_fluid)

@@ -278,6 +278,24 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     return wall
 
 
+def subgrid_pair_style(walls=(), subgrid=True, model=None, cutoff=None, wall_cutoff=None) -> str:
+    """The pair_style line of fdm/subgrid (docs/dem.md): the sub-grid model, its cut-offs in mesh cells
+    (pairs, walls; None: the pair style's defaults), `lubrication no` without the correction, and the
+    walls as (face, (ux, uy, uz)) pairs, e.g. (("ylo", (0, 0, 0)), ("yhi", (U, 0, 0)))."""
+    words = ["fdm/subgrid"]
+    if model is not None:
+        words.append("model %s" % model)
+    if cutoff is not None:
+        words.append("cutoff %g" % cutoff)
+    if wall_cutoff is not None:
+        words.append("wall_cutoff %g" % wall_cutoff)
+    if not subgrid:
+        words.append("lubrication no")
+    for face, velocity in walls:
+        words.append("wall %s %s" % (face, " ".join("%r" % float(v) for v in velocity)))
+    return " ".join(words)
+
+
 def halton_points(n: int, dims: int) -> np.ndarray:
     """The first n points of the Halton sequence in [0, 1)^dims (bases 2, 3, 5, ...; unscrambled, the
     origin left out): positions spread evenly over a mesh cell for any count, the cases' --positions."""
