@@ -38,6 +38,7 @@ class Row:
     error_unit: str = "%"               # "%": relative error in per cent; otherwise the unit of an absolute one
     spread: Optional[float] = None      # standard deviation over positions in the cell, where averaged
     headline: bool = True               # False: a comparison run (the FDM alone), left out of the summary
+    percent: bool = False               # the value is a fraction, shown in per cent (a balance's error)
 
     def error_text(self) -> str:
         if self.error is None or not math.isfinite(self.error):
@@ -141,7 +142,7 @@ def sheared_sphere_rows(r: dict) -> List[Row]:
         rows.append(Row("Ω_z/(−γ̇/2)", config, a["omega_z_over_minus_half_gamma"], 1.0, "→ 1 as H grows (Fig. 10)",
                         relative(a["omega_z_over_minus_half_gamma"], 1.0)))
         rows.append(Row("momentum balance on the walls (largest)", config, a["wall_balance_rel_error_max"],
-                        paper="—", error_unit="%"))
+                        percent=True))
     return rows
 
 
@@ -270,7 +271,7 @@ def table8_rows(summary: dict) -> List[Row]:
         rows.append(Row("N̂1", config, r["N1_hat"], spread=r.get("N1_hat_err"), paper="Fig. 22"))
         rows.append(Row("N̂2", config, r["N2_hat"], spread=r.get("N2_hat_err"), paper="Fig. 22"))
         rows.append(Row("stress balance (core against walls)", config, r["stress_balance_rel_error"],
-                        paper="—", error_unit="%"))
+                        percent=True))
     fit = summary.get("fit")
     if fit:
         for q, key, paper in (("Maron–Pierce α", "alpha", PAPER_MARON_PIERCE[0]),
@@ -385,10 +386,8 @@ def table(rows: List[Row]) -> List[str]:
         return ["(no rows)", ""]
     lines = ["| quantity | configuration | paper | this project | reference | error |", "|---|---|---|---|---|---|"]
     for row in rows:
-        value = number(row.value) + (" ± %s" % number(row.spread) if row.spread else "")
-        if row.reference is None and row.error is None and row.error_unit == "%" and row.quantity.startswith(
-                ("momentum balance", "stress balance")):
-            value = "%.2g %%" % (100 * row.value)
+        value = ("%.2g %%" % (100 * row.value) if row.percent else number(row.value)) + \
+            (" ± %s" % number(row.spread) if row.spread else "")
         lines.append("| %s | %s | %s | %s | %s | %s |" % (row.quantity, row.configuration, row.paper, value,
                                                          number(row.reference), row.error_text()))
     return lines + [""]
