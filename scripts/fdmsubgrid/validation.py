@@ -220,6 +220,34 @@ def poiseuille_sphere_rows(r: dict) -> List[Row]:
     return rows
 
 
+def pair_poiseuille_rows(r: dict) -> List[Row]:
+    """cases/pairPoiseuille (5.4): no tabulated reference (Bhattacharya et al. 2006 are plots in the
+    paper): the sign change of the centre-line sphere's U_y beside the paper's ~0.6, the near-contact
+    relative normal velocity with and without the correction (lubrication: -> 0), and the far pair
+    against the isolated spheres."""
+    rows = []
+    config = "H = 4a, d2/a %g, a/Δ %g, box %s a, %d positions" % (
+        r["d2_over_a"], r["a_over_delta"], "×".join("%g" % v for v in r["box"]), r["n_positions"])
+    for scene in r["scenes"]:
+        mode = "subgrid" if scene["subgrid"] else "no_subgrid"
+        summary = r["summary"][mode]
+        with_block = scene["subgrid"]
+        label = "with the correction" if with_block else "FDM alone"
+        crossings = summary.get("Uy1_sign_change_rho_over_H") or []
+        if with_block and crossings:
+            rows.append(Row("ρ12/H where U_y1 changes sign", config, crossings[0], paper="≈ 0.6 (Fig. 18)"))
+        near = summary["nearest"]
+        rows.append(Row("(U2 − U1)·n / isolated pair's, ξ = %.0e (%s)" % (near["xi"], label), config,
+                        near["Un_ratio"], paper="→ 0 with the correction (Figs. 17–18)", headline=with_block))
+        if with_block:
+            far = summary["farthest"]
+            single = scene["single"]
+            rows.append(Row("U_x2/U_c at ρ12/H %g against sphere 2 alone" % far["rho_over_H"], config,
+                            single["Ux2"] + far["Ux2_minus_single"], single["Ux2"], "far field: the isolated sphere",
+                            relative(single["Ux2"] + far["Ux2_minus_single"], single["Ux2"])))
+    return rows
+
+
 # Every case of the report, in the paper's order; pairShear runs twice (smooth, contact), keyed apart
 CASES: Dict[str, Case] = {}
 for _c in [
@@ -243,6 +271,9 @@ for _c in [
     Case("poiseuilleSphere", "5.2.3 a free sphere in plane Poiseuille flow",
          "Staben et al. (2003) on the centre plane at 2a/H 0.6; elsewhere Faxén's laws with the leading wall "
          "reflections (none within 1.5 a of a wall)", poiseuille_sphere_rows),
+    Case("pairPoiseuille", "5.4 two free spheres in a confined plane Poiseuille flow (H = 4a)",
+         "no tabulated values (Bhattacharya et al. 2006 are plots): the sign change of U_y, lubrication near "
+         "contact, the isolated spheres far apart", pair_poiseuille_rows),
     Case("threeSpheres", "5.5 three spheres, one pushed toward the centroid",
          "far-field reflections with exact pairs in unbounded fluid (r/a ≥ 4)", three_spheres_rows),
 ]:
