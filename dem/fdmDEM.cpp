@@ -6,6 +6,7 @@
 #include "fix_contact_history_fdm.h"
 #include "fix_fdm_couple.h"
 #include "fix_fdm_output.h"
+#include "fix_fdm_torque.h"
 #include "pair_fdm_subgrid.h"
 #include "style_registry.h"
 
@@ -65,6 +66,7 @@ int main(int argc, char **argv)
   LAMMPS_NS::LAMMPS *lmp = new LAMMPS_NS::LAMMPS(int(args.size()) - 1, args.data(), MPI_COMM_WORLD);
   fdm::registerFix<LAMMPS_NS::FixFdmCouple>(lmp, "fdm/couple");
   fdm::registerFix<LAMMPS_NS::FixFdmOutput>(lmp, "fdm/output");
+  fdm::registerFix<LAMMPS_NS::FixFdmTorque>(lmp, "fdm/torque");
   fdm::registerPair<LAMMPS_NS::PairFdmSubgrid>(lmp, "fdm/subgrid");
   // LIGGGHTS's contact history, made to serve pair fdm/subgrid too (Neighbor finds it by this name)
   fdm::registerFix<LAMMPS_NS::FixContactHistoryFdm>(lmp, "contacthistory");

@@ -21,7 +21,7 @@
 #include "update.h"
 
 #include "fdm/resistance/blocks.hpp"
-#include "fdm/resistance/squeeze_calibration.hpp"
+#include "fdm/resistance/subgrid_calibration.hpp"
 
 #include <Eigen/Dense>
 
@@ -188,10 +188,11 @@ void PairFdmSubgrid::fluidParameters()
   // Two cut-offs: the solver resolves a wall gap less well than a pair gap of the same width
   // (measured with cases/pairSqueeze and cases/wallSqueeze, docs/validation.md)
   if (calibrated_ && !model_) {
-    // the squeeze functions measured with the solver itself (Appendix B; squeeze_calibration.hpp)
-    const std::string path = calibrationFile_.empty() ? res::SqueezeCalibration::defaultPath() : calibrationFile_;
+    // the functions measured with the solver itself (Appendix B; subgrid_calibration.hpp): the squeeze
+    // functions and, where tabulated, the tangential wall functions
+    const std::string path = calibrationFile_.empty() ? res::SubgridCalibration::defaultPath() : calibrationFile_;
     try {
-      calibration_.reset(new res::SqueezeCalibration(res::SqueezeCalibration::read(path)));
+      calibration_.reset(new res::SubgridCalibration(res::SubgridCalibration::read(path)));
       model_ = std::make_shared<res::CalibratedSubgridModel>(*calibration_, meshSize_, cutoffCells_, wallCutoffCells_);
       wallModel_ = model_;   // it holds both cut-offs
     } catch (const std::exception &e) {

@@ -30,7 +30,7 @@
 namespace fdm {
 namespace resistance {
 class SubgridModel;
-class SqueezeCalibration;
+class SubgridCalibration;
 }
 }
 
@@ -122,8 +122,8 @@ class PairFdmSubgrid : public Pair {
 
   // settings
   bool lubrication_;
-  bool calibrated_;                 // model calibrated: the squeeze calibration of Appendix B
-  std::string calibrationFile_;     // its table (default: SqueezeCalibration::defaultPath())
+  bool calibrated_;                 // model calibrated: the calibration of Appendix B
+  std::string calibrationFile_;     // its table (default: SubgridCalibration::defaultPath())
   double cutoffCells_, wallCutoffCells_;
   double kn_, kt_, mu_, hr_;
   bool unstableStepIsError_;   // unstable_step error (default) | warn
@@ -134,7 +134,7 @@ class PairFdmSubgrid : public Pair {
   double viscosity_, meshSize_;
   // pairs, walls: two cut-off models (their cut-offs differ); the calibrated model serves both
   std::shared_ptr<fdm::resistance::SubgridModel> model_, wallModel_;
-  std::unique_ptr<fdm::resistance::SqueezeCalibration> calibration_;  // model calibrated
+  std::unique_ptr<fdm::resistance::SubgridCalibration> calibration_;  // model calibrated
 
   double rangeGap_;            // largest surface gap with any pair interaction (contact or lubrication)
   double rmin_, rmax_, distanceFactor_;

@@ -12,7 +12,7 @@ from conftest import PROJECT
 from fdmsubgrid import calibration, squeeze, theory
 
 DATA = os.path.join(PROJECT, "dem", "resistance", "data")
-TABLE = os.path.join(DATA, "squeeze_calibration.dat")
+TABLE = os.path.join(DATA, "subgrid_calibration.dat")
 
 
 def test_box_extrapolation_removes_dipole_images():

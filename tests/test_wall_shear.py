@@ -215,13 +215,43 @@ def test_agreement_where_the_code_is_good(scene):
     assert abs(on["S_star_rel_error"]) < abs(off["S_star_rel_error"])
 
 
-@pytest.mark.xfail(strict=True, reason="issue 14: the cut-off sub-grid model over-corrects the tangential wall "
-                                       "functions: the free sphere is 10-17 % too slow for eps 0.001-0.1 with the "
-                                       "correction (measured -13.7 % at eps = 0.1, -14.7 % at eps = 0.01)")
-def test_issue14_free_sphere_within_two_percent_with_correction(scene):
+@pytest.mark.xfail(strict=True, reason="the cut-off sub-grid model over-corrects the tangential wall functions: "
+                                       "the free sphere is 10-17 % too slow for eps 0.001-0.1 with the correction "
+                                       "(measured -13.7 % at eps = 0.1, -14.7 % at eps = 0.01); the calibrated "
+                                       "model below fixes it")
+def test_cutoff_model_free_sphere_within_two_percent_with_correction(scene):
     rows, _, _ = scene
     for eps in (0.1, 0.01):
         assert abs(rows[(True, eps)]["Ux_norm_rel_error"]) < 0.02, eps
+
+
+@pytest.fixture(scope="module")
+def calibrated(wall_shear, tmp_path_factory, env):
+    # the same offsets with pair_style fdm/subgrid model calibrated (the tangential wall functions measured
+    # with the solver, docs/resistance.md "Tangential wall calibration"), the correction on only
+    work = tmp_path_factory.mktemp("wallShearCalibrated")
+    result = wall_shear.main(["--eps", "0.1", "0.01", "--model", "calibrated", "--subgrid-only",
+                              "--offset", *map(str, OFFSET_VERTEX), "--offset", *map(str, OFFSET_GENERIC),
+                              "--workdir", str(work), "--out", str(work / "results.json")])
+    return {r["eps"]: r for r in result["rows"]}
+
+
+def test_calibrated_wall_functions_slide_the_free_sphere_at_the_right_speed(calibrated, scene):
+    # measured (2 Halton offsets, 12^3 a, a/Delta 3): U within -2.3 ... +0.6 % at eps 1e-3 ... 0.54, against
+    # -10 ... -17 % with the cut-off model; at the test's offsets -1.0 % (eps 0.1) and -1.4 % (0.01)
+    rows, _, _ = scene
+    for eps in (0.1, 0.01):
+        assert abs(calibrated[eps]["Ux_norm_rel_error"]) < 0.03, (eps, calibrated[eps]["Ux_norm_rel_error"])
+        assert abs(calibrated[eps]["Ux_norm_rel_error"]) < abs(rows[(True, eps)]["Ux_norm_rel_error"])
+
+
+@pytest.mark.xfail(strict=True, reason="issue 14: Omega_z is still 6 % slow near contact and 13-17 % fast at eps = 0.1 "
+                                       "with the calibrated model: at eps 0.05-0.5 the solver couples translation "
+                                       "and rotation (its Y^B) 2-3 times more than the theory, which a dissipative "
+                                       "correction cannot take away (docs/resistance.md)")
+def test_issue14_calibrated_rotation_within_two_percent(calibrated):
+    for eps in (0.1, 0.01):
+        assert abs(calibrated[eps]["Wz_norm_rel_error"]) < 0.02, eps
 
 
 @pytest.mark.parametrize("options, message", [

@@ -35,9 +35,13 @@ changes sign, and is tapered to zero between TAPER_START and TAPER_END.
 Output: a text table (`write_table`) the resistance library reads (CalibratedSubgridModel,
 docs/resistance.md): for every (kind, a/Delta, ratio) the columns xi and xi * s_hat(xi) on a
 logarithmic grid from 1e-5 to xi_max (xi * s_hat is smooth at both ends: it tends to the leading
-lubrication coefficient as xi -> 0 and to 0 at xi_max; linear interpolation in ln xi).
+lubrication coefficient as xi -> 0 and to 0 at xi_max; linear interpolation in ln xi). The table also
+holds the tangential wall functions (kinds wall_YA, wall_YB, wall_YC, wall_XC) that
+wallcalibration.py measures: `--tangential` runs them, `--tangential-from-raw` takes them from an
+earlier run. Beside the table: its squeeze measurements (squeeze_calibration.json), the tangential
+ones (wall_tangential_calibration.json) and a figure of each (.png).
 
-    python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --out dem/resistance/data/squeeze_calibration.dat
+    python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --tangential --out dem/resistance/data/subgrid_calibration.dat
 """
 from __future__ import annotations
 
@@ -53,7 +57,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import squeeze, theory
+from . import squeeze, theory, wallcalibration
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
 # positions of the gap centre inside its mesh cell (fractions of Delta)
@@ -197,7 +201,7 @@ def project_relative(path: str) -> str:
     return os.path.relpath(full, root) if full.startswith(root + os.sep) else full
 
 
-def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str) -> str:
+def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str, tangential: bool = False) -> str:
     """The one command that measures and analyses these calibrations again."""
     ads = sorted({c.a_over_delta for c in calibrations})
     ratios = sorted({c.ratio for c in calibrations if c.kind == "pair"})
@@ -207,24 +211,39 @@ def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str) -> 
     words += (["--ratios"] + ["%g" % r for r in ratios]) if ratios else ["--no-pairs"]
     if not any(c.kind == "wall" for c in calibrations):
         words.append("--no-wall")
-    words += ["--boxes"] + ["%g" % L for L in c0.boxes] + ["--offsets", str(n_offsets), "--out", out]
-    return " ".join(words)
+    words += ["--boxes"] + ["%g" % L for L in c0.boxes] + ["--offsets", str(n_offsets)]
+    if tangential:
+        words.append("--tangential")
+    return " ".join(words + ["--out", out])
 
 
 def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Sequence[Dict],
-                tables: Sequence[List[tuple]], command: str) -> None:
-    """The text table CalibratedSubgridModel reads (dem/resistance/src/squeeze_calibration.cpp): per
-    calibration its fit and its rows (SqueezeCalibration.fit, .table)."""
+                tables: Sequence[List[tuple]], command: str, tangential: Sequence[Dict] = ()) -> None:
+    """The text table CalibratedSubgridModel reads (dem/resistance/src/subgrid_calibration.cpp): per
+    calibration its fit and its rows (SqueezeCalibration.fit, .table), then the tangential wall blocks
+    of the wallcalibration summaries `tangential`."""
     with open(path, "w") as f:
-        f.write("# Squeeze calibration of the fictitious-domain solver (paper Appendix B; docs/resistance.md)\n")
-        f.write("# s_hat(xi) = 1/V_th - 1/V_FDM: the squeeze resistance the sub-grid block adds, in units of\n")
-        f.write("# 6 pi eta a1 (a1 the smaller sphere). pair: X21A^SG = -6 pi a1 s_hat; wall: X^A_SG = 6 pi a s_hat.\n")
+        f.write("# Sub-grid calibration of the fictitious-domain solver (paper Appendix B; docs/resistance.md)\n")
+        f.write("# pair, wall: s_hat(xi) = 1/V_th - 1/V_FDM, the squeeze resistance the sub-grid block adds, in units\n")
+        f.write("# of 6 pi eta a1 (a1 the smaller sphere). pair: X21A^SG = -6 pi a1 s_hat; wall: X^A_SG = 6 pi a s_hat.\n")
         f.write("# Block header: kind a1/Delta a2/a1 rows r_0 r_inf xi_1 p fit_rms; then rows: xi  xi*s_hat\n")
-        f.write("# Regenerate: %s\n" % regenerate_command(calibrations, project_relative(path)))
-        if "--from-raw" in command:
-            f.write("# (this file was analysed from the measurements kept by earlier calls: --from-raw)\n")
+        f.write("# wall_YA, wall_YB, wall_YC, wall_XC (scripts/fdmsubgrid/wallcalibration.py): s_hat the sub-grid\n")
+        f.write("# function in Kim-Karrila units (6 pi a, 4 pi a^2, 8 pi a^3, 8 pi a^3; d into the wall);\n")
+        f.write("# header: kind a/Delta 1 rows f_0 eps_c p fit_rms; rows: eps  eps*s_hat\n")
+        f.write("# Regenerate: %s\n" % regenerate_command(calibrations, project_relative(path), bool(tangential)))
+        if "from-raw" in command:
+            f.write("# (this file was analysed from the measurements kept by earlier calls: --from-raw, "
+                    "--tangential-from-raw)\n")
         for c, fit, rows in zip(calibrations, fits, tables):
             write_block(f, c, fit, rows)
+        for t in tangential:
+            blocks = wallcalibration.table_blocks(t["a_over_delta"], t["fits"])
+            for name in wallcalibration.FUNCTIONS:
+                fit = t["fits"][name]
+                f.write("wall_%s %.6g 1 %d %.6g %.6g %.6g %.4g\n" % (name, t["a_over_delta"], len(blocks[name]),
+                                                                   fit["f_0"], fit["eps_c"], fit["p"], fit["rms"]))
+                for eps, v in blocks[name]:
+                    f.write("%.8e %.8e\n" % (eps, v))
 
 
 def write_block(f, c: SqueezeCalibration, fit: Dict[str, float], rows: List[tuple]) -> None:
@@ -288,7 +307,11 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p.add_argument("--workdir", default="calibration_runs")
     p.add_argument("--out", required=True, help="the table (text); its .json beside it holds every measurement")
     p.add_argument("--from-raw", metavar="RAW_JSON", nargs="+", help="analyse the measurements earlier calls "
-                   "kept (<workdir>/measurements.json) instead of running")
+                   "kept (<workdir>/measurements.json, or the .json beside a table) instead of running")
+    p.add_argument("--tangential", action="store_true", help="also measure the tangential wall functions "
+                   "(wallcalibration.py) at every --a-over-delta")
+    p.add_argument("--tangential-from-raw", metavar="JSON", help="the tangential wall measurements of an earlier "
+                   "run (wall_tangential_calibration.json beside a table, or wallcalibration --out)")
     args = p.parse_args(argv)
     if any(r < 1 for r in args.ratios):
         p.error("--ratios: a2/a1 must be >= 1 (a pair 1/1.4 is the pair 1.4 seen from the other sphere)")
@@ -296,9 +319,10 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     raw_path = os.path.join(args.workdir, "measurements.json")
     cals: List[SqueezeCalibration] = []
     if args.from_raw:
+        keys = SqueezeCalibration.__dataclass_fields__.keys()
         for path in args.from_raw:
             with open(path) as f:
-                cals += [SqueezeCalibration(**d) for d in json.load(f)]
+                cals += [SqueezeCalibration(**{k: v for k, v in d.items() if k in keys}) for d in json.load(f)]
     else:
         for ad in args.a_over_delta:
             jobs = (([] if args.no_pairs else [("pair", r) for r in args.ratios])
@@ -316,12 +340,27 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
               "correction up to xi %.3g" % (c.kind, c.a_over_delta, c.ratio, c.wall_seconds, fit["r_0"], fit["xi_1"],
                                             fit["p"], 100 * fit["rms_rel"], 100 * fit["max_rel"], s["xi_max"]),
               flush=True)
+    tangential: List[Dict] = []
+    if args.tangential_from_raw:
+        with open(args.tangential_from_raw) as f:
+            tangential = [wallcalibration.summary(wallcalibration.from_summary(d)) for d in json.load(f)]
+    elif args.tangential:
+        for ad in args.a_over_delta:
+            tangential.append(wallcalibration.summary(wallcalibration.measure(
+                ad, args.workdir, offsets=wallcalibration.OFFSETS[:args.offsets])))
+            with open(os.path.join(args.workdir, "wall_tangential.json"), "w") as f:   # kept before the table
+                json.dump(tangential, f)
     command = "python3 -m fdmsubgrid.calibration " + " ".join(argv if argv is not None else sys.argv[1:])
-    write_table(args.out, cals, fits, tables, command)
-    json_path = os.path.splitext(args.out)[0] + ".json"
+    write_table(args.out, cals, fits, tables, command, tangential)
+    if tangential:
+        t_path = os.path.join(os.path.dirname(os.path.abspath(args.out)), "wall_tangential_calibration.json")
+        with open(t_path, "w") as f:
+            json.dump(tangential, f, indent=1)
+        wallcalibration.plot(os.path.splitext(t_path)[0] + ".png", tangential)
+    json_path = os.path.join(os.path.dirname(os.path.abspath(args.out)), "squeeze_calibration.json")
     with open(json_path, "w") as f:
         json.dump(summaries, f, indent=1)
-    plot(os.path.splitext(args.out)[0] + ".png", summaries)
+    plot(os.path.splitext(json_path)[0] + ".png", summaries)
     return summaries
 
 

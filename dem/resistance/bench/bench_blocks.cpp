@@ -2,7 +2,7 @@
 // median over repeats.  Usage: fdmResistanceBench [repeats=50] [calibrated]
 // (calibrated: the squeeze calibration's model, CalibratedSubgridModel, with the shipped table)
 #include "fdm/resistance/resistance.hpp"
-#include "fdm/resistance/squeeze_calibration.hpp"
+#include "fdm/resistance/subgrid_calibration.hpp"
 
 #include <memory>
 #include <string>
@@ -69,7 +69,7 @@ int main(int argc, char** argv)
 
     std::unique_ptr<SubgridModel> owned;
     if (calibrated)
-        owned.reset(new CalibratedSubgridModel(SqueezeCalibration::read(SqueezeCalibration::defaultPath()), delta, 1.0, 1.0));
+        owned.reset(new CalibratedSubgridModel(SubgridCalibration::read(SubgridCalibration::defaultPath()), delta, 1.0, 1.0));
     else
         owned.reset(new CutoffSubgridModel(delta, 1.0));
     const SubgridModel& model = *owned;

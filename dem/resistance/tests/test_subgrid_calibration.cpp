@@ -1,8 +1,8 @@
-// The squeeze calibration (paper Appendix B; squeeze_calibration.hpp): reading the table, interpolating
+// The squeeze calibration (paper Appendix B; subgrid_calibration.hpp): reading the table, interpolating
 // it, refusing what it does not cover, the calibrated sub-grid model built on it, and the table shipped
 // in the repository against the lubrication limit of the theory.
 #include "fdm/resistance/resistance.hpp"
-#include "fdm/resistance/squeeze_calibration.hpp"
+#include "fdm/resistance/subgrid_calibration.hpp"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -48,9 +48,9 @@ std::string syntheticTable()
 
 }  // namespace
 
-TEST(SqueezeCalibration, InterpolatesTheTableAndEndsAtItsLastRow)
+TEST(SubgridCalibration, InterpolatesTheTableAndEndsAtItsLastRow)
 {
-    const SqueezeCalibration cal = SqueezeCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
+    const SubgridCalibration cal = SubgridCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
     const double delta = 1.0 / 3;
     // at the nodes: the table itself
     EXPECT_NEAR(cal.pairSHat(1, 1, delta, 1e-3) * 1e-3, 0.25 * (1 - 1e-3), 1e-12);
@@ -69,9 +69,9 @@ TEST(SqueezeCalibration, InterpolatesTheTableAndEndsAtItsLastRow)
     EXPECT_DOUBLE_EQ(cal.pairRange(1, 1, delta), 1.0);
 }
 
-TEST(SqueezeCalibration, RefusesWhatItDoesNotCover)
+TEST(SubgridCalibration, RefusesWhatItDoesNotCover)
 {
-    const SqueezeCalibration cal = SqueezeCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
+    const SubgridCalibration cal = SubgridCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
     EXPECT_TRUE(cal.coversPair(1, 1.4, 0.25));
     EXPECT_FALSE(cal.coversPair(1, 1, 0.5));   // a/Delta 2
     EXPECT_FALSE(cal.coversPair(1, 2, 0.25));  // ratio 2
@@ -86,7 +86,7 @@ TEST(SqueezeCalibration, RefusesWhatItDoesNotCover)
     }
 }
 
-TEST(SqueezeCalibration, MalformedTablesNameTheFileAndLine)
+TEST(SubgridCalibration, MalformedTablesNameTheFileAndLine)
 {
     const char* bad[] = {
         "pair 3 1 2 0 0 0 0 0\n1e-3 0.2\n",                 // one row short
@@ -98,20 +98,20 @@ TEST(SqueezeCalibration, MalformedTablesNameTheFileAndLine)
     for (const char* text : bad) {
         const std::string path = writeTable("squeeze_bad.dat", text);
         try {
-            SqueezeCalibration::read(path);
+            SubgridCalibration::read(path);
             FAIL() << "accepted: " << text;
         } catch (const std::runtime_error& e) {
             EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
         }
     }
-    EXPECT_THROW(SqueezeCalibration::read("/nonexistent/squeeze.dat"), std::runtime_error);
+    EXPECT_THROW(SubgridCalibration::read("/nonexistent/squeeze.dat"), std::runtime_error);
 }
 
 // The calibrated model changes the squeeze functions only, and keeps the block frame-invariant,
 // symmetric and positive semi-definite.
 TEST(CalibratedSubgridModel, ReplacesTheSqueezeFunctionsOnly)
 {
-    const SqueezeCalibration cal = SqueezeCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
+    const SubgridCalibration cal = SubgridCalibration::read(writeTable("squeeze_synthetic.dat", syntheticTable()));
     const double delta = 0.25;
     const CalibratedSubgridModel model(cal, delta, 0.65, 0.75);
     const CutoffSubgridModel cutoff(delta, 0.65);
@@ -149,9 +149,9 @@ TEST(CalibratedSubgridModel, ReplacesTheSqueezeFunctionsOnly)
 // correction is the theory's lubrication singularity (the solver's own resistance stays finite):
 // xi * s_hat -> 2 lambda^2/(1 + lambda)^3 for a pair (Jeffrey & Onishi's leading term of the squeeze
 // resistance in units of 6 pi eta a1), eps * s_hat -> 1 for a wall (Cox & Brenner).
-TEST(SqueezeCalibration, ShippedTableHasTheLubricationLimit)
+TEST(SubgridCalibration, ShippedTableHasTheLubricationLimit)
 {
-    const SqueezeCalibration cal = SqueezeCalibration::read(SqueezeCalibration::defaultPath());
+    const SubgridCalibration cal = SubgridCalibration::read(SubgridCalibration::defaultPath());
     for (double ad : {3.0, 4.0, 5.0}) {
         const double delta = 1 / ad;
         for (double ratio : {1.0, 1.4}) {
@@ -167,4 +167,98 @@ TEST(SqueezeCalibration, ShippedTableHasTheLubricationLimit)
     // the bidisperse suspension at a1/Delta = 3 (a2 = 1.4 a1): every pair and wall gap is covered
     EXPECT_TRUE(cal.coversPair(1.4, 1.4, 1.0 / 3));
     EXPECT_TRUE(cal.coversWall(1.4, 1.0 / 3));
+}
+
+namespace {
+
+// The synthetic table plus the tangential wall functions at a/Delta = 3 only: s_hat constant
+// (xi * s_hat = s xi) at the rows up to xi = 0.5 (the last row 0), the given values of Y^A, Y^B, Y^C,
+// X^C (Kim-Karrila units).
+std::string tableWithTangential(double yA, double yB, double yC, double xC)
+{
+    std::string text = syntheticTable();
+    const char* names[4] = {"wall_YA", "wall_YB", "wall_YC", "wall_XC"};
+    const double values[4] = {yA, yB, yC, xC};
+    for (int k = 0; k < 4; ++k) {
+        text += std::string(names[k]) + " 3 1 5 0 0 0 0 0\n";
+        for (double xi : {1e-5, 1e-2, 0.02, 0.25, 0.5}) {
+            char row[64];
+            std::snprintf(row, sizeof row, "%.10e %.10e\n", xi, values[k] * xi);
+            text += row;
+        }
+    }
+    return text;
+}
+
+Eigen::Matrix<double, 6, 6> wallMatrix(const WallBlock& block)
+{
+    Eigen::Matrix<double, 6, 6> R;
+    for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j) R(i, j) = block.R[i][j];
+    return R;
+}
+
+}  // namespace
+
+// Where the table has them, the tangential wall functions replace the cut-off model's (with Y^G, Y^H
+// following from them by Eq. D.4); elsewhere (a/Delta = 5 here) the cut-off model's stay. The range is
+// the longest of the wall functions'.
+TEST(CalibratedSubgridModel, ReplacesTheTangentialWallFunctionsWhereTabulated)
+{
+    const SubgridCalibration cal =
+        SubgridCalibration::read(writeTable("tangential_synthetic.dat", tableWithTangential(0.6, -0.15, 0.4, 0.05)));
+    EXPECT_TRUE(cal.coversWallFunction(WallTangentialYB, 1.0, 1.0 / 3));
+    EXPECT_FALSE(cal.coversWallFunction(WallTangentialYB, 1.0, 1.0 / 5));
+    const double a = 1.0, eps = 0.02;
+    const CalibratedSubgridModel model(cal, a / 3, 0.65, 0.75);
+    const WallScalars w = model.wall(a, eps);
+    EXPECT_NEAR(w.f[WallXA], 6 * pi * a * cal.wallSHat(a, a / 3, eps), 1e-12);
+    EXPECT_NEAR(w.f[WallYA], 6 * pi * 0.6, 1e-9);
+    EXPECT_NEAR(w.f[WallYB], 4 * pi * -0.15, 1e-9);
+    EXPECT_NEAR(w.f[WallYC], 8 * pi * 0.4, 1e-9);
+    EXPECT_NEAR(w.f[WallXC], 8 * pi * 0.05, 1e-9);
+    EXPECT_NEAR(w.f[WallYG], (1 + eps) * a * w.f[WallYA] + 0.5 * w.f[WallYB], 1e-12);
+    EXPECT_NEAR(w.f[WallYH], -(1 + eps) * a * w.f[WallYB] - 0.5 * w.f[WallYC], 1e-12);
+    EXPECT_EQ(model.wallClipped(), 0);
+    EXPECT_GE(model.wallRange(a), 0.5 * (1 - 1e-12));
+    // beyond the cut-off model's range the calibrated tangential functions still act
+    const WallScalars mid = model.wall(a, 0.25);
+    EXPECT_NEAR(mid.f[WallYA], 6 * pi * 0.6, 1e-9);
+
+    // a table without the tangential functions: they are the cut-off model's
+    const CalibratedSubgridModel wall3(SubgridCalibration::read(writeTable("squeeze_only3.dat", syntheticTable())), a / 3,
+                                       0.65, 0.75);
+    const CutoffSubgridModel cutoff3(a / 3, 0.75);
+    const WallScalars w3 = wall3.wall(a, eps), c3 = cutoff3.wall(a, eps);
+    for (WallFunction f : {WallYA, WallYB, WallYC, WallXC, WallYG, WallYH}) EXPECT_EQ(w3.f[f], c3.f[f]) << f;
+
+    // the block stays symmetric, positive semi-definite and frame-invariant (a wall moving with the
+    // sphere: no force)
+    WallBlock block;
+    const double x[3] = {0.2, a * (1 + eps), -0.4}, wallPoint[3] = {0, 0, 0}, normal[3] = {0, -1, 0};
+    ASSERT_TRUE(subgridWallBlock(model, x, a, wallPoint, normal, 1.0, block));
+    const Eigen::Matrix<double, 6, 6> R = wallMatrix(block);
+    EXPECT_LT((R - R.transpose()).norm(), 1e-12 * R.norm());
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6> > eig(R);
+    EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12 * R.norm());
+}
+
+// The dissipation rule for a wall: a tabulated Y^B beyond sqrt(Y^A Y^C) (or a negative Y^A, Y^C, X^C)
+// is clipped so that the block stays positive semi-definite, and counted.
+TEST(CalibratedSubgridModel, WallDissipationRuleClipsAndCounts)
+{
+    const SubgridCalibration cal =
+        SubgridCalibration::read(writeTable("tangential_clip.dat", tableWithTangential(0.3, -1.5, 0.4, -0.02)));
+    const double a = 1.0;
+    const CalibratedSubgridModel model(cal, a / 3, 0.65, 0.75);
+    const WallScalars w = model.wall(a, 0.05);
+    EXPECT_EQ(model.wallClipped(), 1);
+    EXPECT_EQ(w.f[WallXC], 0.0);
+    EXPECT_NEAR(std::fabs(w.f[WallYB]), std::sqrt(w.f[WallYA] * w.f[WallYC]), 1e-12);
+    EXPECT_LT(w.f[WallYB], 0);  // the sign is kept
+    WallBlock block;
+    const double x[3] = {0, a * 1.05, 0}, wallPoint[3] = {0, 0, 0}, normal[3] = {0, -1, 0};
+    ASSERT_TRUE(subgridWallBlock(model, x, a, wallPoint, normal, 1.0, block));
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6> > eig(wallMatrix(block));
+    EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-10 * wallMatrix(block).norm());
 }
