@@ -161,10 +161,7 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
         return (x0 + o[0] * delta, H / 2, z0 + o[1] * delta)
 
     runs = ["fix             output all fdm/output records 1 particles.records"]
-    for k, o in enumerate(offsets):
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % centre(o))
-        runs.append("run             1")
+    runs += case.held_step_runs([[centre(o)] for o in offsets])
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [centre(offsets[0]) + (a,)], dt=0.01,
                          fix_options="move no stresslets yes", runs=runs,
                          # both no-slip walls at the fluid case's velocities (the pair style checks they agree

@@ -246,11 +246,7 @@ def run_configurations(run_dir: str, scene: Scene, configurations: Sequence[np.n
                           acceleration=options.acceleration)
     case.write_initial_velocity(fluid, scene.box, lambda c: np.column_stack(
         [scene.discrete_profile(c[:, 1]), np.zeros(len(c)), np.zeros(len(c))]))
-    runs = []
-    for k, x in enumerate(configurations):
-        if k > 0:
-            runs += ["set             atom %d x %r y %r z %r" % (i + 1, *map(float, x[i])) for i in range(n)]
-        runs.append("run             1")
+    runs = case.held_step_runs(configurations)
     spheres = [tuple(map(float, p)) + (A,) for p in configurations[0]]
     case.write_dem_input(os.path.join(run_dir, "dem"), scene.box, spheres, dt=1.0, fix_options="move no",
                          pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid,

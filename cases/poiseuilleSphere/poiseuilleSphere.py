@@ -337,11 +337,7 @@ def run_channel(workdir: str, scene: Scene, d_list: Sequence[float], offsets: Se
     # the far field starts converged: the solver's own undisturbed profile (Scene.discrete_profile)
     case.write_initial_velocity(fluid, scene.box, lambda c: np.column_stack(
         [scene.discrete_profile(c[:, 1]), np.zeros(len(c)), np.zeros(len(c))]))
-    runs = []
-    for k, (d, o) in enumerate(configurations):
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % scene.centre(d, o))
-        runs.append("run             1")
+    runs = case.held_step_runs([[scene.centre(d, o)] for d, o in configurations])
     first = scene.centre(*configurations[0])
     case.write_dem_input(os.path.join(run_dir, "dem"), scene.box, [first + (scene.radius,)], dt=1.0,
                          fix_options="move no stresslets yes",

@@ -154,11 +154,7 @@ def _write_and_run(run_dir: str, box: case.Box, configurations: list[np.ndarray]
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, tol_lambda=options.tol_lambda,
                           n_max=options.n_max, first_step=(options.tol_lambda / 10, 4 * options.n_max),
                           n_particles=n, acceleration=options.acceleration)
-    runs = []
-    for k, x in enumerate(configurations):
-        if k > 0:
-            runs += ["set             atom %d x %r y %r z %r" % (i + 1, *map(float, x[i])) for i in range(n)]
-        runs.append("run             1")
+    runs = case.held_step_runs(configurations)
     spheres = [tuple(map(float, p)) + (RADIUS,) for p in configurations[0]]
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=1.0,
                          pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))),

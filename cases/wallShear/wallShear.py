@@ -173,11 +173,7 @@ def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool,
     # the undisturbed flow: the far field starts converged, the inner iterations build the sphere's disturbance
     case.write_initial_velocity(fluid, box, lambda c: np.column_stack(
         [SHEAR_RATE * c[:, 1], np.zeros(len(c)), np.zeros(len(c))]))
-    runs = []
-    for k, p in enumerate(positions):
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % p)
-        runs.append("run             1")
+    runs = case.held_step_runs([[p] for p in positions])
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [positions[0] + (radius,)], dt=1.0,
                          fix_options="move no stresslets yes",
                          # the walls as in the fluid case: y = 0 at rest, y = L_y at gamma_dot L_y along x

@@ -296,6 +296,19 @@ def subgrid_pair_style(walls=(), subgrid=True, model=None, cutoff=None, wall_cut
     return " ".join(words)
 
 
+def held_step_runs(configurations) -> list:
+    """The LIGGGHTS lines that hold the particles at each configuration in turn for one coupled step
+    (`fix fdm/couple ... move no`): configurations[k] lists each particle's centre (x, y, z) in tag
+    order; the first is the data file's, so only the later ones are set. One `run 1` per configuration,
+    each warm-started by the solver from the previous one."""
+    runs = []
+    for k, centres in enumerate(configurations):
+        if k > 0:
+            runs += ["set             atom %d x %r y %r z %r" % (i + 1, *map(float, c)) for i, c in enumerate(centres)]
+        runs.append("run             1")
+    return runs
+
+
 def halton_points(n: int, dims: int) -> np.ndarray:
     """The first n points of the Halton sequence in [0, 1)^dims (bases 2, 3, 5, ...; unscrambled, the
     origin left out): positions spread evenly over a mesh cell for any count, the cases' --positions."""

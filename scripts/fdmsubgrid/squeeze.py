@@ -90,13 +90,7 @@ def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_
 
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
                           n_particles=2)
-    runs = []
-    for k, xi in enumerate(xis):
-        p1, p2 = positions(xi)
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % p1)
-            runs.append("set             atom 2 x %r y %r z %r" % p2)
-        runs.append("run             1")
+    runs = case.held_step_runs([positions(xi) for xi in xis])
     p1, p2 = positions(xis[0])
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0,
                          pair_style=_pair_style(subgrid, cutoff, pair_options),
@@ -131,11 +125,7 @@ def run_wall(workdir: str, epss: Sequence[float], subgrid: bool, a_over_delta: f
 
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
                           n_particles=1)
-    runs = []
-    for k, eps in enumerate(epss):
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % position(eps))
-        runs.append("run             1")
+    runs = case.held_step_runs([[position(eps)] for eps in epss])
     pair = _pair_style(subgrid, cutoff, ("wall ylo 0 0 0 wall yhi 0 0 0 " + pair_options).strip())
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
                          before_run="fix             push all addforce 0 %r 0" % (-F), runs=runs,

@@ -115,11 +115,7 @@ def run_loaded_sphere(workdir: str, epss: Sequence[float], a_over_delta: float, 
 
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
                           n_particles=1)
-    runs = []
-    for k, eps in enumerate(epss):
-        if k > 0:
-            runs.append("set             atom 1 x %r y %r z %r" % position(eps))
-        runs.append("run             1")
+    runs = case.held_step_runs([[position(eps)] for eps in epss])
     pair = case.subgrid_pair_style(walls=(("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid=False)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
                          before_run="fix             push all addforce %r 0 0\n"
