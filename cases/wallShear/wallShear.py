@@ -20,10 +20,12 @@ sphere from the exact wall resistance functions (bipolar-coordinate tables) and 
 (1967) fixed sphere in shear, S* from Sangani et al.'s (2011) fit, paper Eq. (46).
 
 The sub-grid wall correction (pair_style fdm/subgrid with both walls declared, Eq. D.6) is on; by default
-every scene is also run with it off (lubrication no), to show what it does: issue 14, the cut-off model
-over-corrects the tangential wall functions: measured at a1/Delta = 3, the free sphere is 11-17 % too slow
-for eps 0.001-0.1 with the correction; without it U is within 3 % at eps = 0.1 (Omega 17 % too fast) and
-stops decreasing below eps ~ 0.03 (the mesh does not resolve the gap).
+every scene is also run with it off (lubrication no), to show what it does. The cut-off model (the pair
+style's default) over-corrects the tangential wall functions: measured at a1/Delta = 3, the free sphere is
+11-17 % too slow for eps 0.001-0.1 with the correction; without it U is within 3 % at eps = 0.1 (Omega 17 %
+too fast) and stops decreasing below eps ~ 0.03 (the mesh does not resolve the gap). With `--model
+calibrated` (the tangential wall functions measured with the solver, a1/Delta 3 and 4: docs/resistance.md)
+U is within -2.3 ... +0.6 % at eps 1e-3 ... 0.54; Omega stays 6-15 % off (docs/validation.md).
 
 Offsets: the three quantities are unchanged by the mirror z -> -z and by x -> -x with the flow reversed
 (Stokes flow is linear: mirror, then reverse every velocity; the walls are back, U_x, Omega_z and S_xy
