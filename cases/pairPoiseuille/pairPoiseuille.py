@@ -78,7 +78,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output  # noqa: E402
+from fdmsubgrid import case  # noqa: E402
 
 ETA = 1.0                         # Pa s
 U_C = 1.0                         # m/s, centre-line velocity of Eq. (47)
@@ -254,12 +254,8 @@ def run_configurations(run_dir: str, scene: Scene, configurations: Sequence[np.n
                          before_run="fix             output all fdm/output records 1 particles.records",
                          runs=runs, name="in.pairPoiseuille")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
-    rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"), mmap=False)
-    steps = output.steps(fluid)
     m = len(configurations)
-    if len(rec) < m or len(steps["step"]) < m:
-        raise RuntimeError("pairPoiseuille: %s recorded %d particle blocks and %d fluid steps for %d configurations"
-                           % (run_dir, len(rec), len(steps["step"]), m))
+    rec, steps = case.read_held_steps(run_dir, m, "pairPoiseuille")
     x = np.asarray(rec["x"][-m:], dtype=float)
     want = np.array([np.asarray(c, dtype=float) for c in configurations])
     # positions are wrapped into the box by LIGGGHTS: compare modulo the periods

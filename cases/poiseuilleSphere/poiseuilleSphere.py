@@ -83,7 +83,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output  # noqa: E402
+from fdmsubgrid import case  # noqa: E402
 
 ETA = 1.0                         # Pa s
 U_C = 1.0                         # m/s, centre-line velocity of the undisturbed flow (Eq. 47)
@@ -346,13 +346,8 @@ def run_channel(workdir: str, scene: Scene, d_list: Sequence[float], offsets: Se
                          before_run="fix             output all fdm/output records 1 particles.records",
                          runs=runs, name="in.poiseuilleSphere")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
-    rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"), mmap=False)
-    steps = output.steps(fluid)
     n = len(configurations)
-    if len(rec) < n or len(steps["step"]) < n:
-        raise RuntimeError("poiseuilleSphere: %s recorded %d particle blocks and %d fluid steps for %d "
-                           "configurations" % (run_dir, len(rec), len(steps["step"]), n))
-    # the last n blocks are the n steps (a block at step 0, if written, holds no solution)
+    rec, steps = case.read_held_steps(run_dir, n, "poiseuilleSphere")
     u = np.asarray(rec["U"][-n:, 0], dtype=float)
     w = np.asarray(rec["omega"][-n:, 0], dtype=float)
     s_xy = np.asarray(rec["S_fluid"][-n:, 0, 1] + rec["S_subgrid"][-n:, 0, 1], dtype=float)

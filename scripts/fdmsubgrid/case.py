@@ -309,6 +309,20 @@ def held_step_runs(configurations) -> list:
     return runs
 
 
+def read_held_steps(run_dir: str, n: int, who: str):
+    """The particle records (dem/particles.records, `fix fdm/output records 1`) and fdmFoam's step records of
+    a run of n held configurations (held_step_runs), checked to hold at least n steps; the last n blocks are
+    the n steps (a block at step 0, if written, holds no solution). Returns (records, steps); a run that
+    recorded fewer is a RuntimeError naming `who` and the folder."""
+    from . import output
+    records = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"), mmap=False)
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    if len(records) < n or len(steps["step"]) < n:
+        raise RuntimeError("%s: %s recorded %d particle blocks and %d fluid steps for %d configurations"
+                           % (who, run_dir, len(records), len(steps["step"]), n))
+    return records, steps
+
+
 def halton_points(n: int, dims: int) -> np.ndarray:
     """The first n points of the Halton sequence in [0, 1)^dims (bases 2, 3, 5, ...; unscrambled, the
     origin left out): positions spread evenly over a mesh cell for any count, the cases' --positions."""
