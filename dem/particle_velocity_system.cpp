@@ -216,12 +216,14 @@ void ParticleVelocitySystem::setVolumes(const std::vector<RigidVolume> &volumes)
     bool finite = std::isfinite(v.Vu);
     for (int k = 0; k < 3; k++) finite = finite && std::isfinite(v.m1[k]);
     for (int k = 0; k < 6; k++) finite = finite && std::isfinite(v.J[k]);
-    const std::string values = "Vu " + number(v.Vu) + ", m1 " + point(v.m1) + ", J " + number(v.J[0]) + " " +
-                               number(v.J[1]) + " " + number(v.J[2]) + " " + number(v.J[3]) + " " + number(v.J[4]) +
-                               " " + number(v.J[5]);
+    // the values for a message (built only when a check fails: this runs for every particle every step)
+    auto values = [&v]() {
+      return "Vu " + number(v.Vu) + ", m1 " + point(v.m1) + ", J " + number(v.J[0]) + " " + number(v.J[1]) + " " +
+             number(v.J[2]) + " " + number(v.J[3]) + " " + number(v.J[4]) + " " + number(v.J[5]);
+    };
     if (!finite)
       throw Error(Error::fluidValue, p, "the fluid solver sent a non-finite volume for particle " + particleId(p) +
-                                        " at " + point(q.x) + " (" + values + ")");
+                                        " at " + point(q.x) + " (" + values() + ")");
     // r x (Omega x r) summed: J = [[xx xy xz], [xy yy yz], [xz yz zz]] of the record
     const double J[3][3] = {{v.J[0], v.J[1], v.J[2]}, {v.J[1], v.J[3], v.J[4]}, {v.J[2], v.J[4], v.J[5]}};
     // [m1]x w = m1 x w
@@ -238,7 +240,7 @@ void ParticleVelocitySystem::setVolumes(const std::vector<RigidVolume> &volumes)
     if (!(v.Vu > 0) || Eigen::LLT<Eigen::Matrix<double, 6, 6> >(B).info() != Eigen::Success)
       throw Error(Error::noVolume, p, "particle " + particleId(p) + " at " + point(q.x) + " with radius " +
                                       number(q.radius) + ": the fluid's indicator function gives it no volume (" +
-                                      values + ")");
+                                      values() + ")");
     for (int i = 0; i < 6; i++)
       for (int j = 0; j < 6; j++) blocks[size_t(36) * p + 6 * i + j] = scale * B(i, j);
   }

@@ -242,12 +242,13 @@ bool SubgridCalibration::coversWallFunction(CalibratedFunction f, double a, doub
     return stencil(f, a / delta, 1.0).covered;
 }
 
-double SubgridCalibration::wallFunctionSHat(CalibratedFunction f, double a, double delta, double eps) const
+bool SubgridCalibration::wallFunctionSHat(CalibratedFunction f, double a, double delta, double eps, double& sHat) const
 {
     const Stencil& st = stencil(f, a / delta, 1.0);
-    double s = 0;
-    for (int k = 0; k < st.n; ++k) s += st.weight[k] * st.block[k]->sHat(eps);
-    return s;
+    if (!st.covered) return false;
+    sHat = 0;
+    for (int k = 0; k < st.n; ++k) sHat += st.weight[k] * st.block[k]->sHat(eps);
+    return true;
 }
 
 std::string SubgridCalibration::coverage() const
@@ -313,11 +314,13 @@ WallScalars CalibratedSubgridModel::wall(double a, double eps) const
                       {WallTangentialYC, WallYC, 8 * pi * a * a * a},
                       {WallTangentialXC, WallXC, 8 * pi * a * a * a}};
     bool any = false;
-    for (const auto& t : tangential)
-        if (calibration_.coversWallFunction(t.table, a, meshSize_)) {
-            w.f[t.function] = t.scale * calibration_.wallFunctionSHat(t.table, a, meshSize_, e);
+    for (const auto& t : tangential) {
+        double s;
+        if (calibration_.wallFunctionSHat(t.table, a, meshSize_, e, s)) {
+            w.f[t.function] = t.scale * s;
             any = true;
         }
+    }
     if (!any) return w;
     // dissipation rule: the block [[Y^A, -Y^B], [-Y^B, Y^C]] and X^C positive semi-definite
     bool clipped = false;

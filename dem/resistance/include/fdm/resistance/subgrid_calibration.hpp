@@ -67,8 +67,8 @@ public:
     double wallSHat(double a, double delta, double eps) const;
     bool coversPair(double a1, double a2, double delta) const;
     bool coversWall(double a, double delta) const;
-    // a tangential wall function (WallTangentialYA ... XC): s_hat, 0 where the table lacks it
-    double wallFunctionSHat(CalibratedFunction f, double a, double delta, double eps) const;
+    // a tangential wall function (WallTangentialYA ... XC): false where the table lacks it, else s_hat
+    bool wallFunctionSHat(CalibratedFunction f, double a, double delta, double eps, double& sHat) const;
     bool coversWallFunction(CalibratedFunction f, double a, double delta) const;
     double pairRange(double a1, double a2, double delta) const;  // largest xi with a correction
     double wallRange(double a, double delta) const;             // over every wall function covered
