@@ -104,6 +104,32 @@ def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_
     return _result((U1 - U2) / (F / (6 * math.pi * eta * a1)), wall, box, steps)
 
 
+def run_wall_scene(run_dir: str, epss: Sequence[float], a_over_delta: float, L_over_a: float, H_over_a: float,
+                   offset_xz: Sequence[float], tol_lambda: float, pair_style: str, loads: str, name: str,
+                   np_fluid: int = 1, keep: bool = False):
+    """The scene of the wall runs: one sphere (a = 1, eta = 1) above the wall y = 0 of a channel L x H x L
+    (walls at rest at y = 0 and H, periodic x and z), its centre at x, z = L/2 + offset_xz Delta, held at
+    each gap eps = h/a - 1 of `epss` for one coupled step (largest first), driven by the LIGGGHTS lines
+    `loads` (fix addforce, fix fdm/torque), in run_dir (emptied first). Returns (wall seconds, particles,
+    steps) of case.run_and_read and the box."""
+    a = 1.0
+    delta = a / a_over_delta
+    L, H = L_over_a * a, H_over_a * a
+    _fresh_run_dir(os.path.dirname(run_dir), os.path.basename(run_dir))
+    box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
+    x, z = L / 2 + offset_xz[0] * delta, L / 2 + offset_xz[1] * delta
+
+    def position(eps: float):
+        return (x, a * (1 + eps), z)
+
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+                          n_particles=1)
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair_style,
+                         before_run=loads, runs=case.held_step_runs([[position(eps)] for eps in epss]), name=name)
+    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    return wall, parts, steps, box
+
+
 def run_wall(workdir: str, epss: Sequence[float], subgrid: bool, a_over_delta: float = 4.0, L_over_a: float = 8.0,
              H_over_a: float = 16.0, tol_lambda: float = 1e-5, cutoff: float | None = None, np_fluid: int = 1,
              keep: bool = False, offset: Sequence[float] = DEFAULT_OFFSET, pair_options: str = "") -> dict:
@@ -111,27 +137,13 @@ def run_wall(workdir: str, epss: Sequence[float], subgrid: bool, a_over_delta: f
     (side L_over_a), pushed toward y = 0 by F = 6 pi eta a at eps = h/a - 1 (largest first).
     `offset`: the centre's x and z inside its mesh cell (fractions of Delta; the y entry is unused:
     the gap sets y). Returns dict(velocity=[velocity toward the wall / (F/(6 pi eta a))], ...)."""
-    a = 1.0
-    delta = a / a_over_delta
-    L, H = L_over_a * a, H_over_a * a
-    eta = 1.0
-    F = 6 * math.pi * eta * a
-    run_dir = _fresh_run_dir(workdir, "ad%g_L%g_H%g_%s" % (a_over_delta, L_over_a, H_over_a, _tag(subgrid, offset)))
-    box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
-    x, z = L / 2 + offset[0] * delta, L / 2 + offset[2] * delta
-
-    def position(eps: float):
-        return (x, a * (1 + eps), z)
-
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
-                          n_particles=1)
-    runs = case.held_step_runs([[position(eps)] for eps in epss])
+    F = 6 * math.pi     # eta = a = 1
+    run_dir = os.path.join(workdir, "ad%g_L%g_H%g_%s" % (a_over_delta, L_over_a, H_over_a, _tag(subgrid, offset)))
     pair = _pair_style(subgrid, cutoff, ("wall ylo 0 0 0 wall yhi 0 0 0 " + pair_options).strip())
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
-                         before_run="fix             push all addforce 0 %r 0" % (-F), runs=runs,
-                         name="in.wallSqueeze")
-    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
-    return _result(-parts["Uy"] / (F / (6 * math.pi * eta * a)), wall, box, steps)
+    wall, parts, steps, box = run_wall_scene(run_dir, epss, a_over_delta, L_over_a, H_over_a, (offset[0], offset[2]),
+                                             tol_lambda, pair, "fix             push all addforce 0 %r 0" % (-F),
+                                             "in.wallSqueeze", np_fluid, keep)
+    return _result(-parts["Uy"] / (F / (6 * math.pi)), wall, box, steps)
 
 
 def extrapolate_box(v1: np.ndarray, v2: np.ndarray, L1: float, L2: float) -> np.ndarray:

@@ -66,14 +66,13 @@ import functools
 import json
 import math
 import os
-import shutil
 import time
 from dataclasses import dataclass, field
 from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import case, theory
+from . import case, squeeze, theory
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
 # (x, z) of the sphere's centre inside its mesh cell, fractions of Delta
@@ -94,10 +93,7 @@ def run_loaded_sphere(workdir: str, epss: Sequence[float], a_over_delta: float, 
     dict(U=[[Ux, Uy, Uz] per gap], W=[[Wx, Wy, Wz] per gap], wall_seconds, cells, inner_iterations,
     converged). The result is kept as <run folder>.json: a later call with the same scene and gaps reads it
     instead of running again (a killed calibration resumes where it stopped)."""
-    a, eta = 1.0, 1.0
-    delta = a / a_over_delta
-    L, H = L_over_a * a, H_over_a * a
-    force, torque = 6 * math.pi * eta * a, 8 * math.pi * eta * a ** 3
+    force, torque = 6 * math.pi, 8 * math.pi     # eta = a = 1
     run_dir = os.path.join(workdir, "ad%g_L%g_H%g_off%g_%g" % (a_over_delta, L_over_a, H_over_a, *offset))
     kept = run_dir + ".json"
     if os.path.isfile(kept):
@@ -105,23 +101,11 @@ def run_loaded_sphere(workdir: str, epss: Sequence[float], a_over_delta: float, 
             result = json.load(f)
         if result.get("gaps") == [float(e) for e in epss] and result.get("tol_lambda") == tol_lambda:
             return result
-    if os.path.isdir(run_dir):
-        shutil.rmtree(run_dir)
-    box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
-    x, z = L / 2 + offset[0] * delta, L / 2 + offset[1] * delta
-
-    def position(eps: float):
-        return (x, a * (1 + eps), z)
-
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
-                          n_particles=1)
-    runs = case.held_step_runs([[position(eps)] for eps in epss])
     pair = case.subgrid_pair_style(walls=(("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid=False)
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair,
-                         before_run="fix             push all addforce %r 0 0\n"
-                                    "fix             turn all fdm/torque %r %r 0" % (force, torque, torque),
-                         runs=runs, name="in.wallTangential")
-    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    wall, parts, steps, box = squeeze.run_wall_scene(
+        run_dir, epss, a_over_delta, L_over_a, H_over_a, offset, tol_lambda, pair,
+        "fix             push all addforce %r 0 0\n"
+        "fix             turn all fdm/torque %r %r 0" % (force, torque, torque), "in.wallTangential", np_fluid, keep)
     U = np.column_stack([parts["Ux"], parts["Uy"], parts["Uz"]])
     W = np.column_stack([parts["Wx"], parts["Wy"], parts["Wz"]])
     result = dict(U=U.tolist(), W=W.tolist(), wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
