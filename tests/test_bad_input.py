@@ -188,7 +188,7 @@ def fluid_alone(root, env):
     ("constant/fdmProperties", "gradP0  ", "gradPO  ", "gradPO", "indicator alphaLambda pseudoTimeFactor"),
     ("indicator", "{ b ", "{ bb ", "bb", "b c"),
     ("innerIterations", "tolLambda   ", "tolLamda   ", "tolLamda",
-     "tolLambda tolVelocity nMax nMin firstStep acceleration depth meanFlowCorrection report"),
+     "tolLambda tolVelocity nMax nMin firstStep acceleration depth meanFlowCorrection meanFlowDamping report"),
     ("innerIterations/firstStep", "innerIterations\n{", "innerIterations\n{\n    firstStep { nmax 10; }", "nmax",
      "tolLambda tolVelocity nMax"),
     ("output", "coupling\n{", "output { particleEvery 2; }\ncoupling\n{", "particleEvery", "particlesEvery"),

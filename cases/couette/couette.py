@@ -91,14 +91,15 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
 
 def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
                strain: float, dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50,
-               write_every: int = 100000, text_dump: bool = False, model: str = "cutoff") -> dict:
+               write_every: int = 100000, text_dump: bool = False, model: str = "cutoff",
+               fluid_options: dict | None = None) -> dict:
     """fluid/ and dem/ of the run (suspension.write_case with the walls at -U and +U); returns the
-    scene's description."""
+    scene's description. fluid_options: more arguments of case.write_fluid_case."""
     U = SHEAR_RATE * float(pack.box[1]) / 2
     steps = int(round(strain / (SHEAR_RATE * dt)))
     scene = suspension.write_case(run_dir, pack, springs, a_over_delta, dt, steps, dump_every, tol_lambda,
                                   acceleration, n_max, write_every, text_dump, model, wall_velocities=(-U, U),
-                                  name="in.couette")
+                                  name="in.couette", fluid_options=fluid_options)
     scene.update(wall_velocity=U)
     return scene
 

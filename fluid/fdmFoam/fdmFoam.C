@@ -98,7 +98,10 @@ int main(int argc, char *argv[])
         gradP0.value()
     );
 
-    meanFlowCorrection meanFlow(grid, U, nu.value(), correctMeanFlow);
+    meanFlowCorrection meanFlow
+    (
+        grid, U, nu.value(), correctMeanFlow, meanFlowDamping
+    );
     Info<< meanFlow.description().c_str() << endl;
 
     #include "createOutput.H"
@@ -161,6 +164,7 @@ int main(int argc, char *argv[])
         // Step 2
         forcing.truncateLambda(lambda);
         forcing.pseudoTimeCoefficient(rDTau, rDTauInside, rDTauOutside);
+        meanFlow.setForcedCells(forcing.covered());
         stepParticleTime += wallClock() - stepStart;
 
         const bool firstStep = (stepsBefore + nStepsDone == 0);
@@ -177,8 +181,8 @@ int main(int argc, char *argv[])
             radii[pi] = stepParticles[pi].radius;
         }
 
-        label innerIteration = 0;
-        scalar residual = GREAT, bestResidual = GREAT;
+        label innerIteration = 0, iterationsAboveOne = 0;
+        scalar residual = GREAT, bestResidual = GREAT, lambdaNormAboveOne = 0;
         bool converged = false;
         List<scalar> integrals, velocities;
         scalarField state;
@@ -229,6 +233,40 @@ int main(int argc, char *argv[])
                 );
             }
             bestResidual = min(bestResidual, residual);
+            // A residual above 1 changes lambda by more than lambda itself:
+            // kept for 20 iterations while lambda grows a thousandfold, the
+            // iteration diverges geometrically although the relative
+            // residual stays bounded
+            if (residual < 1)
+            {
+                iterationsAboveOne = 0;
+            }
+            else if (iterationsAboveOne++ == 0)
+            {
+                lambdaNormAboveOne = forcing.lambdaNorm();
+            }
+            if
+            (
+                iterationsAboveOne >= 20
+             && forcing.lambdaNorm() > 1e3*lambdaNormAboveOne
+            )
+            {
+                coupling.fatal
+                (
+                    "the lambda iteration is diverging at time step "
+                  + name(coupling.step()) + ": the lambda residual has"
+                    " stayed above 1 for " + name(iterationsAboveOne)
+                  + " inner iterations (now " + name(residual)
+                  + " at inner iteration " + name(innerIteration)
+                  + ") while |lambda| grew by "
+                  + name(forcing.lambdaNorm()/max(lambdaNormAboveOne, VSMALL))
+                  + "."
+                    " Use the Anderson acceleration (innerIterations {"
+                    " acceleration anderson; }), keep meanFlowDamping"
+                    " above 0, or try a smaller pseudoTimeFactor in"
+                    " constant/fdmProperties"
+                );
+            }
             if (innerIteration > 20 && residual > 1e4*bestResidual)
             {
                 coupling.fatal

@@ -2,7 +2,8 @@
 // plane-averaged steady Stokes equation of a channel on the finite-volume stencil fdmFoam uses.
 // Checked against profiles with closed forms: Couette flow (linear, exact on the stencil at any
 // n), plane Poiseuille flow (second-order convergence to the parabola, and the exact
-// discrete flow rate), and the stencil itself (the residual of every row, including the walls).
+// discrete flow rate), and the stencil itself (the residual of every row, including the walls),
+// with and without the damping viscosity of meanFlowCorrection.H.
 #include "channelProfile.H"
 
 #include <gtest/gtest.h>
@@ -70,8 +71,50 @@ TEST(ChannelProfile, PoiseuilleFlowConvergesAtSecondOrder) {
   EXPECT_LT(previous, 1e-3 * G * H * H / (8 * nu));
 }
 
+TEST(ChannelProfile, DampingLeavesTheSteadyProfileUnchanged) {
+  // When the profile it relaxes towards is already the steady one, the damping viscosity nuP
+  // cancels: the answer is the undamped profile, whatever nuP (here uneven, zero at a wall)
+  const int n = 30;
+  const double nu = 0.4, delta = 0.2, low = -1.0, high = 2.5;
+  std::vector<double> s(n), nuP(n + 1);
+  for (int j = 0; j < n; j++) s[j] = std::cos(0.7 * j) - 0.1 * j;
+  for (int f = 0; f <= n; f++) nuP[f] = f == 0 ? 0.0 : 3.0 + 2.0 * std::sin(0.9 * f);
+  const auto steady = fdm::channel::solveProfile(s, nu, delta, low, high);
+  const auto damped = fdm::channel::solveProfile(s, nu, delta, low, high, nuP, steady);
+  for (int j = 0; j < n; j++) EXPECT_NEAR(damped[j], steady[j], 1e-12 * (1 + std::fabs(steady[j]))) << j;
+}
+
+TEST(ChannelProfile, EveryRowOfTheDampedStencilHolds) {
+  // -d/dy((nu + nuP) du/dy) = s - d/dy(nuP dv/dy) row by row, v a profile far from the answer,
+  // with the face coefficients doubled at the walls (half a cell from the first and last centres)
+  const int n = 17;
+  const double nu = 0.7, delta = 0.13, low = 0.4, high = -1.1;
+  std::vector<double> s(n), nuP(n + 1), v(n);
+  for (int j = 0; j < n; j++) {
+    s[j] = std::sin(1.3 * j) + 0.2 * j;
+    v[j] = 5.0 * std::cos(0.4 * j);
+  }
+  for (int f = 0; f <= n; f++) nuP[f] = 1.0 + 0.5 * f;
+  const auto u = fdm::channel::solveProfile(s, nu, delta, low, high, nuP, v);
+  // the flux of w through face f (upwards) with viscosity mu_f, walls at their velocities
+  auto flux = [&](const std::vector<double> &w, int f, double mu) {
+    const double below = f == 0 ? low : w[f - 1], above = f == n ? high : w[f];
+    return mu * (above - below) / (f == 0 || f == n ? delta / 2 : delta);
+  };
+  for (int j = 0; j < n; j++) {
+    const double lhs = -(flux(u, j + 1, nu + nuP[j + 1]) - flux(u, j, nu + nuP[j])) / delta;
+    const double rhs = s[j] - (flux(v, j + 1, nuP[j + 1]) - flux(v, j, nuP[j])) / delta;
+    EXPECT_NEAR(lhs, rhs, 1e-9 * (1 + std::fabs(rhs))) << "row " << j;
+  }
+}
+
 TEST(ChannelProfile, BadInputIsRefused) {
   EXPECT_THROW(fdm::channel::solveProfile({}, 1.0, 1.0, 0, 0), std::invalid_argument);
   EXPECT_THROW(fdm::channel::solveProfile({1.0}, 0.0, 1.0, 0, 0), std::invalid_argument);
   EXPECT_THROW(fdm::channel::solveProfile({1.0}, 1.0, -1.0, 0, 0), std::invalid_argument);
+  // the damping viscosity needs a value per face (n + 1) and the profile one per cell
+  EXPECT_THROW(fdm::channel::solveProfile({1.0, 2.0}, 1.0, 1.0, 0, 0, {1.0, 1.0}, {0.0, 0.0}),
+               std::invalid_argument);
+  EXPECT_THROW(fdm::channel::solveProfile({1.0, 2.0}, 1.0, 1.0, 0, 0, {1.0, 1.0, 1.0}, {0.0}),
+               std::invalid_argument);
 }

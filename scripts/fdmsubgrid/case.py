@@ -83,12 +83,12 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
                      tol_lambda=1e-4, n_max=500, n_min=1, first_step=None, tol_u=1e-6, tol_p=5e-6,
                      pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
                      n_correctors=2, extra_fdm="", acceleration="anderson", tol_velocity=0.0,
-                     mean_flow_correction=True):
+                     mean_flow_correction=True, mean_flow_damping=None):
     """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/). acceleration: the inner
     iteration's, "anderson" (default) or "none" (the plain iteration of paper 4.3); tol_velocity: the
     innerIterations tolVelocity (0 = not checked, the first step included); mean_flow_correction: the
-    exact plane-averaged profile of a channel at every inner iteration (a no-op in other boxes),
-    docs/fluid.md."""
+    exact plane-averaged profile of a channel at every inner iteration (a no-op in other boxes);
+    mean_flow_damping: its meanFlowDamping (None: fdmFoam's default, 10), docs/fluid.md."""
     x0, y0, z0 = box.lo
     x1, y1, z1 = box.hi
     names = ("x", "y", "z")
@@ -201,7 +201,7 @@ innerIterations
     nMin        %(nmin)d;
     nMax        %(nmax)d;%(first)s
     acceleration %(accel)s;
-    meanFlowCorrection %(meanflow)s;
+    meanFlowCorrection %(meanflow)s;%(damping)s
 }
 coupling
 {
@@ -217,7 +217,8 @@ coupling
            ptfo=pseudo_time_factor if pseudo_time_factor_outside is None else pseudo_time_factor_outside,
            np=n_particles, tol=tol_lambda, nmin=n_min, nmax=n_max, first=first, extra=extra_fdm,
            accel=acceleration, tolv=tol_velocity,
-           meanflow="yes" if mean_flow_correction else "no"))
+           meanflow="yes" if mean_flow_correction else "no",
+           damping="" if mean_flow_damping is None else "\n    meanFlowDamping %.17g;" % mean_flow_damping))
 
     foam_file(os.path.join(case_dir, "0/U"), "volVectorField", """
 dimensions      [0 1 -1 0 0 0 0];

@@ -82,21 +82,25 @@ def choose_springs(stress: float, dt: float, delta: float, kn: float | None = No
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, steps: int,
                dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
                text_dump: bool = False, model: str = "cutoff", wall_velocities: tuple[float, float] = (0.0, 0.0),
-               grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension") -> dict:
+               grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension",
+               fluid_options: dict | None = None) -> dict:
     """fluid/ and dem/ of the run; returns the scene's description. wall_velocities: the x velocities of
     the walls y = 0 and y = L_y; grad_p0: the uniform pressure gradient (Eq. 58) [Pa/m]. model:
     pair_style fdm/subgrid's sub-grid model (cutoff, or calibrated: the squeeze calibration,
     docs/dem.md). The particles are recorded every dump_every steps in dem/particles.records (fix
     fdm/output), and written for ParaView with the fluid fields every write_every steps
     (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also the LIGGGHTS text dump
-    dem/particles.dump of the same steps (for comparisons)."""
+    dem/particles.dump of the same steps (for comparisons). fluid_options: more (or other) arguments
+    of case.write_fluid_case, e.g. first_step or mean_flow_damping."""
     delta = A1 / a_over_delta
     Lx, Ly, Lz = (float(v) for v in pack.box)
     u_lo, u_hi = (float(u) for u in wall_velocities)
     box = case.Box((0, 0, 0), (Lx, Ly, Lz), delta, faces=("cyclic", ((u_lo, 0, 0), (u_hi, 0, 0)), "cyclic"))
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=ETA, rho=1.0, grad_p0=tuple(grad_p0),
-                          tol_lambda=tol_lambda, n_max=n_max, first_step=(tol_lambda / 10, 3000), n_particles=pack.n,
-                          tol_u=1e-5, tol_p=1e-3, acceleration=acceleration, write_interval=write_every)
+    fluid = dict(nu=ETA, rho=1.0, grad_p0=tuple(grad_p0), tol_lambda=tol_lambda, n_max=n_max,
+                 first_step=(tol_lambda / 10, 3000), n_particles=pack.n, tol_u=1e-5, tol_p=1e-3,
+                 acceleration=acceleration, write_interval=write_every)
+    fluid.update(fluid_options or {})
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, **fluid)
     pair = ("fdm/subgrid model %s contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
             % (model, springs.kn, springs.kt, springs.mu_s, springs.h_r, u_lo, u_hi))
     spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]

@@ -9,7 +9,8 @@ Foam::meanFlowCorrection::meanFlowCorrection
     const uniformCartesianMesh& grid,
     const volVectorField& U,
     scalar nu,
-    bool enabled
+    bool enabled,
+    scalar damping
 )
 :
     grid_(grid),
@@ -17,6 +18,7 @@ Foam::meanFlowCorrection::meanFlowCorrection
     axis_(-1),
     uLow_(Zero),
     uHigh_(Zero),
+    damping_(damping),
     lastChange_(0)
 {
     const Vector<bool>& periodic = grid.periodic();
@@ -103,7 +105,13 @@ Foam::string Foam::meanFlowCorrection::description() const
     return
         string("mean-flow correction on: the profile of the flow averaged over ")
       + "planes normal to " + names[axis_] + " (" + name(grid_.nCells()[axis_])
-      + " planes) solved exactly at every inner iteration";
+      + " planes) solved exactly at every inner iteration"
+      + (
+            damping_ > 0
+          ? ", damped where particles force the flow (meanFlowDamping "
+          + name(damping_) + ")"
+          : string(", undamped (meanFlowDamping 0)")
+        );
 }
 
 
@@ -131,6 +139,39 @@ Foam::List<Foam::vector> Foam::meanFlowCorrection::planeAverages
         averages[j] /= cellsPerPlane;
     }
     return averages;
+}
+
+
+void Foam::meanFlowCorrection::setForcedCells
+(
+    const boolList& covered
+)
+{
+    nuP_.clear();
+    if (!active() || damping_ <= 0)
+    {
+        return;
+    }
+    const label n = nPlanes();
+    List<scalar> count(n, 0.0);
+    forAll(covered, celli)
+    {
+        if (covered[celli])
+        {
+            count[plane_[celli]] += 1;
+        }
+    }
+    Pstream::listCombineGather(count, plusEqOp<scalar>());
+    Pstream::listCombineScatter(count);
+    const Vector<label>& nCells = grid_.nCells();
+    const scalar cellsPerPlane = scalar(nCells.x())*nCells.y()*nCells.z()/n;
+    nuP_.resize(n + 1);
+    for (label f = 0; f <= n; ++f)
+    {
+        const scalar below = count[max(f - 1, label(0))];
+        const scalar above = count[min(f, n - 1)];
+        nuP_[f] = damping_*nu_*0.5*(below + above)/cellsPerPlane;
+    }
 }
 
 
@@ -176,9 +217,21 @@ void Foam::meanFlowCorrection::correct
         {
             source[j] = sums[n + j][d]/cellsPerPlane - gradP0OverRho[d];
         }
+        // The PISO solution's own plane averages: nu_P holds the new
+        // profile close to them
+        std::vector<double> piso;
+        if (!nuP_.empty())
+        {
+            piso.resize(n);
+            for (label j = 0; j < n; ++j)
+            {
+                piso[j] = sums[j][d]/cellsPerPlane;
+            }
+        }
         const std::vector<double> profile = fdm::channel::solveProfile
         (
-            source, nu_, grid_.delta(), uLow_[d], uHigh_[d]
+            source, nu_, grid_.delta(), uLow_[d], uHigh_[d],
+            nuP_, piso
         );
         for (label j = 0; j < n; ++j)
         {

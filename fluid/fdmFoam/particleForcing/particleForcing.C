@@ -21,6 +21,7 @@ Foam::particleForcing::particleForcing
     IuScale_(grid.mesh().nCells(), 1.0),
     covered_(grid.mesh().nCells(), false),
     maxCoreSlip_(0),
+    lambdaNorm_(0),
     wallOverlapReported_(false)
 {}
 
@@ -343,6 +344,7 @@ Foam::scalar Foam::particleForcing::correct
     U.correctBoundaryConditions();
     lambda.correctBoundaryConditions();
 
+    lambdaNorm_ = Foam::sqrt(sumL2);
     return Foam::sqrt(sumDl2/max(sumL2, VSMALL));
 }
 
