@@ -266,7 +266,7 @@ for _c in [
     Case("wallShear", "5.2.1 a free sphere in simple shear next to one wall",
          "the free sphere from the exact wall resistance functions and Goldman, Cox & Brenner's fixed sphere "
          "(U, Ω); Sangani et al.'s fit, Eq. (46) (S*)", wall_shear_rows,
-         # the calibrated tangential wall functions (a/Δ 3 and 4); --full's a/Δ 5 and 7 are not calibrated
+         # the calibrated tangential wall functions (a/Δ 3, 4 and 5); --full's a2 sphere (a/Δ 7) is not
          default_args=["--model", "calibrated"]),
     Case("channelShear", "5.2.2 a free sphere at the centre of a sheared channel, H/a from 2.2 to 20",
          "the unbounded limits Ω_z = −γ̇/2, S* = 1 (wide channels); no tabulated values", channel_shear_rows),

@@ -197,10 +197,6 @@ class WallTangentialCalibration:
     def theory(self) -> np.ndarray:
         return np.array([[theory_functions(g)[k] for k in FUNCTIONS] for g in self.gaps])
 
-    def measured_difference(self) -> np.ndarray:
-        """(gaps, 4): theory - FDM of Y^A, Y^B, Y^C, X^C at the measured gaps (Kim-Karrila), before the fit."""
-        return self.theory() - self.fdm_functions()
-
     def reciprocity(self) -> np.ndarray:
         """Per gap |M12 - M21| / sqrt(M11 M22), infinite box (the solver spreads forces with I_lambda and
         averages velocities with I_u: its operator need not be symmetric; the fit uses the symmetric part)."""
@@ -311,7 +307,7 @@ def summary(c: WallTangentialCalibration) -> Dict:
     corrections = [dissipative({name: correction(name, g, fits[name]) for name in FUNCTIONS}) for g in c.gaps]
     return dict(a_over_delta=c.a_over_delta, gaps=c.gaps, boxes=c.boxes, offsets=c.offsets, functions=FUNCTIONS,
                 fdm=fdm.tolist(), fdm_by_box=by_box, offset_spread=spread,
-                theory=th.tolist(), measured_difference=c.measured_difference().tolist(), fits=fits,
+                theory=th.tolist(), measured_difference=(th - fdm).tolist(), fits=fits,
                 correction=[[cg[name] for name in FUNCTIONS] for cg in corrections],
                 reciprocity=c.reciprocity().tolist(), responses=c.responses, wall_seconds=c.wall_seconds)
 

@@ -212,21 +212,13 @@ void Foam::meanFlowCorrection::correct
         {
             continue;
         }
-        std::vector<double> source(n);
+        // source, and the PISO solution's own plane averages (nu_P holds
+        // the new profile close to them)
+        std::vector<double> source(n), piso(n);
         for (label j = 0; j < n; ++j)
         {
             source[j] = sums[n + j][d]/cellsPerPlane - gradP0OverRho[d];
-        }
-        // The PISO solution's own plane averages: nu_P holds the new
-        // profile close to them
-        std::vector<double> piso;
-        if (!nuP_.empty())
-        {
-            piso.resize(n);
-            for (label j = 0; j < n; ++j)
-            {
-                piso[j] = sums[j][d]/cellsPerPlane;
-            }
+            piso[j] = sums[j][d]/cellsPerPlane;
         }
         const std::vector<double> profile = fdm::channel::solveProfile
         (
@@ -235,7 +227,7 @@ void Foam::meanFlowCorrection::correct
         );
         for (label j = 0; j < n; ++j)
         {
-            shift[j][d] = profile[j] - sums[j][d]/cellsPerPlane;
+            shift[j][d] = profile[j] - piso[j];
             largest = max(largest, mag(shift[j][d]));
         }
     }
