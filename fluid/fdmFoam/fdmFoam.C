@@ -181,8 +181,8 @@ int main(int argc, char *argv[])
             radii[pi] = stepParticles[pi].radius;
         }
 
-        label innerIteration = 0, iterationsAboveOne = 0;
-        scalar residual = GREAT, bestResidual = GREAT, lambdaNormAboveOne = 0;
+        label innerIteration = 0;
+        scalar residual = GREAT;
         bool converged = false;
         List<scalar> integrals, velocities;
         scalarField state;
@@ -222,60 +222,14 @@ int main(int argc, char *argv[])
             residual = forcing.correct(U, lambda, velocities);
             stepParticleTime += wallClock() - t0;
 
-            if (!std::isfinite(residual))
+            const string divergence =
+                convergence.diverging(innerIteration, residual, forcing.lambdaNorm());
+            if (!divergence.empty())
             {
                 coupling.fatal
                 (
-                    "the lambda iteration produced a non-finite residual ("
-                  + name(residual) + ") at time step " + name(coupling.step())
-                  + ", inner iteration " + name(innerIteration)
-                  + ": check the time step, gradP0 and the particle forces"
-                );
-            }
-            bestResidual = min(bestResidual, residual);
-            // A residual above 1 changes lambda by more than lambda itself:
-            // kept for 20 iterations while lambda grows a thousandfold, the
-            // iteration diverges geometrically although the relative
-            // residual stays bounded
-            if (residual < 1)
-            {
-                iterationsAboveOne = 0;
-            }
-            else if (iterationsAboveOne++ == 0)
-            {
-                lambdaNormAboveOne = forcing.lambdaNorm();
-            }
-            if
-            (
-                iterationsAboveOne >= 20
-             && forcing.lambdaNorm() > 1e3*lambdaNormAboveOne
-            )
-            {
-                coupling.fatal
-                (
-                    "the lambda iteration is diverging at time step "
-                  + name(coupling.step()) + ": the lambda residual has"
-                    " stayed above 1 for " + name(iterationsAboveOne)
-                  + " inner iterations (now " + name(residual)
-                  + " at inner iteration " + name(innerIteration)
-                  + ") while |lambda| grew by "
-                  + name(forcing.lambdaNorm()/max(lambdaNormAboveOne, VSMALL))
-                  + "."
-                    " Use the Anderson acceleration (innerIterations {"
-                    " acceleration anderson; }), keep meanFlowDamping"
-                    " above 0, or try a smaller pseudoTimeFactor in"
-                    " constant/fdmProperties"
-                );
-            }
-            if (innerIteration > 20 && residual > 1e4*bestResidual)
-            {
-                coupling.fatal
-                (
-                    "the lambda iteration is diverging at time step "
-                  + name(coupling.step()) + ": residual " + name(residual)
-                  + " at inner iteration " + name(innerIteration)
-                  + " after reaching " + name(bestResidual)
-                  + " (try a smaller pseudoTimeFactor in constant/fdmProperties)"
+                    "the lambda iteration at time step " + name(coupling.step())
+                  + " " + divergence
                 );
             }
             convergence.endIteration(U, velocities, radii, residual);

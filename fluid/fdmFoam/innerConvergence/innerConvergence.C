@@ -10,9 +10,12 @@ Foam::innerConvergence::innerConvergence()
     tolVelocity_(0),
     tolLambda_(0),
     lambdaResidual_(GREAT),
+    bestLambdaResidual_(GREAT),
     flowChange_(GREAT),
     particleChange_(GREAT),
-    errorEstimate_(GREAT)
+    errorEstimate_(GREAT),
+    iterationsAboveOne_(0),
+    lambdaNormAboveOne_(0)
 {}
 
 
@@ -25,6 +28,60 @@ void Foam::innerConvergence::reset(scalar tolVelocity, scalar tolLambda)
     changes_.clear();
     previousVelocities_.clear();
     lambdaResidual_ = flowChange_ = particleChange_ = errorEstimate_ = GREAT;
+    bestLambdaResidual_ = GREAT;
+    iterationsAboveOne_ = 0;
+    lambdaNormAboveOne_ = 0;
+}
+
+
+Foam::string Foam::innerConvergence::diverging
+(
+    label innerIteration,
+    scalar lambdaResidual,
+    scalar lambdaNorm
+)
+{
+    if (!std::isfinite(lambdaResidual))
+    {
+        return
+            "produced a non-finite residual (" + name(lambdaResidual)
+          + ") at inner iteration " + name(innerIteration)
+          + ": check the time step, gradP0 and the particle forces";
+    }
+    bestLambdaResidual_ = min(bestLambdaResidual_, lambdaResidual);
+
+    // geometric divergence with a bounded relative residual
+    if (lambdaResidual < 1)
+    {
+        iterationsAboveOne_ = 0;
+    }
+    else if (iterationsAboveOne_++ == 0)
+    {
+        lambdaNormAboveOne_ = lambdaNorm;
+    }
+    if (iterationsAboveOne_ >= 20 && lambdaNorm > 1e3*lambdaNormAboveOne_)
+    {
+        return
+            "is diverging: the lambda residual has stayed above 1 for "
+          + name(iterationsAboveOne_) + " inner iterations (now "
+          + name(lambdaResidual) + " at inner iteration "
+          + name(innerIteration) + ") while |lambda| grew by "
+          + name(lambdaNorm/max(lambdaNormAboveOne_, VSMALL)) + "."
+            " Use the Anderson acceleration (innerIterations {"
+            " acceleration anderson; }), keep meanFlowDamping above 0, or"
+            " try a smaller pseudoTimeFactor in constant/fdmProperties";
+    }
+
+    // a spike
+    if (innerIteration > 20 && lambdaResidual > 1e4*bestLambdaResidual_)
+    {
+        return
+            "is diverging: residual " + name(lambdaResidual)
+          + " at inner iteration " + name(innerIteration) + " after reaching "
+          + name(bestLambdaResidual_)
+          + " (try a smaller pseudoTimeFactor in constant/fdmProperties)";
+    }
+    return string::null;
 }
 
 
