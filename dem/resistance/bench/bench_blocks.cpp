@@ -104,6 +104,22 @@ int main(int argc, char** argv)
         withScatter.push_back(secondsSince(t0));
     }
 
+    // Wall blocks: one per particle, radius 1 (a/Delta 5: the calibration's largest), gaps eps = 1e-4 ... 0.9
+    std::vector<double> wallEps(particles);
+    for (int p = 0; p < particles; ++p) wallEps[p] = std::exp(std::log(1e-4) + (std::log(0.9) - std::log(1e-4)) * (0.5 + 0.5 * unit(rng)));
+    const double wallPoint[3] = {0, 0, 0}, wallNormal[3] = {0, -1, 0};
+    std::vector<double> wallBlocks;
+    WallBlock wallBlock;
+    for (int r = 0; r < repeats; ++r) {
+        const std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
+        for (int p = 0; p < particles; ++p) {
+            const double centre[3] = {x[3 * p], 1 + wallEps[p], x[3 * p + 2]};
+            if (subgridWallBlock(model, centre, 1.0, wallPoint, wallNormal, 1.0, wallBlock))
+                checksum += wallBlock.R[0][0];
+        }
+        wallBlocks.push_back(secondsSince(t0));
+    }
+
     // Per-new-lambda cost (cache miss): constants for a radius pair never seen before.
     std::vector<double> miss;
     for (int r = 0; r < 20; ++r) {
@@ -119,6 +135,7 @@ int main(int argc, char** argv)
     std::printf("| %d sub-grid pair blocks (12x12 + stress rows), cached constants | %.3f ms |\n", pairs, 1e3 * median(blocksOnly));
     std::printf("| same + scatter into 6N triplets (%d entries) | %.3f ms |\n", 144 * pairs, 1e3 * median(withScatter));
     std::printf("| per pair | %.0f ns |\n", 1e9 * median(blocksOnly) / pairs);
+    std::printf("| per wall block (radius 1, eps 1e-4 ... 0.9) | %.0f ns |\n", 1e9 * median(wallBlocks) / particles);
     std::printf("| first pass (series recurrences + constants for 2 radius pairs) | %.1f ms |\n", 1e3 * firstCall);
     std::printf("| constants for one new radius pair (lambda and 1/lambda sums) | %.3f ms |\n", 1e3 * median(miss));
     std::printf("(checksum %g)\n", checksum);

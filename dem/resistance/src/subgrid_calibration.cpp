@@ -322,16 +322,22 @@ WallScalars CalibratedSubgridModel::wall(double a, double eps) const
         }
     }
     if (!any) return w;
-    // dissipation rule: the block [[Y^A, -Y^B], [-Y^B, Y^C]] and X^C positive semi-definite
+    // dissipation rule: R^th + R^SG positive semi-definite (the block [[Y^A, -Y^B], [-Y^B, Y^C]] and X^C)
+    WallScalars th;  // the tangential theory only (the normal functions' series are the costly ones)
+    th.f[WallYA] = wallKimKarrilaFactor(WallYA, a) * wallParallelTranslation(e);
+    th.f[WallYB] = wallKimKarrilaFactor(WallYB, a) * -2 * wallCouplingMagnitude(e);
+    th.f[WallYC] = wallKimKarrilaFactor(WallYC, a) * wallParallelRotation(e);
+    th.f[WallXC] = wallKimKarrilaFactor(WallXC, a) * wallNormalRotation(e);
     bool clipped = false;
     for (WallFunction f : {WallYA, WallYC, WallXC})
-        if (w.f[f] < 0) {
-            w.f[f] = 0;
+        if (w.f[f] < -th.f[f]) {
+            w.f[f] = -th.f[f];
             clipped = true;
         }
-    const double bound = std::sqrt(w.f[WallYA] * w.f[WallYC]);
-    if (std::fabs(w.f[WallYB]) > bound) {
-        w.f[WallYB] = std::copysign(bound, w.f[WallYB]);
+    const double bound = std::sqrt((th.f[WallYA] + w.f[WallYA]) * (th.f[WallYC] + w.f[WallYC]));
+    const double coupling = th.f[WallYB] + w.f[WallYB];
+    if (std::fabs(coupling) > bound) {
+        w.f[WallYB] = std::copysign(bound, coupling) - th.f[WallYB];
         clipped = true;
     }
     if (clipped) ++wallClipped_;

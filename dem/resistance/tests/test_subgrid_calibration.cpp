@@ -243,22 +243,46 @@ TEST(CalibratedSubgridModel, ReplacesTheTangentialWallFunctionsWhereTabulated)
     EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12 * R.norm());
 }
 
-// The dissipation rule for a wall: a tabulated Y^B beyond sqrt(Y^A Y^C) (or a negative Y^A, Y^C, X^C)
-// is clipped so that the block stays positive semi-definite, and counted.
+// The dissipation rule for a wall: R^th + R^SG positive semi-definite (the correction takes away at
+// most half of what the solver resolves). A correction that is indefinite on its own but leaves the
+// theory's block positive passes unchanged; one beyond it is clipped (Y^A, Y^C, X^C at minus the
+// theory, |Y^B_th + Y^B_SG| at sqrt((Y^A_th + Y^A_SG)(Y^C_th + Y^C_SG))) and counted.
 TEST(CalibratedSubgridModel, WallDissipationRuleClipsAndCounts)
 {
-    const SubgridCalibration cal =
-        SubgridCalibration::read(writeTable("tangential_clip.dat", tableWithTangential(0.3, -1.5, 0.4, -0.02)));
     const double a = 1.0;
-    const CalibratedSubgridModel model(cal, a / 3, 0.65, 0.75);
-    const WallScalars w = model.wall(a, 0.05);
+    // the solver's excess coupling taken away: Y^B_SG > 0 with Y^A_SG = Y^C_SG = 0, kept
+    const CalibratedSubgridModel allowed(
+        SubgridCalibration::read(writeTable("tangential_coupling.dat", tableWithTangential(0, 0.2, 0, 0))), a / 3,
+        0.65, 0.75);
+    const WallScalars kept = allowed.wall(a, 0.25);  // a row of the table
+    EXPECT_EQ(allowed.wallClipped(), 0);
+    EXPECT_NEAR(kept.f[WallYB], 4 * pi * 0.2, 1e-9);
+    EXPECT_LT(kept.f[WallYA] * kept.f[WallYC], kept.f[WallYB] * kept.f[WallYB]);  // indefinite alone
+
+    const CalibratedSubgridModel model(
+        SubgridCalibration::read(writeTable("tangential_clip.dat", tableWithTangential(0.3, -5, 0.4, -2))), a / 3,
+        0.65, 0.75);
+    const double eps = 0.05;
+    const WallScalars w = model.wall(a, eps), th = wallTheoryDimensional(a, eps);
     EXPECT_EQ(model.wallClipped(), 1);
-    EXPECT_EQ(w.f[WallXC], 0.0);
-    EXPECT_NEAR(std::fabs(w.f[WallYB]), std::sqrt(w.f[WallYA] * w.f[WallYC]), 1e-12);
-    EXPECT_LT(w.f[WallYB], 0);  // the sign is kept
+    EXPECT_NEAR(w.f[WallXC], -th.f[WallXC], 1e-12);
+    EXPECT_NEAR(std::fabs(th.f[WallYB] + w.f[WallYB]),
+                std::sqrt((th.f[WallYA] + w.f[WallYA]) * (th.f[WallYC] + w.f[WallYC])), 1e-12);
+    EXPECT_LT(th.f[WallYB] + w.f[WallYB], 0);  // the sign is kept
+    // the coupled block R^th + R^SG is positive semi-definite
     WallBlock block;
-    const double x[3] = {0, a * 1.05, 0}, wallPoint[3] = {0, 0, 0}, normal[3] = {0, -1, 0};
+    const double x[3] = {0, a * (1 + eps), 0}, wallPoint[3] = {0, 0, 0}, normal[3] = {0, -1, 0};
     ASSERT_TRUE(subgridWallBlock(model, x, a, wallPoint, normal, 1.0, block));
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6> > eig(wallMatrix(block));
-    EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-10 * wallMatrix(block).norm());
+    struct Theory : SubgridModel {
+        double pairRange(double, double) const { return 0; }
+        double wallRange(double) const { return 1; }
+        PairSubgridBase pair(double, double, double) const { return PairSubgridBase(); }
+        WallScalars wall(double a, double eps) const { return wallTheoryDimensional(a, eps); }
+        const char* describe() const { return "theory"; }
+    } theory;
+    WallBlock theoryBlock;
+    ASSERT_TRUE(subgridWallBlock(theory, x, a, wallPoint, normal, 1.0, theoryBlock));
+    const Eigen::Matrix<double, 6, 6> total = wallMatrix(block) + wallMatrix(theoryBlock);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6> > eig(total);
+    EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-10 * total.norm());
 }

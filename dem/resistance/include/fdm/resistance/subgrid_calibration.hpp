@@ -98,9 +98,13 @@ private:
 // The cut-off model with the functions the table calibrates replaced: the squeeze functions (pair X21A,
 // wall X^A; required) and, where the table has them, the tangential wall functions Y^A, Y^B, Y^C, X^C.
 // The other functions stay the cut-off model's until their calibration exists (docs/resistance.md).
-// Dissipation rule for a wall (docs/resistance.md): the tangential block [[Y^A, -Y^B], [-Y^B, Y^C]]
-// (dimensional) and X^C are made positive semi-definite by clipping Y^A, Y^C, X^C at 0 and |Y^B| at
-// sqrt(Y^A Y^C); wallClipped() counts the calls that changed anything.
+// Dissipation rule for a wall (docs/resistance.md): the correction may take away at most half of what
+// the solver itself resolves, R^SG + R^FDM/2 >= 0 with R^FDM = R^th - R^SG, i.e. R^th + R^SG positive
+// semi-definite for the tangential block [[Y^A, -Y^B], [-Y^B, Y^C]] (dimensional) and X^C. Y^A, Y^C,
+// X^C are clipped at minus the theory and |Y^B_th + Y^B_SG| at sqrt((Y^A_th + Y^A_SG)(Y^C_th + Y^C_SG));
+// wallClipped() counts the calls that changed anything. (The correction alone may be indefinite: the
+// solver over-couples translation and rotation at gaps of about 0.3 cell, and taking that coupling
+// away is what makes a free sphere turn at the theory's rate.)
 class CalibratedSubgridModel : public SubgridModel {
 public:
     CalibratedSubgridModel(const SubgridCalibration& calibration, double meshSize, double cutoffCells,
