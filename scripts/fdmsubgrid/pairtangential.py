@@ -1,0 +1,342 @@
+"""The solver's own tangential pair resistance (paper section 2.2 and Appendix B): what fdmFoam resolves of
+the internal modes of two spheres other than the squeeze, and the sub-grid correction R_SG = R_th - R_FDM
+that would make the coupled resistance the theory's. The squeeze is calibrated by calibration.py; the wall
+functions by wallcalibration.py. This module measures; the sub-grid model does not use its output yet.
+
+The internal modes. With Appendix C.2's relations the pair's sub-grid block is R_SG = P^T K P exactly, K
+acting on six internal modes (checked with the resistance library to 1e-15; docs/resistance.md): for the
+line of centres d (from sphere 1 to sphere 2, r = |x2 - x1|) and a transverse direction e, n = d x e,
+
+    squeeze  (U1 - U2).d                           twist  (W1 - W2).d
+    q1 = (U1 - U2).e + (r/2)(W1 + W2).n            q2 = (W1 - W2).n       (per transverse direction)
+
+A rigid motion of the pair leaves all six at zero. Their conjugate loads are self-equilibrated (no net
+force or moment): Q1 is the force pair +-Q e on spheres 1 and 2 with the torque (r/2) Q n on each, Q2 the
+torque couple +-Q n, the twist the torque couple +-T d. The responses q to loads Q give the internal
+mobility M (2 x 2 per transverse direction, a scalar for the twist), of the solver (measured) and of the
+theory (P R_th^-1 P^T with the full-range two-sphere functions), and the correction on these modes is
+K = M_th^-1 - M_FDM^-1 (Sherman-Morrison/Woodbury: the coupled solver's internal resistance is its own
+plus K).
+
+What is run. Spheres of radii 1 and `ratio` along x in a periodic cube, the sub-grid lubrication off, all
+loads at once: Q1 along y (force pair and torques about z), Q2 along z (the torque couple about -y, i.e.
+the y case turned by 90 degrees about d: its responses U_z and -W_y stand for U_y and W_z), and the twist
+about x. In the continuous problem the three decouple by symmetry. Each gap is one coupled step with the
+spheres held (quasi-static), largest gap first; the centre of the gap sits at `offset` inside its cell;
+two box sizes are extrapolated as M_inf + c L^-3 (the loads are self-equilibrated: their far field
+decays like a force dipole's, as the squeeze's).
+
+    python3 -m fdmsubgrid.pairtangential --a-over-delta 3 --ratio 1 --out runs/pair_tangential.json
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import time
+from typing import Dict, List, Sequence
+
+import numpy as np
+
+from . import case, squeeze, theory
+
+GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
+OFFSETS = [(0.1, 0.2, 0.3), (0.35, 0.45, 0.55), (0.6, 0.7, 0.8), (0.85, 0.95, 0.05)]
+BOXES = (8.0, 12.0)
+FORCE = 6 * math.pi          # eta = a1 = 1
+TORQUE = 8 * math.pi
+
+
+def centres(ratio: float, xi: float, centre: Sequence[float]) -> tuple:
+    """Sphere centres (radii 1 and ratio) along x with the gap's middle at `centre`, reduced gap xi."""
+    a1, a2 = 1.0, ratio
+    gap = xi * (a1 + a2) / 2
+    return ((centre[0] - gap / 2 - a1, centre[1], centre[2]), (centre[0] + gap / 2 + a2, centre[1], centre[2]))
+
+
+def separation(ratio: float, xi: float) -> float:
+    """r = |x2 - x1| at the reduced gap xi = 2r/(a1 + a2) - 2."""
+    return (1.0 + ratio) / 2 * (2 + xi)
+
+
+def loads(r: float) -> Dict[str, np.ndarray]:
+    """Force and torque on each sphere (rows: sphere 1, sphere 2; [Fx Fy Fz Tx Ty Tz]) of the three
+    loads at once for the separation r: Q1 = FORCE along y, Q2 = TORQUE about -y, twist TORQUE about x."""
+    q1, q2, tw = FORCE, TORQUE, TORQUE
+    s1 = np.array([0, q1, 0, tw, -q2, 0.5 * r * q1])
+    s2 = np.array([0, -q1, 0, -tw, q2, 0.5 * r * q1])
+    return dict(sphere1=s1, sphere2=s2)
+
+
+def _load_lines(r: float) -> List[str]:
+    """The LIGGGHTS fixes of the three loads at separation r (groups one, two defined)."""
+    load = loads(r)
+    lines = []
+    for name, group, s in (("1", "one", load["sphere1"]), ("2", "two", load["sphere2"])):
+        lines.append("fix             push%s %s addforce %r %r %r" % (name, group, *map(float, s[:3])))
+        lines.append("fix             turn%s %s fdm/torque %r %r %r" % (name, group, *map(float, s[3:])))
+    return lines
+
+
+def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_delta: float, L_over_a: float,
+                    offset: Sequence[float], tol_lambda: float = 1e-5, np_fluid: int = 1, keep: bool = False) -> dict:
+    """The loaded pair at the gaps `xis` (largest first, each one coupled step warm-started from the
+    previous) in a periodic cube of side L_over_a a1; returns dict(U1, W1, U2, W2: per gap [x, y, z],
+    wall_seconds, inner_iterations, converged). The torques' moment arm r/2 changes with the gap: the
+    fixes are redefined before each step. Kept as <run folder>.json: a later call with the same scene and
+    gaps reads it (a killed measurement resumes)."""
+    run_dir = os.path.join(workdir, "lambda%g_ad%g_L%g_off%g_%g_%g" % (ratio, a_over_delta, L_over_a, *offset))
+    kept = run_dir + ".json"
+    if os.path.isfile(kept):
+        with open(kept) as f:
+            result = json.load(f)
+        if result.get("gaps") == [float(x) for x in xis] and result.get("tol_lambda") == tol_lambda:
+            return result
+    squeeze._fresh_run_dir(workdir, os.path.basename(run_dir))
+    delta = 1.0 / a_over_delta
+    L = L_over_a
+    box = case.Box((0, 0, 0), (L, L, L), delta)
+    centre = [L / 2 + o * delta for o in offset]
+    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+                          n_particles=2)
+    runs: List[str] = []
+    for k, xi in enumerate(xis):
+        if k > 0:
+            runs += ["unfix           push1", "unfix           turn1", "unfix           push2", "unfix           turn2"]
+            runs += ["set             atom %d x %r y %r z %r" % (i + 1, *map(float, c))
+                     for i, c in enumerate(centres(ratio, xi, centre))]
+        runs += _load_lines(separation(ratio, xi))
+        runs.append("run             1")
+    p1, p2 = centres(ratio, xis[0], centre)
+    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
+                         pair_style="fdm/subgrid lubrication no",
+                         before_run="group           one id 1\ngroup           two id 2", runs=runs,
+                         name="in.pairTangential")
+    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    out: Dict[str, object] = {}
+    for tag, k in ((1, "1"), (2, "2")):
+        sel = parts["tag"] == tag
+        out["U" + k] = np.column_stack([parts[c][sel] for c in ("Ux", "Uy", "Uz")]).tolist()
+        out["W" + k] = np.column_stack([parts[c][sel] for c in ("Wx", "Wy", "Wz")]).tolist()
+    out.update(wall_seconds=wall, inner_iterations=[int(n) for n in steps["innerIterations"]],
+               converged=bool(steps["converged"].all()), gaps=[float(x) for x in xis], tol_lambda=tol_lambda)
+    with open(kept + ".tmp", "w") as f:
+        json.dump(out, f)
+    os.replace(kept + ".tmp", kept)
+    return out
+
+
+def internal_mobility(result: dict, ratio: float) -> np.ndarray:
+    """Per gap [M11, M12, M21, M22, M_twist] of the measured internal modes (module docstring): column 1
+    from the Q1 load along y, column 2 from the Q2 load along z read in the turned frame."""
+    U1, W1, U2, W2 = (np.asarray(result[k]) for k in ("U1", "W1", "U2", "W2"))
+    r = np.array([separation(ratio, xi) for xi in result["gaps"]])
+    # y block: q1 = (U1 - U2)_y + r/2 (W1 + W2)_z, q2 = (W1 - W2)_z
+    q1_from_Q1 = (U1[:, 1] - U2[:, 1]) + 0.5 * r * (W1[:, 2] + W2[:, 2])
+    q2_from_Q1 = W1[:, 2] - W2[:, 2]
+    # z block turned: U_y -> U_z, W_z -> -W_y
+    q1_from_Q2 = (U1[:, 2] - U2[:, 2]) - 0.5 * r * (W1[:, 1] + W2[:, 1])
+    q2_from_Q2 = -(W1[:, 1] - W2[:, 1])
+    twist = W1[:, 0] - W2[:, 0]
+    return np.column_stack([q1_from_Q1 / FORCE, q1_from_Q2 / TORQUE, q2_from_Q1 / FORCE, q2_from_Q2 / TORQUE,
+                            twist / TORQUE])
+
+
+def _levi_civita_dot(d: np.ndarray) -> np.ndarray:
+    e = np.zeros((3, 3, 3))
+    e[0, 1, 2] = e[1, 2, 0] = e[2, 0, 1] = 1
+    e[0, 2, 1] = e[2, 1, 0] = e[1, 0, 2] = -1
+    return np.einsum("ijk,k->ij", e, d)
+
+
+def theory_matrix(ratio: float, xi: float) -> np.ndarray:
+    """The 12 x 12 two-sphere resistance (eta = 1, a1 = 1, d = e_x; F = -R U, order U1 W1 U2 W2) from the
+    full-range functions of `fdmResistance pair --theory --full` (Jeffrey & Onishi; same convention as
+    `fdmResistance matrix`, checked to 1e-13 with the near-field forms)."""
+    f = theory.resistance("pair", "--a1", 1, "--a2", ratio, "--xi", "%.17g" % xi, "--theory",
+                          "--full")["dimensional_over_eta"]
+    d = np.array([1.0, 0.0, 0.0])
+    dd, eye, ed = np.outer(d, d), np.eye(3), _levi_civita_dot(d)
+    R = np.zeros((12, 12))
+    for a in range(2):
+        for b in range(2):
+            s = "%d%d" % (a + 1, b + 1)
+            R[6 * a:6 * a + 3, 6 * b:6 * b + 3] = f["XA" + s] * dd + f["YA" + s] * (eye - dd)
+            R[6 * a:6 * a + 3, 6 * b + 3:6 * b + 6] = (f["YB%d%d" % (b + 1, a + 1)] * ed).T
+            R[6 * a + 3:6 * a + 6, 6 * b:6 * b + 3] = f["YB" + s] * ed
+            R[6 * a + 3:6 * a + 6, 6 * b + 3:6 * b + 6] = f["XC" + s] * dd + f["YC" + s] * (eye - dd)
+    return R
+
+
+def mode_matrix(r: float) -> np.ndarray:
+    """P (3 x 12): q1, q2 of the transverse direction y and the twist, for d = e_x and separation r."""
+    P = np.zeros((3, 12))
+    P[0, 1], P[0, 7], P[0, 5], P[0, 11] = 1, -1, r / 2, r / 2
+    P[1, 5], P[1, 11] = 1, -1
+    P[2, 3], P[2, 9] = 1, -1
+    return P
+
+
+def theory_mobility(ratio: float, xi: float) -> np.ndarray:
+    """[M11, M12, M21, M22, M_twist] of the theory: P R_th^-1 P^T."""
+    P = mode_matrix(separation(ratio, xi))
+    M = P @ np.linalg.solve(theory_matrix(ratio, xi), P.T)
+    return np.array([M[0, 0], M[0, 1], M[1, 0], M[1, 1], M[2, 2]])
+
+
+def correction(m_th: np.ndarray, m_fdm: np.ndarray) -> np.ndarray:
+    """K = M_th^-1 - M_FDM^-1 on the internal modes: [K11, K12, K22, K_twist] (the 2 x 2 symmetrised)."""
+    out = []
+    for th, fdm in zip(np.atleast_2d(m_th), np.atleast_2d(m_fdm)):
+        a = np.array([[th[0], 0.5 * (th[1] + th[2])], [0.5 * (th[1] + th[2]), th[3]]])
+        b = np.array([[fdm[0], 0.5 * (fdm[1] + fdm[2])], [0.5 * (fdm[1] + fdm[2]), fdm[3]]])
+        k = np.linalg.inv(a) - np.linalg.inv(b)
+        out.append([k[0, 0], k[0, 1], k[1, 1], 1 / th[4] - 1 / fdm[4]])
+    return np.array(out)
+
+
+def full_mode_matrix(r: float) -> np.ndarray:
+    """P (6 x 12) of all six internal modes for d = e_x: squeeze, twist, and (q1, q2) along y and z."""
+    P = np.zeros((6, 12))
+    P[0, 0], P[0, 6] = 1, -1                                        # squeeze (U1 - U2).d
+    P[1, 3], P[1, 9] = 1, -1                                        # twist (W1 - W2).d
+    P[2, 1], P[2, 7], P[2, 5], P[2, 11] = 1, -1, r / 2, r / 2      # e = e_y, n = e_z
+    P[3, 5], P[3, 11] = 1, -1
+    P[4, 2], P[4, 8], P[4, 4], P[4, 10] = 1, -1, -r / 2, -r / 2    # e = e_z, n = -e_y
+    P[5, 4], P[5, 10] = -1, 1
+    return P
+
+
+def model_correction(ratio: float, xi: float, delta: float, model: str = "cutoff") -> tuple:
+    """([K11, K12, K22, K_twist], residual): the internal-mode matrix K of the sub-grid block the pair
+    style builds (`fdmResistance matrix --delta`, the cut-off model) at xi, and |R_SG - P^T K P| / |R_SG|,
+    which is zero (to rounding) when the block acts on the internal modes only."""
+    r = separation(ratio, xi)
+    R = np.array(theory.resistance("matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % r, 0, 0, "--a1", 1, "--a2", ratio,
+                                   "--delta", "%.17g" % delta)["R"])
+    P = full_mode_matrix(r)
+    G = np.linalg.inv(P @ P.T)
+    K = G @ P @ R @ P.T @ G
+    residual = float(np.linalg.norm(R - P.T @ K @ P) / max(np.linalg.norm(R), 1e-300))
+    return np.array([K[2, 2], K[2, 3], K[3, 3], K[1, 1]]), residual
+
+
+def measure(ratio: float, a_over_delta: float, workdir: str, gaps: Sequence[float] = GAPS,
+            boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS,
+            tol_lambda: float = 1e-5) -> Dict:
+    """Every offset in the first box, the first offset in the second; the summary the JSON keeps."""
+    t0 = time.time()
+    raw: Dict[str, List[dict]] = {}
+    for k, L in enumerate(boxes):
+        raw["%g" % L] = []
+        for off in (offsets if k == 0 else offsets[:1]):
+            res = run_loaded_pair(workdir, ratio, gaps, a_over_delta, L, off, tol_lambda)
+            if not res["converged"]:
+                raise RuntimeError("pair tangential: ratio %g a/Delta %g L %g offset %s: a step did not converge"
+                                   % (ratio, a_over_delta, L, off))
+            raw["%g" % L].append(res)
+            print("pair tangential: ratio %g a/Delta %g L %g offset %s done (%.0f s)"
+                  % (ratio, a_over_delta, L, off, res["wall_seconds"]), flush=True)
+    return summarize(ratio, a_over_delta, list(gaps), list(boxes), [list(o) for o in offsets], raw,
+                     sum(r["wall_seconds"] for runs in raw.values() for r in runs) or time.time() - t0)
+
+
+def summarize(ratio: float, a_over_delta: float, gaps: List[float], boxes: List[float], offsets: List[List[float]],
+              raw: Dict[str, List[dict]], wall_seconds: float) -> Dict:
+    """Mobilities (offset-averaged in the first box plus the box correction M_inf - M(L1) of the first
+    offset, M = M_inf + c L^-3), the theory's, the scatter over offsets and the correction K."""
+    by_box = {L: [internal_mobility(res, ratio) for res in runs] for L, runs in raw.items()}
+    L1, L2 = boxes
+    first, second = by_box["%g" % L1][0], by_box["%g" % L2][0]
+    box_correction = squeeze.extrapolate_box(first, second, L1, L2) - first
+    m_fdm = np.mean(by_box["%g" % L1], axis=0) + box_correction
+    m_th = np.array([theory_mobility(ratio, xi) for xi in gaps])
+    cells = np.array(by_box["%g" % L1])
+    spread = np.ptp(cells, axis=0) / np.abs(np.mean(cells, axis=0))
+    cutoff = np.array([model_correction(ratio, xi, 1 / a_over_delta)[0] for xi in gaps])
+    return dict(ratio=ratio, a_over_delta=a_over_delta, gaps=gaps, boxes=boxes, offsets=offsets,
+                mobility_fdm=m_fdm.tolist(), mobility_theory=m_th.tolist(),
+                mobility_by_box={k: v[0].tolist() for k, v in by_box.items()}, offset_spread=spread.tolist(),
+                correction=correction(m_th, m_fdm).tolist(), cutoff_correction=cutoff.tolist(), raw=raw,
+                wall_seconds=wall_seconds)
+
+
+def plot(path: str, summaries: Sequence[Dict]) -> None:
+    """Like the paper's Fig. B.24 for the tangential internal modes: the solver's mobility over the
+    theory's (sliding q1, rolling q2, twist) per box and extrapolated, and the correction K the solver
+    needs against the one the cut-off model adds."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(len(summaries), 2, figsize=(11, 3.6 * len(summaries)), squeeze=False)
+    for (left, right), s in zip(axes, summaries):
+        xi = np.array(s["gaps"])
+        th, fdm = np.array(s["mobility_theory"]), np.array(s["mobility_fdm"])
+        for j, name, c in ((0, "sliding q1", "C0"), (3, "rolling q2", "C1"), (4, "twist", "C2")):
+            left.semilogx(xi, fdm[:, j] / th[:, j], "^-", color=c, label=name + ", L → ∞")
+            for L, m in s["mobility_by_box"].items():
+                left.semilogx(xi, np.array(m)[:, j] / th[:, j], "x", color=c, ms=4)
+        left.axhline(1, color="k", lw=0.8)
+        left.set_xlabel(r"$\xi$")
+        left.set_ylabel("M_FDM / M_theory")
+        left.set_title("a2/a1 = %g, a1/Δ = %g (x: boxes %s, first position)" % (s["ratio"], s["a_over_delta"],
+                                                                             ", ".join(s["mobility_by_box"])),
+                       fontsize=9)
+        left.legend(fontsize=7)
+        k, cut = np.array(s["correction"]), np.array(s["cutoff_correction"])
+        for j, name, c in ((0, "K11 (sliding)", "C0"), (2, "K22 (rolling)", "C1"), (3, "K twist", "C2"),
+                           (1, "K12", "C3")):
+            right.semilogx(xi, k[:, j], "^-", color=c, label=name + " measured")
+            right.semilogx(xi, cut[:, j], "--", color=c, label="cut-off model")
+        right.axhline(0, color="k", lw=0.8)
+        right.set_xlabel(r"$\xi$")
+        right.set_ylabel("K (η a1, η a1², η a1³)")
+        right.legend(fontsize=6, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv: Sequence[str] | None = None) -> List[Dict]:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--a-over-delta", type=float, default=3.0, help="a1/Delta")
+    p.add_argument("--ratio", type=float, nargs="+", default=[1.0], help="a2/a1")
+    p.add_argument("--boxes", type=float, nargs=2, default=list(BOXES))
+    p.add_argument("--offsets", type=int, default=len(OFFSETS), help="positions in the cell averaged (1-4)")
+    p.add_argument("--gaps", type=float, nargs="+", default=GAPS, help="xi, largest first")
+    p.add_argument("--tol-lambda", type=float, default=1e-5)
+    p.add_argument("--workdir", default="pair_tangential_runs")
+    p.add_argument("--out", required=True, help="JSON of every measurement and the corrections (a .png beside)")
+    p.add_argument("--from-raw", metavar="JSON", nargs="+", help="analyse the measurements earlier calls kept (--out)")
+    args = p.parse_args(argv)
+    out = []
+    if args.from_raw:
+        for path in args.from_raw:
+            with open(path) as f:
+                out += [summarize(s["ratio"], s["a_over_delta"], s["gaps"], s["boxes"], s["offsets"], s["raw"],
+                                  s["wall_seconds"]) for s in json.load(f)]
+    else:
+        os.makedirs(args.workdir, exist_ok=True)
+        for ratio in args.ratio:
+            out.append(measure(ratio, args.a_over_delta, args.workdir, args.gaps, args.boxes, OFFSETS[:args.offsets],
+                               args.tol_lambda))
+            with open(args.out, "w") as f:
+                json.dump(out, f, indent=1)
+    with open(args.out, "w") as f:
+        json.dump(out, f, indent=1)
+    plot(os.path.splitext(args.out)[0] + ".png", out)
+    for s in out:
+        print("ratio %g a1/Delta %g (%.0f s): xi, FDM/theory of M11 M22 M_twist, (M12 - M12_th)/sqrt(M11 M22),"
+              " then K11 K12 K22 K_twist measured and [the cut-off model's]" % (s["ratio"], s["a_over_delta"],
+                                                                               s["wall_seconds"]))
+        for xi, f, t, k, cut in zip(s["gaps"], s["mobility_fdm"], s["mobility_theory"], s["correction"],
+                                    s["cutoff_correction"]):
+            print("  %8.2g  %7.4f %7.4f %7.4f %+7.4f   %9.4g %9.4g %9.4g %9.4g   [%.4g %.4g %.4g %.4g]"
+                  % (xi, f[0] / t[0], f[3] / t[3], f[4] / t[4], (0.5 * (f[1] + f[2]) - t[1]) / np.sqrt(t[0] * t[3]),
+                     *k, *cut))
+    return out
+
+
+if __name__ == "__main__":
+    main()
