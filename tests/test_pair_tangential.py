@@ -1,5 +1,6 @@
 """The tangential pair measurement (scripts/fdmsubgrid/pairtangential.py, issue 14): the internal-mode
 decomposition it relies on, its theory side, and one small coupled run."""
+import json
 import os
 
 import numpy as np
@@ -47,11 +48,12 @@ def test_loaded_pair_decouples_and_resolves_a_wide_gap(env, tmp_path):
     assert abs(m[1] - m[2]) < 0.02 * np.sqrt(m[0] * m[3])
     squeeze = abs(res["U1"][0][0] - res["U2"][0][0])
     assert squeeze < 0.05 * abs(res["U1"][0][1] - res["U2"][0][1])
+    # kept: the same scene again is read, not run (a killed measurement resumes)
+    assert pt.run_loaded_pair(str(tmp_path), 1.0, [1.0], 3.0, 8.0, pt.OFFSETS[0]) == json.loads(json.dumps(res))
 
 
 @pytest.fixture(scope="module")
 def shipped():
-    import json
     with open(SHIPPED) as f:
         return json.load(f)
 

@@ -87,12 +87,9 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
     fixes are redefined before each step. Kept as <run folder>.json: a later call with the same scene and
     gaps reads it (a killed measurement resumes)."""
     run_dir = os.path.join(workdir, "lambda%g_ad%g_L%g_off%g_%g_%g" % (ratio, a_over_delta, L_over_a, *offset))
-    kept = run_dir + ".json"
-    if os.path.isfile(kept):
-        with open(kept) as f:
-            result = json.load(f)
-        if result.get("gaps") == [float(x) for x in xis] and result.get("tol_lambda") == tol_lambda:
-            return result
+    kept = squeeze.kept_result(run_dir, xis, tol_lambda)
+    if kept is not None:
+        return kept
     squeeze._fresh_run_dir(workdir, os.path.basename(run_dir))
     delta = 1.0 / a_over_delta
     L = L_over_a
@@ -121,9 +118,7 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
         out["W" + k] = np.column_stack([parts[c][sel] for c in ("Wx", "Wy", "Wz")]).tolist()
     out.update(wall_seconds=wall, inner_iterations=[int(n) for n in steps["innerIterations"]],
                converged=bool(steps["converged"].all()), gaps=[float(x) for x in xis], tol_lambda=tol_lambda)
-    with open(kept + ".tmp", "w") as f:
-        json.dump(out, f)
-    os.replace(kept + ".tmp", kept)
+    squeeze.keep_result(run_dir, out)
     return out
 
 

@@ -11,6 +11,7 @@ the velocity toward the wall).
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 import shutil
@@ -41,6 +42,26 @@ def _fresh_run_dir(workdir: str, name: str) -> str:
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
     return run_dir
+
+
+def kept_result(run_dir: str, gaps: Sequence[float], tol_lambda: float) -> dict | None:
+    """The result an earlier call kept as <run_dir>.json for the same gaps and tolerance, else None (a killed
+    calibration resumes where it stopped)."""
+    kept = run_dir + ".json"
+    if os.path.isfile(kept):
+        with open(kept) as f:
+            result = json.load(f)
+        if result.get("gaps") == [float(g) for g in gaps] and result.get("tol_lambda") == tol_lambda:
+            return result
+    return None
+
+
+def keep_result(run_dir: str, result: dict) -> None:
+    """Write `result` as <run_dir>.json, whole or absent (through a temporary file)."""
+    kept = run_dir + ".json"
+    with open(kept + ".tmp", "w") as f:
+        json.dump(result, f)
+    os.replace(kept + ".tmp", kept)
 
 
 def _result(velocity, wall_seconds: float, box, steps) -> dict:

@@ -103,12 +103,9 @@ def run_loaded_sphere(workdir: str, epss: Sequence[float], a_over_delta: float, 
     instead of running again (a killed calibration resumes where it stopped)."""
     force, torque = 6 * math.pi, 8 * math.pi     # eta = a = 1
     run_dir = os.path.join(workdir, "ad%g_L%g_H%g_off%g_%g" % (a_over_delta, L_over_a, H_over_a, *offset))
-    kept = run_dir + ".json"
-    if os.path.isfile(kept):
-        with open(kept) as f:
-            result = json.load(f)
-        if result.get("gaps") == [float(e) for e in epss] and result.get("tol_lambda") == tol_lambda:
-            return result
+    kept = squeeze.kept_result(run_dir, epss, tol_lambda)
+    if kept is not None:
+        return kept
     pair = case.subgrid_pair_style(walls=(("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid=False)
     wall, parts, steps, box = squeeze.run_wall_scene(
         run_dir, epss, a_over_delta, L_over_a, H_over_a, offset, tol_lambda, pair,
@@ -119,9 +116,7 @@ def run_loaded_sphere(workdir: str, epss: Sequence[float], a_over_delta: float, 
     result = dict(U=U.tolist(), W=W.tolist(), wall_seconds=wall, cells=box.n[0] * box.n[1] * box.n[2],
                   inner_iterations=[int(n) for n in steps["innerIterations"]],
                   converged=bool(steps["converged"].all()), gaps=[float(e) for e in epss], tol_lambda=tol_lambda)
-    with open(kept + ".tmp", "w") as f:
-        json.dump(result, f)
-    os.replace(kept + ".tmp", kept)    # whole or absent
+    squeeze.keep_result(run_dir, result)
     return result
 
 
