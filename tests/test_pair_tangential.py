@@ -61,7 +61,7 @@ def shipped():
 def test_shipped_measurements_reanalyse_to_their_corrections(env, shipped):
     # a1/Delta 3 (the suspension runs) and the size ratios of the bidisperse suspension are measured; the
     # kept raw responses give the same corrections again
-    assert {(3.0, 1.0), (3.0, 1.4)} <= {(s["a_over_delta"], s["ratio"]) for s in shipped}
+    assert {(3.0, 1.0), (3.0, 1.4), (4.0, 1.0), (4.0, 1.4)} <= {(s["a_over_delta"], s["ratio"]) for s in shipped}
     for s in shipped[:1]:
         again = pt.summarize(s["ratio"], s["a_over_delta"], s["gaps"], s["boxes"], s["offsets"], s["raw"],
                              s["wall_seconds"])
