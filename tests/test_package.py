@@ -12,8 +12,8 @@ import pytest
 TESTS = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(TESTS)
 MODULES = ("calibration", "case", "checkpoint", "decomposition", "demonly", "environment", "output", "packing",
-           "periodicarray", "poiseuille", "profiles", "rheology", "sbm", "shear", "squeeze", "suspension", "theory",
-           "timeseries", "validation", "wallcalibration")
+           "pairtangential", "periodicarray", "poiseuille", "profiles", "rheology", "sbm", "shear", "squeeze",
+           "suspension", "theory", "timeseries", "validation", "wallcalibration")
 
 
 def clean_environment() -> dict:
