@@ -164,18 +164,9 @@ def theory_matrix(ratio: float, xi: float) -> np.ndarray:
     return R
 
 
-def mode_matrix(r: float) -> np.ndarray:
-    """P (3 x 12): q1, q2 of the transverse direction y and the twist, for d = e_x and separation r."""
-    P = np.zeros((3, 12))
-    P[0, 1], P[0, 7], P[0, 5], P[0, 11] = 1, -1, r / 2, r / 2
-    P[1, 5], P[1, 11] = 1, -1
-    P[2, 3], P[2, 9] = 1, -1
-    return P
-
-
 def theory_mobility(ratio: float, xi: float) -> np.ndarray:
     """[M11, M12, M21, M22, M_twist] of the theory: P R_th^-1 P^T."""
-    P = mode_matrix(separation(ratio, xi))
+    P = mode_matrix(separation(ratio, xi))[[2, 3, 1]]     # q1, q2 along y and the twist
     M = P @ np.linalg.solve(theory_matrix(ratio, xi), P.T)
     return np.array([M[0, 0], M[0, 1], M[1, 0], M[1, 1], M[2, 2]])
 
@@ -191,7 +182,7 @@ def correction(m_th: np.ndarray, m_fdm: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-def full_mode_matrix(r: float) -> np.ndarray:
+def mode_matrix(r: float) -> np.ndarray:
     """P (6 x 12) of all six internal modes for d = e_x: squeeze, twist, and (q1, q2) along y and z."""
     P = np.zeros((6, 12))
     P[0, 0], P[0, 6] = 1, -1                                        # squeeze (U1 - U2).d
@@ -203,14 +194,14 @@ def full_mode_matrix(r: float) -> np.ndarray:
     return P
 
 
-def model_correction(ratio: float, xi: float, delta: float, model: str = "cutoff") -> tuple:
+def model_correction(ratio: float, xi: float, delta: float) -> tuple:
     """([K11, K12, K22, K_twist], residual): the internal-mode matrix K of the sub-grid block the pair
     style builds (`fdmResistance matrix --delta`, the cut-off model) at xi, and |R_SG - P^T K P| / |R_SG|,
     which is zero (to rounding) when the block acts on the internal modes only."""
     r = separation(ratio, xi)
     R = np.array(theory.resistance("matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % r, 0, 0, "--a1", 1, "--a2", ratio,
                                    "--delta", "%.17g" % delta)["R"])
-    P = full_mode_matrix(r)
+    P = mode_matrix(r)
     G = np.linalg.inv(P @ P.T)
     K = G @ P @ R @ P.T @ G
     residual = float(np.linalg.norm(R - P.T @ K @ P) / max(np.linalg.norm(R), 1e-300))
