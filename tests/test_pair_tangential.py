@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import PROJECT
-from fdmsubgrid import pairtangential as pt
+from fdmsubgrid import pairtangential as pt, squeeze
 
 SHIPPED = os.path.join(PROJECT, "dem", "resistance", "data", "pair_tangential_calibration.json")
 
@@ -72,7 +72,8 @@ def test_solver_resolves_the_twist_and_more_sliding_than_the_cutoff_model_assume
     """What the measurement shows (docs/resistance.md, "Tangential pair measurement"): the solver's twist
     mobility is the theory's within 3 % at every gap (the cut-off model adds up to 1.1-1.8 eta a1^3 of
     twist resistance), and near contact the sliding correction it needs is below the cut-off model's by a
-    constant (it resolves sliding down to a smaller gap), while the rolling one is the cut-off model's."""
+    constant (it resolves sliding down to a smaller gap), while the rolling one is near the cut-off model's
+    (within 2 % at a1/Delta 3 and 4, 3-14 % below it at 5)."""
     for s in shipped:
         xi = np.array(s["gaps"])
         fdm, th = np.array(s["mobility_fdm"]), np.array(s["mobility_theory"])
@@ -80,4 +81,89 @@ def test_solver_resolves_the_twist_and_more_sliding_than_the_cutoff_model_assume
         k, cut = np.array(s["correction"]), np.array(s["cutoff_correction"])
         near = xi <= 1e-2
         assert np.all(cut[near, 0] - k[near, 0] > 1.0), (s["a_over_delta"], s["ratio"])
-        assert np.all(np.abs(k[near, 2] - cut[near, 2]) < 0.1 * cut[near, 2]), (s["a_over_delta"], s["ratio"])
+        assert np.all(np.abs(k[near, 2] - cut[near, 2]) < 0.15 * cut[near, 2]), (s["a_over_delta"], s["ratio"])
+
+
+def test_shipped_fits_follow_the_seen_gap_and_reproduce_the_measurements(shipped):
+    """The seen-gap fits R_FDM(xi) = R_th((xi^p + xi_c^p)^(1/p)) of the sliding and rolling resistance:
+    within 3 % of the measured values at every gap (relative to the theory's scale), and the surface gap
+    the solver stops seeing is 0.3-0.4 cell at every a1/Delta and both size ratios."""
+    assert {(3.0, 1.0), (3.0, 1.4), (4.0, 1.0), (4.0, 1.4), (5.0, 1.0), (5.0, 1.4)} <= {
+        (s["a_over_delta"], s["ratio"]) for s in shipped}
+    for s in shipped:
+        fits = {f["element"]: f for f in s["fits"]}
+        for name in pt.ELEMENTS:
+            assert fits[name]["rms"] < 0.02 and fits[name]["max"] < 0.03, (s["a_over_delta"], s["ratio"], name)
+        for name in ("K11", "K22"):
+            cells = fits[name]["xi_c"] * (1 + s["ratio"]) / 2 * s["a_over_delta"]     # surface gap / Delta
+            assert 0.25 < cells < 0.45, (s["a_over_delta"], s["ratio"], name, cells)
+        assert s["clipped_rows"] == 0
+        if s["ratio"] == 1:
+            assert fits["K12"].get("symmetric_zero")
+
+
+def _table_blocks(path):
+    """{(kind, a1/Delta, ratio): (xi, xi*K)} of the pair_K blocks of a calibration table."""
+    blocks, rows, key = {}, 0, None
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            words = line.split()
+            if rows == 0:
+                key, rows = (words[0], float(words[1]), float(words[2])), int(words[3])
+                blocks[key] = []
+                continue
+            blocks[key].append((float(words[0]), float(words[1])))
+            rows -= 1
+    return {k: np.array(v) for k, v in blocks.items() if k[0].startswith("pair_K")}
+
+
+def test_shipped_table_holds_the_measured_corrections(shipped):
+    # the C++ model reads these rows (linear in ln xi of xi K): at the measured gaps below the taper they
+    # give the measured K within 4 % of the theory's internal resistance (sqrt(R11 R22) for K12)
+    blocks = _table_blocks(os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat"))
+    for s in shipped:
+        xi = np.array(s["gaps"])
+        use = xi <= 0.3
+        measured = np.array(s["correction"])[use]
+        th = pt.internal_resistance(np.array(s["mobility_theory"]))[use]
+        scale = np.column_stack([th[:, 0], np.sqrt(th[:, 0] * th[:, 2]), th[:, 2], th[:, 3]])
+        for j, name in enumerate(pt.ELEMENTS):
+            rows = blocks[("pair_" + name, s["a_over_delta"], s["ratio"])]
+            table = np.interp(np.log(xi[use]), np.log(rows[:, 0]), rows[:, 1]) / xi[use]
+            err = np.abs(table - measured[:, j]) / scale[:, j]
+            assert np.all(err < 0.04), (s["a_over_delta"], s["ratio"], name, err.max())
+
+
+def test_dissipation_rule_keeps_what_the_theory_allows_and_clips_beyond():
+    r_th = np.array([10.0, -2.0, 12.0, 1.0])
+    kept, changed = pt.dissipative(np.array([-3.0, 1.0, 2.0, -0.5]), r_th)     # indefinite alone, allowed
+    assert not changed and np.allclose(kept, [-3.0, 1.0, 2.0, -0.5])
+    clipped, changed = pt.dissipative(np.array([-12.0, 30.0, 2.0, -2.0]), r_th)
+    assert changed
+    total = np.array([[r_th[0] + clipped[0], r_th[1] + clipped[1]], [r_th[1] + clipped[1], r_th[2] + clipped[2]]])
+    assert np.linalg.eigvalsh(total).min() > -1e-12 and r_th[3] + clipped[3] >= 0
+    assert r_th[1] + clipped[1] >= 0        # the coupling's sign kept
+
+
+def test_calibrated_model_brings_sliding_and_twist_to_the_theory(env, tmp_path, shipped):
+    """The coupled solver with `model calibrated` against the theory, at a position in the cell the
+    calibration did not use (a2/a1 = 1.4, a1/Delta 3, L = 8 a1 with the shipped box correction): sliding,
+    rolling and twist mobilities within 4.5 % at xi = 0.05, 0.01, 1e-3 (measured: 3.0 %), where the cut-off
+    model leaves sliding 7-10 % and the twist 5-8 % too slow (docs/validation.md, "Tangential pair
+    calibration")."""
+    gaps, offset, ratio = [0.05, 0.01, 1e-3], (0.23, 0.57, 0.71), 1.4
+    s = next(x for x in shipped if x["a_over_delta"] == 3.0 and x["ratio"] == ratio)
+    rows = [s["gaps"].index(g) for g in gaps]
+    first = {L: pt.internal_mobility(s["raw"][L][0], ratio) for L in ("8", "12")}
+    box = (squeeze.extrapolate_box(first["8"], first["12"], 8.0, 12.0) - first["8"])[rows]   # M_inf - M(L = 8)
+    th = np.array([pt.theory_mobility(ratio, xi) for xi in gaps])
+    errors = {}
+    for model in ("calibrated", "cutoff"):
+        res = pt.run_loaded_pair(str(tmp_path), ratio, gaps, 3.0, 8.0, offset, model=model)
+        assert res["converged"]
+        m = pt.internal_mobility(res, ratio) + box
+        errors[model] = m[:, [0, 3, 4]] / th[:, [0, 3, 4]] - 1
+    assert np.all(np.abs(errors["calibrated"]) < 0.045), errors["calibrated"]
+    assert np.all(errors["cutoff"][:, 0] < -0.06) and np.all(errors["cutoff"][:, 2] < -0.04), errors["cutoff"]

@@ -38,10 +38,13 @@ logarithmic grid from 1e-5 to xi_max (xi * s_hat is smooth at both ends: it tend
 lubrication coefficient as xi -> 0 and to 0 at xi_max; linear interpolation in ln xi). The table also
 holds the tangential wall functions (kinds wall_YA, wall_YB, wall_YC, wall_XC) that
 wallcalibration.py measures: `--tangential` runs them, `--tangential-from-raw` takes them from an
-earlier run. Beside the table: its squeeze measurements (squeeze_calibration.json), the tangential
-ones (wall_tangential_calibration.json) and a figure of each (.png).
+earlier run; and the pair's other internal modes (kinds pair_K11, pair_K12, pair_K22, pair_Ktw: sliding,
+sliding-rolling coupling, rolling, twist) that pairtangential.py measures: `--pair-tangential` runs them,
+`--pair-tangential-from-raw` takes them from earlier runs. Beside the table: its squeeze measurements
+(squeeze_calibration.json), the tangential ones (wall_tangential_calibration.json,
+pair_tangential_calibration.json) and a figure of each (.png).
 
-    python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --tangential --out dem/resistance/data/subgrid_calibration.dat
+    python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --tangential --pair-tangential --out dem/resistance/data/subgrid_calibration.dat
 """
 from __future__ import annotations
 
@@ -57,7 +60,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import squeeze, theory, wallcalibration
+from . import pairtangential, squeeze, theory, wallcalibration
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
 # positions of the gap centre inside its mesh cell (fractions of Delta)
@@ -201,7 +204,8 @@ def project_relative(path: str) -> str:
     return os.path.relpath(full, root) if full.startswith(root + os.sep) else full
 
 
-def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str, tangential: bool = False) -> str:
+def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str, tangential: bool = False,
+                       pair_tangential: bool = False) -> str:
     """The one command that measures and analyses these calibrations again."""
     ads = sorted({c.a_over_delta for c in calibrations})
     ratios = sorted({c.ratio for c in calibrations if c.kind == "pair"})
@@ -214,14 +218,18 @@ def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str, tan
     words += ["--boxes"] + ["%g" % L for L in c0.boxes] + ["--offsets", str(n_offsets)]
     if tangential:
         words.append("--tangential")
+    if pair_tangential:
+        words.append("--pair-tangential")
     return " ".join(words + ["--out", out])
 
 
 def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Sequence[Dict],
-                tables: Sequence[List[tuple]], command: str, tangential: Sequence[Dict] = ()) -> None:
+                tables: Sequence[List[tuple]], command: str, tangential: Sequence[Dict] = (),
+                pair_tangential: Sequence[Dict] = ()) -> None:
     """The text table CalibratedSubgridModel reads (dem/resistance/src/subgrid_calibration.cpp): per
     calibration its fit and its rows (SqueezeCalibration.fit, .table), then the tangential wall blocks
-    of the wallcalibration summaries `tangential`."""
+    of the wallcalibration summaries `tangential` and the pair blocks of the pairtangential summaries
+    `pair_tangential` (with their fits and rows: pairtangential.add_fits)."""
     with open(path, "w") as f:
         f.write("# Sub-grid calibration of the fictitious-domain solver (paper Appendix B; docs/resistance.md)\n")
         f.write("# pair, wall: s_hat(xi) = 1/V_th - 1/V_FDM, the squeeze resistance the sub-grid block adds, in units\n")
@@ -230,10 +238,14 @@ def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Seq
         f.write("# wall_YA, wall_YB, wall_YC, wall_XC (scripts/fdmsubgrid/wallcalibration.py): s_hat the sub-grid\n")
         f.write("# function in Kim-Karrila units (6 pi a, 4 pi a^2, 8 pi a^3, 8 pi a^3; d into the wall);\n")
         f.write("# header: kind a/Delta 1 rows f_0 eps_c p fit_rms; rows: eps  eps*s_hat\n")
-        f.write("# Regenerate: %s\n" % regenerate_command(calibrations, project_relative(path), bool(tangential)))
+        f.write("# pair_K11, pair_K12, pair_K22, pair_Ktw (scripts/fdmsubgrid/pairtangential.py): K on the pair's\n")
+        f.write("# internal modes (sliding q1, rolling q2, twist) in units of eta a1, eta a1^2, eta a1^3, eta a1^3, for\n")
+        f.write("# sphere 1 the smaller one; header: kind a1/Delta a2/a1 rows xi_c p fit_rms; rows: xi  xi*K\n")
+        f.write("# Regenerate: %s\n" % regenerate_command(calibrations, project_relative(path), bool(tangential),
+                                                        bool(pair_tangential)))
         if "from-raw" in command:
             f.write("# (this file was analysed from the measurements kept by earlier calls: --from-raw, "
-                    "--tangential-from-raw)\n")
+                    "--tangential-from-raw, --pair-tangential-from-raw)\n")
         for c, fit, rows in zip(calibrations, fits, tables):
             write_block(f, c, fit, rows)
         for t in tangential:
@@ -244,6 +256,13 @@ def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Seq
                                                                    fit["f_0"], fit["eps_c"], fit["p"], fit["rms"]))
                 for eps, v in blocks[name]:
                     f.write("%.8e %.8e\n" % (eps, v))
+        for t in pair_tangential:
+            for fit in t["fits"]:
+                rows = t["table"][fit["element"]]
+                f.write("pair_%s %.6g %.6g %d %.6g %.6g %.4g\n" % (fit["element"], t["a_over_delta"], t["ratio"],
+                                                                len(rows), fit["xi_c"], fit["p"], fit["rms"]))
+                for xi, v in rows:
+                    f.write("%.8e %.8e\n" % (xi, v))
 
 
 def write_block(f, c: SqueezeCalibration, fit: Dict[str, float], rows: List[tuple]) -> None:
@@ -312,6 +331,10 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                    "(wallcalibration.py) at every --a-over-delta")
     p.add_argument("--tangential-from-raw", metavar="JSON", help="the tangential wall measurements of an earlier "
                    "run (wall_tangential_calibration.json beside a table, or wallcalibration --out)")
+    p.add_argument("--pair-tangential", action="store_true", help="also measure the pairs' sliding, rolling and "
+                   "twist (pairtangential.py) at every --a-over-delta and --ratios")
+    p.add_argument("--pair-tangential-from-raw", metavar="JSON", nargs="+", help="the tangential pair measurements "
+                   "of earlier runs (pair_tangential_calibration.json beside a table, or pairtangential --out)")
     args = p.parse_args(argv)
     if any(r < 1 for r in args.ratios):
         p.error("--ratios: a2/a1 must be >= 1 (a pair 1/1.4 is the pair 1.4 seen from the other sphere)")
@@ -350,8 +373,28 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                 ad, args.workdir, offsets=wallcalibration.OFFSETS[:args.offsets])))
             with open(os.path.join(args.workdir, "wall_tangential.json"), "w") as f:   # kept before the table
                 json.dump(tangential, f)
+    pair_tangential: List[Dict] = []
+    if args.pair_tangential_from_raw:
+        for path in args.pair_tangential_from_raw:
+            with open(path) as f:
+                pair_tangential += [pairtangential.summarize(s["ratio"], s["a_over_delta"], s["gaps"], s["boxes"],
+                                                             s["offsets"], s["raw"], s["wall_seconds"])
+                                    for s in json.load(f)]
+    elif args.pair_tangential:
+        for ad in args.a_over_delta:
+            for ratio in args.ratios:
+                pair_tangential.append(pairtangential.measure(ratio, ad, args.workdir,
+                                                              offsets=pairtangential.OFFSETS[:args.offsets]))
+                with open(os.path.join(args.workdir, "pair_tangential.json"), "w") as f:   # kept before the table
+                    json.dump(pair_tangential, f)
+    pair_tangential = [pairtangential.add_fits(s) for s in pair_tangential]
     command = "python3 -m fdmsubgrid.calibration " + " ".join(argv if argv is not None else sys.argv[1:])
-    write_table(args.out, cals, fits, tables, command, tangential)
+    write_table(args.out, cals, fits, tables, command, tangential, pair_tangential)
+    if pair_tangential:
+        p_path = os.path.join(os.path.dirname(os.path.abspath(args.out)), "pair_tangential_calibration.json")
+        with open(p_path, "w") as f:
+            json.dump(pair_tangential, f, indent=1)
+        pairtangential.plot(os.path.splitext(p_path)[0] + ".png", pair_tangential)
     if tangential:
         t_path = os.path.join(os.path.dirname(os.path.abspath(args.out)), "wall_tangential_calibration.json")
         with open(t_path, "w") as f:

@@ -1,7 +1,9 @@
 """The solver's own tangential pair resistance (paper section 2.2 and Appendix B): what fdmFoam resolves of
 the internal modes of two spheres other than the squeeze, and the sub-grid correction R_SG = R_th - R_FDM
 that would make the coupled resistance the theory's. The squeeze is calibrated by calibration.py; the wall
-functions by wallcalibration.py. This module measures; the sub-grid model does not use its output yet.
+functions by wallcalibration.py. This module measures the pair's other internal modes, fits them and
+writes the rows of the table's pair_K11, pair_K12, pair_K22 and pair_Ktw blocks (calibration.py
+--pair-tangential puts them in the table CalibratedSubgridModel reads).
 
 The internal modes. With Appendix C.2's relations the pair's sub-grid block is R_SG = P^T K P exactly, K
 acting on six internal modes (checked with the resistance library to 1e-15; docs/resistance.md): for the
@@ -31,6 +33,7 @@ decays like a force dipole's, as the squeeze's).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import os
@@ -80,13 +83,16 @@ def _load_lines(r: float) -> List[str]:
 
 
 def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_delta: float, L_over_a: float,
-                    offset: Sequence[float], tol_lambda: float = 1e-5, np_fluid: int = 1, keep: bool = False) -> dict:
+                    offset: Sequence[float], tol_lambda: float = 1e-5, np_fluid: int = 1, keep: bool = False,
+                    model: str | None = None) -> dict:
     """The loaded pair at the gaps `xis` (largest first, each one coupled step warm-started from the
     previous) in a periodic cube of side L_over_a a1; returns dict(U1, W1, U2, W2: per gap [x, y, z],
     wall_seconds, inner_iterations, converged). The torques' moment arm r/2 changes with the gap: the
     fixes are redefined before each step. Kept as <run folder>.json: a later call with the same scene and
-    gaps reads it (a killed measurement resumes)."""
-    run_dir = os.path.join(workdir, "lambda%g_ad%g_L%g_off%g_%g_%g" % (ratio, a_over_delta, L_over_a, *offset))
+    gaps reads it (a killed measurement resumes). `model` None: the solver alone (lubrication off, the
+    measurement); 'calibrated' or 'cutoff': the coupled solver with that sub-grid model (the validation)."""
+    run_dir = os.path.join(workdir, "lambda%g_ad%g_L%g_off%g_%g_%g" % (ratio, a_over_delta, L_over_a, *offset)
+                           + ("" if model is None else "_" + model))
     kept = squeeze.kept_result(run_dir, xis, tol_lambda)
     if kept is not None:
         return kept
@@ -107,7 +113,7 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
         runs.append("run             1")
     p1, p2 = centres(ratio, xis[0], centre)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
-                         pair_style="fdm/subgrid lubrication no",
+                         pair_style="fdm/subgrid " + ("lubrication no" if model is None else "model " + model),
                          before_run="group           one id 1\ngroup           two id 2", runs=runs,
                          name="in.pairTangential")
     wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
@@ -171,15 +177,20 @@ def theory_mobility(ratio: float, xi: float) -> np.ndarray:
     return np.array([M[0, 0], M[0, 1], M[1, 0], M[1, 1], M[2, 2]])
 
 
+def internal_resistance(m: np.ndarray) -> np.ndarray:
+    """Per row of [M11, M12, M21, M22, M_twist] the internal resistance [R11, R12, R22, R_twist]: the
+    inverse of the symmetrised 2 x 2 (the solver's operator need not be exactly reciprocal) and 1/M_twist."""
+    out = []
+    for m_row in np.atleast_2d(m):
+        off = 0.5 * (m_row[1] + m_row[2])
+        r = np.linalg.inv(np.array([[m_row[0], off], [off, m_row[3]]]))
+        out.append([r[0, 0], r[0, 1], r[1, 1], 1 / m_row[4]])
+    return np.array(out)
+
+
 def correction(m_th: np.ndarray, m_fdm: np.ndarray) -> np.ndarray:
     """K = M_th^-1 - M_FDM^-1 on the internal modes: [K11, K12, K22, K_twist] (the 2 x 2 symmetrised)."""
-    out = []
-    for th, fdm in zip(np.atleast_2d(m_th), np.atleast_2d(m_fdm)):
-        a = np.array([[th[0], 0.5 * (th[1] + th[2])], [0.5 * (th[1] + th[2]), th[3]]])
-        b = np.array([[fdm[0], 0.5 * (fdm[1] + fdm[2])], [0.5 * (fdm[1] + fdm[2]), fdm[3]]])
-        k = np.linalg.inv(a) - np.linalg.inv(b)
-        out.append([k[0, 0], k[0, 1], k[1, 1], 1 / th[4] - 1 / fdm[4]])
-    return np.array(out)
+    return internal_resistance(m_th) - internal_resistance(m_fdm)
 
 
 def mode_matrix(r: float) -> np.ndarray:
@@ -248,6 +259,120 @@ def summarize(ratio: float, a_over_delta: float, gaps: List[float], boxes: List[
                 wall_seconds=wall_seconds)
 
 
+ELEMENTS = ("K11", "K12", "K22", "Ktw")   # the table's kinds are pair_K11, ...: sliding, coupling, rolling, twist
+SCALE_POWER = (1, 2, 3, 3)               # K in eta a1^n (a1 the smaller sphere)
+
+
+@functools.lru_cache(maxsize=None)
+def _theory_resistance_splines(ratio: float) -> tuple:
+    """The theory's [R11, R12, R22, R_twist] as cubic splines in ln xi, xi = 1e-6 ... 3 (36 gaps: one
+    `fdmResistance pair --full` call each, about 1.4 s)."""
+    from scipy.interpolate import CubicSpline
+    xis = np.logspace(-6, math.log10(3.0), 36)
+    r = internal_resistance(np.array([theory_mobility(ratio, float("%.6g" % x)) for x in xis]))
+    return tuple(CubicSpline(np.log(xis), r[:, j]) for j in range(4))
+
+
+def theory_resistance(ratio: float, xi) -> np.ndarray:
+    """[R11, R12, R22, R_twist] of the theory at xi (1e-6 ... 3; any shape, the elements last)."""
+    t = np.log(np.asarray(xi, dtype=float))
+    return np.stack([s(t) for s in _theory_resistance_splines(ratio)], axis=-1)
+
+
+def seen_gap(xi, xi_c: float, p: float):
+    """The gap the solver sees: (xi^p + xi_c^p)^(1/p)."""
+    return (np.asarray(xi, dtype=float) ** p + xi_c ** p) ** (1 / p)
+
+
+def fit_elements(summary: Dict) -> List[Dict[str, float]]:
+    """Per element of the internal resistance (R11, R12, R22, R_twist) the seen-gap fit
+    R_FDM(xi) = R_th(seen_gap(xi, xi_c, p)) through the measured (box-extrapolated, offset-averaged) one,
+    least squares relative to the theory's scale (|R_th|; sqrt(R11 R22) for R12). The solver's sliding and
+    rolling resistance is the theory's at a gap no smaller than about 0.3 cell (docs/resistance.md). For
+    equal spheres R12 is zero by symmetry in both: its fit is the theory's (xi_c = 0)."""
+    from scipy.optimize import least_squares
+    ratio, xi = summary["ratio"], np.asarray(summary["gaps"], dtype=float)
+    fdm = internal_resistance(np.array(summary["mobility_fdm"]))
+    th = internal_resistance(np.array(summary["mobility_theory"]))
+    fits = []
+    for j, name in enumerate(ELEMENTS):
+        scale = np.sqrt(th[:, 0] * th[:, 2]) if j == 1 else np.abs(th[:, j])
+        if j == 1 and ratio == 1:
+            fits.append(dict(element=name, xi_c=0.0, p=1.0, rms=0.0, max=0.0, symmetric_zero=True))
+            continue
+
+        def residual(q: np.ndarray, j: int = j, scale: np.ndarray = scale) -> np.ndarray:
+            return (theory_resistance(ratio, seen_gap(xi, 10 ** q[0], q[1]))[:, j] - fdm[:, j]) / scale
+
+        sol = min((least_squares(residual, x0=[x0, 2.0], bounds=([-4, 0.5], [0.5, 8])) for x0 in (-2, -1, -0.3)),
+                  key=lambda r: r.cost)
+        fits.append(dict(element=name, xi_c=10 ** float(sol.x[0]), p=float(sol.x[1]),
+                         rms=float(np.sqrt(np.mean(sol.fun ** 2))), max=float(np.max(np.abs(sol.fun)))))
+    return fits
+
+
+def dissipative(k: np.ndarray, r_th: np.ndarray) -> tuple:
+    """The dissipation rule on one gap's [K11, K12, K22, K_twist]: R_th + K positive semi-definite on the
+    internal modes (K11, K22, K_twist at least minus the theory's; |R12_th + K12| at most the geometric
+    mean of the diagonals, its sign kept). Returns (K after the rule, whether it changed anything)."""
+    out = np.array(k, dtype=float)
+    for j in (0, 2, 3):
+        out[j] = max(out[j], -r_th[j])
+    bound = math.sqrt((r_th[0] + out[0]) * (r_th[2] + out[2]))
+    coupling = r_th[1] + out[1]
+    out[1] = math.copysign(min(abs(coupling), bound), coupling) - r_th[1]
+    return out, bool(np.any(np.abs(out - k) > 1e-12 * (1 + np.abs(k))))
+
+
+def table_blocks(ratio: float, fits: Sequence[Dict[str, float]], min_gap: float = 1e-5, per_decade: int = 20,
+                 taper_start: float = 0.5, taper_end: float = 1.0) -> tuple:
+    """({element: rows (xi, xi K)}, clipped rows) from min_gap to taper_end (the last row 0): K = R_th(xi) -
+    R_FDM(xi) of the fits, through the dissipation rule, tapered to zero between taper_start and taper_end
+    linearly in ln xi (as the squeeze and wall blocks)."""
+    n = int(round(per_decade * math.log10(taper_end / min_gap)))
+    xis = np.array([min_gap * 10 ** (k / per_decade) for k in range(n + 1)])
+    r_th = theory_resistance(ratio, xis)
+    r_fdm = np.column_stack([theory_resistance(ratio, seen_gap(xis, f["xi_c"], f["p"]))[:, j]
+                             for j, f in enumerate(fits)])
+    rows: Dict[str, List[tuple]] = {name: [] for name in ELEMENTS}
+    clipped = 0
+    for k, xi in enumerate(xis):
+        t = 1.0 if xi <= taper_start else max(0.0, math.log(taper_end / xi) / math.log(taper_end / taper_start))
+        values, changed = dissipative(r_th[k] - r_fdm[k], r_th[k])
+        clipped += changed
+        for j, name in enumerate(ELEMENTS):
+            rows[name].append((float(xi), 0.0 if k == n else float(xi * values[j] * t)))
+    return rows, clipped
+
+
+def add_fits(summary: Dict) -> Dict:
+    """The summary with its fits and table rows (what calibration.py writes as the pair_K.. blocks)."""
+    fits = fit_elements(summary)
+    rows, clipped = table_blocks(summary["ratio"], fits)
+    return dict(summary, fits=fits, table=rows, clipped_rows=clipped)
+
+
+def validate(ratio: float, a_over_delta: float, workdir: str, model: str, gaps: Sequence[float] = GAPS,
+             boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS[:1],
+             tol_lambda: float = 1e-5) -> Dict:
+    """The coupled solver with the sub-grid `model` on, loaded as in the measurement, in both boxes
+    (extrapolated the same way) at `offsets`: per gap the internal mobilities [M11, M12, M21, M22, M_twist]
+    and the errors of sliding, rolling and twist against the theory, M/M_th - 1."""
+    by_box = {}
+    for k, L in enumerate(boxes):
+        runs = [run_loaded_pair(workdir, ratio, gaps, a_over_delta, L, off, tol_lambda, model=model)
+                for off in (offsets if k == 0 else offsets[:1])]
+        if not all(r["converged"] for r in runs):
+            raise RuntimeError("pair tangential validation: a step did not converge (ratio %g, L %g)" % (ratio, L))
+        by_box[L] = [internal_mobility(r, ratio) for r in runs]
+    L1, L2 = boxes
+    m = np.mean(by_box[L1], axis=0) + squeeze.extrapolate_box(by_box[L1][0], by_box[L2][0], L1, L2) - by_box[L1][0]
+    th = np.array([theory_mobility(ratio, xi) for xi in gaps])
+    errors = m[:, [0, 3, 4]] / th[:, [0, 3, 4]] - 1
+    return dict(ratio=ratio, a_over_delta=a_over_delta, model=model, gaps=list(gaps), offsets=[list(o) for o in offsets],
+                mobility=m.tolist(), mobility_theory=th.tolist(), errors=errors.tolist())
+
+
 def plot(path: str, summaries: Sequence[Dict]) -> None:
     """Like the paper's Fig. B.24 for the tangential internal modes: the solver's mobility over the
     theory's (sliding q1, rolling q2, twist) per box and extrapolated, and the correction K the solver
@@ -275,6 +400,10 @@ def plot(path: str, summaries: Sequence[Dict]) -> None:
                            (1, "K12", "C3")):
             right.semilogx(xi, k[:, j], "^-", color=c, label=name + " measured")
             right.semilogx(xi, cut[:, j], "--", color=c, label="cut-off model")
+            if "table" in s:
+                rows = np.array(s["table"][ELEMENTS[j]])
+                right.semilogx(rows[:, 0], rows[:, 1] / rows[:, 0], "-", color=c, lw=0.8, alpha=0.7,
+                               label="table (seen-gap fit)")
         right.axhline(0, color="k", lw=0.8)
         right.set_xlabel(r"$\xi$")
         right.set_ylabel("K (η a1, η a1², η a1³)")
@@ -295,8 +424,26 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p.add_argument("--workdir", default="pair_tangential_runs")
     p.add_argument("--out", required=True, help="JSON of every measurement and the corrections (a .png beside)")
     p.add_argument("--from-raw", metavar="JSON", nargs="+", help="analyse the measurements earlier calls kept (--out)")
+    p.add_argument("--validate", choices=["calibrated", "cutoff"], help="run the coupled solver with this sub-grid "
+                   "model instead of measuring, and print its errors against the theory (--out: their JSON)")
+    p.add_argument("--offset", type=float, nargs=3, action="append", metavar=("X", "Y", "Z"),
+                   help="with --validate: a position of the gap centre in its cell (fractions of Delta; repeat for "
+                   "several) instead of the first --offsets of the calibration's")
     args = p.parse_args(argv)
     out = []
+    if args.validate:
+        os.makedirs(args.workdir, exist_ok=True)
+        for ratio in args.ratio:
+            out.append(validate(ratio, args.a_over_delta, args.workdir, args.validate, args.gaps, args.boxes,
+                                args.offset or OFFSETS[:args.offsets], args.tol_lambda))
+            with open(args.out, "w") as f:
+                json.dump(out, f, indent=1)
+        for v in out:
+            print("%s model, ratio %g, a1/Delta %g, %d positions: xi, M/M_th - 1 of sliding, rolling, twist"
+                  % (v["model"], v["ratio"], v["a_over_delta"], len(v["offsets"])))
+            for xi, e in zip(v["gaps"], v["errors"]):
+                print("  %8.2g  %+7.2f%% %+7.2f%% %+7.2f%%" % (xi, *(100 * np.array(e))))
+        return out
     if args.from_raw:
         for path in args.from_raw:
             with open(path) as f:
@@ -309,6 +456,7 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                                args.tol_lambda))
             with open(args.out, "w") as f:
                 json.dump(out, f, indent=1)
+    out = [add_fits(s) for s in out]
     with open(args.out, "w") as f:
         json.dump(out, f, indent=1)
     plot(os.path.splitext(args.out)[0] + ".png", out)
@@ -321,6 +469,9 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
             print("  %8.2g  %7.4f %7.4f %7.4f %+7.4f   %9.4g %9.4g %9.4g %9.4g   [%.4g %.4g %.4g %.4g]"
                   % (xi, f[0] / t[0], f[3] / t[3], f[4] / t[4], (0.5 * (f[1] + f[2]) - t[1]) / np.sqrt(t[0] * t[3]),
                      *k, *cut))
+        print("  seen-gap fits (xi_c in cells, p, rms, max): " + "; ".join(
+            "%s %.2f %.2f %.1f%% %.1f%%" % (f["element"], f["xi_c"] * s["a_over_delta"], f["p"], 100 * f["rms"],
+                                          100 * f["max"]) for f in s["fits"]) + "; clipped rows %d" % s["clipped_rows"])
     return out
 
 

@@ -27,7 +27,8 @@ std::string num(double x)
     return os.str();
 }
 
-const char* const functionNames[NumCalibratedFunctions] = {"pair", "wall", "wall_YA", "wall_YB", "wall_YC", "wall_XC"};
+const char* const functionNames[NumCalibratedFunctions] = {"pair",    "wall",    "wall_YA", "wall_YB",  "wall_YC",
+                                                           "wall_XC", "pair_K11", "pair_K12", "pair_K22", "pair_Ktw"};
 
 bool parseFunction(const std::string& kind, CalibratedFunction* f)
 {
@@ -46,10 +47,9 @@ bool signedFunction(CalibratedFunction f) { return f != PairSqueeze && f != Wall
 
 const char* calibratedFunctionName(CalibratedFunction f) { return functionNames[f]; }
 
-double SubgridCalibration::Block::sHat(double xi) const
+double SubgridCalibration::Block::sHatAt(double t, double xi) const
 {
     if (logXi.empty()) return 0;
-    const double t = std::log(std::max(xi, 1e-300));
     if (!(t < logXi.back())) return 0;
     if (t <= logXi.front()) return xiS.front() / xi;  // below the table: the leading 1/xi lubrication
     const size_t k = size_t(std::upper_bound(logXi.begin(), logXi.end(), t) - logXi.begin());
@@ -79,8 +79,9 @@ SubgridCalibration SubgridCalibration::read(const std::string& path)
             CalibratedFunction function;
             if (!(words >> kind >> aOverDelta >> ratio >> rows) || !parseFunction(kind, &function) ||
                 !(aOverDelta > 0) || !(ratio >= 1) || rows < 2)
-                throw std::runtime_error(where + "expected a block header 'pair|wall|wall_YA|wall_YB|wall_YC|wall_XC "
-                                         "a/Delta ratio(>=1) rows(>=2) ...', got '" + line + "'");
+                throw std::runtime_error(where + "expected a block header 'pair|wall|wall_YA|wall_YB|wall_YC|wall_XC|"
+                                         "pair_K11|pair_K12|pair_K22|pair_Ktw a/Delta ratio(>=1) rows(>=2) ...', "
+                                         "got '" + line + "'");
             Block b;
             b.function = function;
             b.aOverDelta = aOverDelta;
@@ -226,7 +227,36 @@ double SubgridCalibration::wallSHat(double a, double delta, double eps) const
 double SubgridCalibration::pairRange(double a1, double a2, double delta) const
 {
     const double small = std::min(a1, a2);
-    return stencil(PairSqueeze, small / delta, std::max(a1, a2) / small).xiMax;
+    double range = 0;
+    for (int f = 0; f < NumCalibratedFunctions; ++f)
+        if (isPairFunction(CalibratedFunction(f)))
+            range = std::max(range, stencil(CalibratedFunction(f), small / delta, std::max(a1, a2) / small).xiMax);
+    return range;
+}
+
+bool SubgridCalibration::pairInternalCorrection(double a1, double a2, double delta, double xi, double K[4]) const
+{
+    const double small = std::min(a1, a2), large = std::max(a1, a2);
+    LastInternal& last = lastInternal_;
+    if (last.small != small || last.large != large || last.delta != delta) {
+        const CalibratedFunction elements[4] = {PairSliding, PairSlidingRolling, PairRolling, PairTwist};
+        for (int j = 0; j < 4; ++j) last.st[j] = &stencil(elements[j], small / delta, large / small);
+        last.small = small;
+        last.large = large;
+        last.delta = delta;
+    }
+    const double t = std::log(std::max(xi, 1e-300));
+    const double scale[4] = {small, small * small, small * small * small, small * small * small};  // eta a1^n
+    for (int j = 0; j < 4; ++j) {
+        const Stencil& st = *last.st[j];
+        if (!st.covered) return false;
+        double k = 0;
+        for (int i = 0; i < st.n; ++i) k += st.weight[i] * st.block[i]->sHatAt(t, xi);
+        K[j] = k * scale[j];
+    }
+    // measured with sphere 1 the smaller: relabelling turns q1 into -q1 and keeps q2
+    if (a1 > a2) K[1] = -K[1];
+    return true;
 }
 
 double SubgridCalibration::wallRange(double a, double delta) const
@@ -255,15 +285,16 @@ std::string SubgridCalibration::coverage() const
 {
     std::string out;
     for (int f = 0; f < NumCalibratedFunctions; ++f) {
-        const bool pair = (f == PairSqueeze);
+        const bool pair = isPairFunction(CalibratedFunction(f));
         std::string list;
         for (const Block& b : blocks_)
             if (b.function == f)
                 list += (list.empty() ? "" : ", ") + std::string("(") + num(b.aOverDelta) +
                         (pair ? ", " + num(b.ratio) : "") + ")";
-        if (list.empty() && f > WallSqueeze) continue;  // the tangential wall functions are optional
-        const std::string what = pair ? "pairs (a1/Delta, a2/a1) "
-                                      : (f == WallSqueeze ? "walls a/Delta " : std::string(functionNames[f]) + " a/Delta ");
+        if (list.empty() && f > WallSqueeze) continue;  // the tangential wall and pair functions are optional
+        const std::string what = f == PairSqueeze ? "pairs (a1/Delta, a2/a1) "
+                                 : f == WallSqueeze ? "walls a/Delta "
+                                 : std::string(functionNames[f]) + (pair ? " (a1/Delta, a2/a1) " : " a/Delta ");
         out += (out.empty() ? "" : "; ") + what + (list.empty() ? "none" : list);
     }
     return out;
@@ -275,9 +306,9 @@ CalibratedSubgridModel::CalibratedSubgridModel(const SubgridCalibration& calibra
       wallCutoff_(meshSize, wallCutoffCells)
 {
     description_ = "calibrated (Appendix B, " + calibration_.path() +
-                   ": pair X21A, wall X^A and, where tabulated, wall Y^A, Y^B, Y^C, X^C measured), the other "
-                   "functions from the cut-off model (" + num(cutoffCells) + " cells, walls " +
-                   num(wallCutoffCells) + ")";
+                   ": pair X21A, wall X^A and, where tabulated, pair Y21A, Y21B, Y11C, X21C and wall Y^A, Y^B, "
+                   "Y^C, X^C measured), the other functions from the cut-off model (" + num(cutoffCells) +
+                   " cells, walls " + num(wallCutoffCells) + ")";
 }
 
 double CalibratedSubgridModel::pairRange(double a1, double a2) const
@@ -290,12 +321,25 @@ double CalibratedSubgridModel::wallRange(double a) const
     return std::max(wallCutoff_.wallRange(a), calibration_.wallRange(a, meshSize_));
 }
 
+void pairBaseFromInternal(const double K[4], double r, PairSubgridBase& b)
+{
+    b.f[BaseY21A] = -K[0];
+    b.f[BaseY21B] = K[1] + 0.5 * r * b.f[BaseY21A];
+    b.f[BaseY11C] = K[2] + r * b.f[BaseY21B] - 0.75 * r * r * b.f[BaseY21A];
+    b.f[BaseX21C] = -K[3];
+}
+
 PairSubgridBase CalibratedSubgridModel::pair(double a1, double a2, double xi) const
 {
     PairSubgridBase b = pairCutoff_.pair(a1, a2, xi);  // zero beyond the cut-off's range
-    // s_hat >= 0 (the reader refuses negative rows, the weights are >= 0): the squeeze stays dissipative,
-    // and the other functions are the cut-off model's, already through makeDissipative
-    b.f[BaseX21A] = -6 * pi * std::min(a1, a2) * calibration_.pairSHat(a1, a2, meshSize_, std::max(xi, minimumGap));
+    const double gap = std::max(xi, minimumGap);
+    // s_hat >= 0 (the reader refuses negative rows, the weights are >= 0): the squeeze stays dissipative
+    b.f[BaseX21A] = -6 * pi * std::min(a1, a2) * calibration_.pairSHat(a1, a2, meshSize_, gap);
+    // sliding, rolling and twist: the table's rows already obey the dissipation rule R_th + K >= 0 on the
+    // internal modes (pairtangential.dissipative), which linear interpolation in ln xi and a/Delta keeps
+    double K[4];
+    if (calibration_.pairInternalCorrection(a1, a2, meshSize_, gap, K))
+        pairBaseFromInternal(K, 0.5 * (a1 + a2) * (2 + xi), b);
     return b;
 }
 

@@ -286,3 +286,134 @@ TEST(CalibratedSubgridModel, WallDissipationRuleClipsAndCounts)
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6> > eig(total);
     EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-10 * total.norm());
 }
+
+namespace {
+
+// The synthetic table plus the pair's internal-mode blocks at a1/Delta = 3 and ratios 1 and 1.4: K
+// constant (xi * K = K xi) up to xi = 0.5, the given [K11, K12, K22, K_twist] (eta a1^n), K12 as given
+// for the unequal pair and 0 for equal spheres (zero by symmetry).
+std::string tableWithPairTangential(const double K[4])
+{
+    std::string text = syntheticTable();
+    const char* names[4] = {"pair_K11", "pair_K12", "pair_K22", "pair_Ktw"};
+    for (double ratio : {1.0, 1.4})
+        for (int k = 0; k < 4; ++k) {
+            text += std::string(names[k]) + " 3 " + std::to_string(ratio) + " 5 0 0 0\n";
+            const double value = (k == 1 && ratio == 1.0) ? 0.0 : K[k];
+            for (double xi : {1e-5, 1e-2, 0.02, 0.25, 0.5}) {
+                char row[64];
+                std::snprintf(row, sizeof row, "%.10e %.10e\n", xi, value * xi);
+                text += row;
+            }
+        }
+    return text;
+}
+
+typedef Eigen::Matrix<double, 12, 12> Matrix12;
+
+Matrix12 pairMatrix(const PairBlock& block)
+{
+    Matrix12 R;
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) R(i, j) = block.R[i][j];
+    return R;
+}
+
+// The six internal modes of a pair (scripts/fdmsubgrid/pairtangential.py) for the line of centres d and
+// centre distance r, columns U1 W1 U2 W2: squeeze, twist, and (q1, q2) for two transverse directions.
+Eigen::Matrix<double, 6, 12> internalModes(const Eigen::Vector3d& d, double r)
+{
+    Eigen::Vector3d e1 = d.unitOrthogonal(), e2 = d.cross(e1);
+    Eigen::Matrix<double, 6, 12> P = Eigen::Matrix<double, 6, 12>::Zero();
+    P.block<1, 3>(0, 0) = d.transpose();
+    P.block<1, 3>(0, 6) = -d.transpose();
+    P.block<1, 3>(1, 3) = d.transpose();
+    P.block<1, 3>(1, 9) = -d.transpose();
+    int row = 2;
+    for (const Eigen::Vector3d& e : {e1, e2}) {
+        const Eigen::Vector3d n = d.cross(e);
+        P.block<1, 3>(row, 0) = e.transpose();
+        P.block<1, 3>(row, 6) = -e.transpose();
+        P.block<1, 3>(row, 3) = 0.5 * r * n.transpose();
+        P.block<1, 3>(row, 9) = 0.5 * r * n.transpose();
+        P.block<1, 3>(row + 1, 3) = n.transpose();
+        P.block<1, 3>(row + 1, 9) = -n.transpose();
+        row += 2;
+    }
+    return P;
+}
+
+}  // namespace
+
+// The pair's tangential functions from K on the internal modes: the block the pair style builds
+// (Appendix C.2, averaged with the relabelled pair) is exactly P^T K P, for radii in either order (K12
+// changes sign with the labels) and any line of centres; a table without them keeps the cut-off model's.
+TEST(CalibratedSubgridModel, PairTangentialBlockIsTheTabulatedInternalCorrection)
+{
+    const double K[4] = {2.5, -0.8, 1.3, 0.2};  // K11 K12 K22 K_twist in eta a1^n; positive definite
+    const SubgridCalibration cal =
+        SubgridCalibration::read(writeTable("pair_tangential_synthetic.dat", tableWithPairTangential(K)));
+    const double a = 0.5, delta = a / 3, xi = 0.02;  // a1 = 0.5: K scales with a1^n
+    const CalibratedSubgridModel model(cal, delta, 0.65, 0.75);
+    for (double a2 : {a, 1.4 * a})
+        for (bool swapped : {false, true}) {
+            const double r1 = swapped ? a2 : a, r2 = swapped ? a : a2;
+            const Eigen::Vector3d d = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+            const double r = 0.5 * (r1 + r2) * (2 + xi);
+            const double x1[3] = {0.1, 0.2, -0.3}, x2[3] = {x1[0] + r * d[0], x1[1] + r * d[1], x1[2] + r * d[2]};
+            PairBlock block;
+            ASSERT_TRUE(subgridPairBlock(model, x1, x2, r1, r2, 1.0, block));
+            const Matrix12 R = pairMatrix(block);
+            const Eigen::Matrix<double, 6, 12> P = internalModes(d, r);
+            const Eigen::Matrix<double, 6, 6> G = (P * P.transpose()).inverse();
+            const Eigen::Matrix<double, 6, 6> Kfound = G * P * R * P.transpose() * G;
+            EXPECT_LT((R - P.transpose() * Kfound * P).norm(), 1e-12 * R.norm()) << a2 << " " << swapped;
+            const double k12 = (a2 == a ? 0.0 : K[1]) * a * a * (swapped ? -1 : 1);
+            EXPECT_NEAR(Kfound(0, 0), 6 * pi * a * cal.pairSHat(r1, r2, delta, xi), 1e-10);  // the squeeze
+            EXPECT_NEAR(Kfound(1, 1), K[3] * a * a * a, 1e-10);
+            for (int row : {2, 4}) {
+                EXPECT_NEAR(Kfound(row, row), K[0] * a, 1e-10) << a2 << " " << swapped;
+                EXPECT_NEAR(Kfound(row, row + 1), k12, 1e-10) << a2 << " " << swapped;
+                EXPECT_NEAR(Kfound(row + 1, row + 1), K[2] * a * a * a, 1e-10) << a2 << " " << swapped;
+            }
+            EXPECT_NEAR(Kfound(2, 4), 0, 1e-10);  // the two transverse directions do not couple
+        }
+    // beyond the cut-off model's range the calibrated functions still act; past the table, nothing
+    EXPECT_NEAR(model.pair(a, a, 0.25).f[BaseY21A], -K[0] * a, 1e-10);
+    EXPECT_EQ(model.pair(a, a, 0.6).f[BaseY21A], 0.0);
+    // a1/Delta 5 has no tangential pair blocks in this table: the cut-off model's functions stay
+    const CalibratedSubgridModel model5(cal, a / 5, 0.65, 0.75);
+    const CutoffSubgridModel cutoff5(a / 5, 0.65);
+    for (int f = 1; f < NumSubgridBase; ++f)
+        EXPECT_EQ(model5.pair(a, a, 0.05).f[f], cutoff5.pair(a, a, 0.05).f[f]) << subgridBaseName(SubgridBaseFunction(f));
+}
+
+// The shipped table's pair blocks: every size the suspension runs need is covered, and the dissipation
+// rule holds: the full-range theory's block plus the sub-grid block is positive semi-definite (the
+// correction takes away at most what the solver resolves), at the tabulated sizes and in between.
+TEST(SubgridCalibration, ShippedPairTangentialBlocksKeepTheCoupledPairDissipative)
+{
+    const SubgridCalibration cal = SubgridCalibration::read(SubgridCalibration::defaultPath());
+    TwoSphereTheory theory;
+    double K[4];
+    int checked = 0;
+    for (double ad : {3.0, 3.5, 4.0, 5.0})
+        for (double ratio : {1.0, 1.2, 1.4, 1 / 1.4}) {
+            const double a1 = 1, a2 = ratio, delta = std::min(a1, a2) / ad;
+            ASSERT_TRUE(cal.pairInternalCorrection(a1, a2, delta, 0.01, K)) << ad << " " << ratio;
+            EXPECT_GT(K[0], 0) << ad << " " << ratio;  // the solver misses sliding resistance near contact
+            const CalibratedSubgridModel model(cal, delta, 0.65, 0.75);
+            for (double xi : {1e-4, 1e-3, 0.01, 0.03, 0.1, 0.2, 0.4, 0.8}) {
+                const double r = 0.5 * (a1 + a2) * (2 + xi);
+                const double x1[3] = {0, 0, 0}, x2[3] = {0.6 * r, 0, 0.8 * r};
+                PairBlock sg, th;
+                ASSERT_TRUE(subgridPairBlock(model, x1, x2, a1, a2, 1.0, sg));
+                buildPairBlock(theory.fullValues(a1, a2, xi), pairGeometry(x1, x2, a1, a2).d, 1.0, th);
+                const Matrix12 total = pairMatrix(sg) + pairMatrix(th);
+                Eigen::SelfAdjointEigenSolver<Matrix12> eig(total);
+                EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-10 * total.norm()) << ad << " " << ratio << " " << xi;
+                ++checked;
+            }
+        }
+    EXPECT_EQ(checked, 128);
+}

@@ -10,19 +10,24 @@
 //     wall     (squeeze)  X^A_SG  =  6 pi a  s_hat(eps)
 //     wall_YA, wall_YB, wall_YC, wall_XC: Y^A_SG = 6 pi a s_hat, Y^B_SG = 4 pi a^2 s_hat,
 //                         Y^C_SG = 8 pi a^3 s_hat, X^C_SG = 8 pi a^3 s_hat (d into the wall, Y^B < 0)
+//     pair_K11, pair_K12, pair_K22, pair_Ktw: the correction K on the pair's internal modes other than the
+//                         squeeze (scripts/fdmsubgrid/pairtangential.py), in eta a1, a1^2, a1^3, a1^3
+//                         (sphere 1 the smaller; docs/resistance.md, "Tangential pair calibration")
 // (squeeze: by Sherman-Morrison the block s e e^T, e = (1, -1), adds s to the solver's resistance F/V;
 // every block adds to the solver's resistance matrix in Eq. 31, so R^SG = R^th - R^FDM holds for the
 // tangential 2x2 block as a whole). Between tabulated a1/Delta and a2/a1 s_hat is interpolated linearly;
 // outside them a squeeze function does not apply and the model says so (std::runtime_error naming the
-// values and what the table covers); a tangential wall function the table lacks stays the cut-off
-// model's.
+// values and what the table covers); a tangential wall or pair function the table lacks stays the
+// cut-off model's.
 #ifndef FDM_RESISTANCE_SUBGRID_CALIBRATION_HPP
 #define FDM_RESISTANCE_SUBGRID_CALIBRATION_HPP
 
 #include "fdm/resistance/subgrid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <deque>
 #include <vector>
 
 namespace fdm {
@@ -30,7 +35,9 @@ namespace resistance {
 
 // What a block of the table calibrates (its kind in the file: pair, wall, wall_YA, ...).
 enum CalibratedFunction { PairSqueeze, WallSqueeze, WallTangentialYA, WallTangentialYB, WallTangentialYC,
-                          WallTangentialXC, NumCalibratedFunctions };
+                          WallTangentialXC, PairSliding, PairSlidingRolling, PairRolling, PairTwist,
+                          NumCalibratedFunctions };
+inline bool isPairFunction(CalibratedFunction f) { return f == PairSqueeze || f >= PairSliding; }
 const char* calibratedFunctionName(CalibratedFunction f);  // the kind written in the table
 
 class SubgridCalibration {
@@ -39,9 +46,10 @@ public:
         CalibratedFunction function;
         double aOverDelta, ratio;
         std::vector<double> logXi, xiS;  // ln xi and xi * s_hat(xi), increasing xi; the last xiS is 0
-        bool wall() const { return function != PairSqueeze; }
+        bool wall() const { return !isPairFunction(function); }
         double xiMax() const { return logXi.empty() ? 0 : std::exp(logXi.back()); }
-        double sHat(double xi) const;    // 0 from xiMax; below the first row xi * s_hat is held
+        double sHat(double xi) const { return sHatAt(std::log(std::max(xi, 1e-300)), xi); }
+        double sHatAt(double logXi, double xi) const;  // sHat with ln xi already taken
     };
 
     SubgridCalibration() {}
@@ -52,6 +60,7 @@ public:
         blocks_ = other.blocks_;
         path_ = other.path_;
         stencils_.clear();
+        lastInternal_ = LastInternal();
         return *this;
     }
 
@@ -70,6 +79,9 @@ public:
     // a tangential wall function (WallTangentialYA ... XC): false where the table lacks it, else s_hat
     bool wallFunctionSHat(CalibratedFunction f, double a, double delta, double eps, double& sHat) const;
     bool coversWallFunction(CalibratedFunction f, double a, double delta) const;
+    // the pair's K = [K11, K12, K22, K_twist] at xi, dimensional (eta = 1) for sphere 1 of radius a1 (K12
+    // changes sign with the labels: the sliding mode q1 does); false where the table lacks them
+    bool pairInternalCorrection(double a1, double a2, double delta, double xi, double K[4]) const;
     double pairRange(double a1, double a2, double delta) const;  // largest xi with a correction
     double wallRange(double a, double delta) const;             // over every wall function covered
     std::string coverage() const;  // "pairs (a1/Delta, a2/a1) (3, 1), ...; walls a/Delta (3), ...; ..."
@@ -92,12 +104,26 @@ private:
     const Stencil& stencil(CalibratedFunction function, double aOverDelta, double ratio) const;
     std::vector<Block> blocks_;
     std::string path_;
-    mutable std::vector<Stencil> stencils_;
+    mutable std::deque<Stencil> stencils_;  // a deque: references to its elements survive push_back
+    // the four stencils of the pair's internal-mode blocks for the last radius pair asked (a suspension
+    // asks for the same few pairs over and over: no search per block)
+    struct LastInternal {
+        double small = -1, large = -1, delta = -1;
+        const Stencil* st[4] = {nullptr, nullptr, nullptr, nullptr};
+    };
+    mutable LastInternal lastInternal_;
 };
 
+// Appendix C.2's tangential base functions of the block P^T K P, K = [K11, K12, K22, K_twist] on the
+// internal modes q1 = (U1 - U2).e + (r/2)(W1 + W2).n, q2 = (W1 - W2).n and the twist (W1 - W2).d
+// (r the centre distance; any radii): Y21A = -K11, Y21B = K12 + (r/2) Y21A,
+// Y11C = K22 + r Y21B - (3 r^2/4) Y21A, X21C = -K_twist.
+void pairBaseFromInternal(const double K[4], double r, PairSubgridBase& base);
+
 // The cut-off model with the functions the table calibrates replaced: the squeeze functions (pair X21A,
-// wall X^A; required) and, where the table has them, the tangential wall functions Y^A, Y^B, Y^C, X^C.
-// The other functions stay the cut-off model's until their calibration exists (docs/resistance.md).
+// wall X^A; required) and, where the table has them, the tangential wall functions Y^A, Y^B, Y^C, X^C and
+// the pair's Y21A, Y21B, Y11C, X21C (from K on the internal modes: pairBaseFromInternal). The stresslet
+// functions (G, H, P) stay the cut-off model's until their calibration exists (docs/resistance.md).
 // Dissipation rule for a wall (docs/resistance.md): the correction may take away at most half of what
 // the solver itself resolves, R^SG + R^FDM/2 >= 0 with R^FDM = R^th - R^SG, i.e. R^th + R^SG positive
 // semi-definite for the tangential block [[Y^A, -Y^B], [-Y^B, Y^C]] (dimensional) and X^C. Y^A, Y^C,
