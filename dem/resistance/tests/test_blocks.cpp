@@ -9,20 +9,11 @@
 #include <cstdio>
 #include <random>
 
+#include "block_matrices.hpp"
+
 using namespace fdm::resistance;
 
 namespace {
-
-typedef Eigen::Matrix<double, 12, 12> Matrix12;
-typedef Eigen::Matrix<double, 12, 1> Vector12;
-
-Matrix12 toEigen(const PairBlock& b)
-{
-    Matrix12 m;
-    for (int i = 0; i < 12; ++i)
-        for (int j = 0; j < 12; ++j) m(i, j) = b.R[i][j];
-    return m;
-}
 
 Eigen::Matrix<double, 14, 12> stressToEigen(const PairBlock& b)
 {
@@ -96,7 +87,7 @@ TEST(SubgridPairBlock, FrameInvariantUnderRigidMotions)
         const double U0[3] = {velocity(rng), velocity(rng), velocity(rng)};
         const double W0[3] = {velocity(rng), velocity(rng), velocity(rng)};
         const Vector12 u = rigidMotion(p, U0, W0);
-        const Matrix12 R = toEigen(block);
+        const Matrix12 R = pairMatrix(block);
         const Eigen::Matrix<double, 14, 12> S = stressToEigen(block);
         const double scale = std::max(R.norm(), S.norm()) * u.norm();
         const double forces = (R * u).norm() / scale, stresses = (S * u).norm() / scale;
@@ -121,7 +112,7 @@ TEST(SubgridPairBlock, IndependentOfLabelling)
         PairBlock block, swapped;
         ASSERT_TRUE(subgridPairBlock(model, p.x1, p.x2, p.a1, p.a2, 1.0, block));
         ASSERT_TRUE(subgridPairBlock(model, p.x2, p.x1, p.a2, p.a1, 1.0, swapped));
-        const double scale = toEigen(block).norm() + stressToEigen(block).norm();
+        const double scale = pairMatrix(block).norm() + stressToEigen(block).norm();
         double difference = 0;
         for (int i = 0; i < 12; ++i)
             for (int j = 0; j < 12; ++j)
@@ -158,7 +149,7 @@ TEST(SubgridPairBlock, SymmetricAndPositiveSemiDefinite)
         const CutoffSubgridModel model(p.delta, 1.0);
         PairBlock block;
         ASSERT_TRUE(subgridPairBlock(model, p.x1, p.x2, p.a1, p.a2, 1.0, block));
-        const Matrix12 R = toEigen(block);
+        const Matrix12 R = pairMatrix(block);
         const double asymmetry = (R - R.transpose()).norm() / R.norm();
         worstAsymmetry = std::max(worstAsymmetry, asymmetry);
         EXPECT_LT(asymmetry, 1e-14);
@@ -215,7 +206,7 @@ TEST(TheoryPairBlock, SymmetricAndPositiveDefiniteNearContact)
             const double x1[3] = {0.3, -0.2, 0.1}, x2[3] = {0.3 + 0.6 * r, -0.2 + 0.8 * r, 0.1};
             PairBlock block;
             theoryPairBlock(theory, x1, x2, a1, a2, 1.0, block);
-            const Matrix12 R = toEigen(block);
+            const Matrix12 R = pairMatrix(block);
             // 12 and 21 come from different series (lambda, 1/lambda): equal to round-off
             EXPECT_LT((R - R.transpose()).norm() / R.norm(), 1e-12);
             Eigen::SelfAdjointEigenSolver<Matrix12> eig(R);
@@ -236,7 +227,7 @@ TEST(SubgridPairBlock, ForcesEqualAndOppositeForUnequalRadii)
         ASSERT_TRUE(subgridPairBlock(model, p.x1, p.x2, p.a1, p.a2, 1.0, block));
         Vector12 u;
         for (int i = 0; i < 12; ++i) u(i) = velocity(rng);
-        const Vector12 f = -toEigen(block) * u;
+        const Vector12 f = -pairMatrix(block) * u;
         for (int k = 0; k < 3; ++k) EXPECT_NEAR(f(k) + f(6 + k), 0, 1e-12 * f.norm());
     }
     // squeeze, radii 1 and 1.4: F1 = -F2 along d
@@ -248,7 +239,7 @@ TEST(SubgridPairBlock, ForcesEqualAndOppositeForUnequalRadii)
     Vector12 u = Vector12::Zero();
     u(0) = 1;
     u(6) = -1;
-    const Vector12 f = -toEigen(block) * u;
+    const Vector12 f = -pairMatrix(block) * u;
     EXPECT_LT(f(0), 0);  // sphere 1 pushed back
     EXPECT_NEAR(f(0), -f(6), 1e-12 * std::fabs(f(0)));
 }

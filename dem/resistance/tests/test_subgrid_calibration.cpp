@@ -14,6 +14,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "block_matrices.hpp"
+
 using namespace fdm::resistance;
 
 namespace {
@@ -132,14 +134,12 @@ TEST(CalibratedSubgridModel, ReplacesTheSqueezeFunctionsOnly)
     PairBlock block;
     const double x1[3] = {0.3, 0.1, -0.2}, x2[3] = {0.3 + 0.6 * (a1 + a2) / 2 * (2 + xi), 0.8 * (a1 + a2) / 2 * (2 + xi), -0.2};
     ASSERT_TRUE(subgridPairBlock(model, x1, x2, a1, a2, 1.0, block));
-    Eigen::Matrix<double, 12, 12> R;
-    for (int i = 0; i < 12; ++i)
-        for (int j = 0; j < 12; ++j) R(i, j) = block.R[i][j];
+    const Matrix12 R = pairMatrix(block);
     EXPECT_LT((R - R.transpose()).norm(), 1e-12 * R.norm());
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12> > eig(R);
+    Eigen::SelfAdjointEigenSolver<Matrix12> eig(R);
     EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12 * R.norm());
     // a rigid translation of the pair meets no resistance
-    Eigen::Matrix<double, 12, 1> u = Eigen::Matrix<double, 12, 1>::Zero();
+    Vector12 u = Vector12::Zero();
     u(0) = u(6) = 0.3;
     u(1) = u(7) = -0.7;
     EXPECT_LT((R * u).norm(), 1e-12 * R.norm());
@@ -188,14 +188,6 @@ std::string tableWithTangential(double yA, double yB, double yC, double xC)
         }
     }
     return text;
-}
-
-Eigen::Matrix<double, 6, 6> wallMatrix(const WallBlock& block)
-{
-    Eigen::Matrix<double, 6, 6> R;
-    for (int i = 0; i < 6; ++i)
-        for (int j = 0; j < 6; ++j) R(i, j) = block.R[i][j];
-    return R;
 }
 
 }  // namespace
@@ -307,16 +299,6 @@ std::string tableWithPairTangential(const double K[4])
             }
         }
     return text;
-}
-
-typedef Eigen::Matrix<double, 12, 12> Matrix12;
-
-Matrix12 pairMatrix(const PairBlock& block)
-{
-    Matrix12 R;
-    for (int i = 0; i < 12; ++i)
-        for (int j = 0; j < 12; ++j) R(i, j) = block.R[i][j];
-    return R;
 }
 
 // The six internal modes of a pair (scripts/fdmsubgrid/pairtangential.py) for the line of centres d and
