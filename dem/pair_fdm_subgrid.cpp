@@ -279,6 +279,9 @@ void PairFdmSubgrid::checkCalibration()
              fmt(radii[b] / radii[a]) + ") in " + calibration_->path() + ", which has " + calibration_->coverage() +
              ": add it (python3 -m fdmsubgrid.calibration) or use 'model cutoff'");
       rangeGap_ = std::max(rangeGap_, calibration_->pairRange(radii[a], radii[b], meshSize_) * rmin_);
+      double K[4];
+      if (!calibration_->pairInternalCorrection(radii[a], radii[b], meshSize_, 0.1, K))
+        uncalibratedTangential_ += (uncalibratedTangential_.empty() ? "" : ", ") + fmt(radii[a]) + "-" + fmt(radii[b]);
     }
     if (!walls_.empty()) {
       if (!calibration_->coversWall(radii[a], meshSize_))
@@ -355,8 +358,10 @@ void PairFdmSubgrid::init_style()
     std::string line = "pair fdm/subgrid: ";
     if (lubricationActive())
       line += "sub-grid lubrication ON (pairs within a surface gap of " +
-              (calibration_ ? "up to " + fmt(rangeGap_) + " m (the calibrated squeeze; the other functions within " +
-                                  fmt(cutoffCells_) + " mesh cells)"
+              (calibration_ ? "up to " + fmt(rangeGap_) + " m (the calibrated squeeze, sliding, rolling and twist" +
+                                  (uncalibratedTangential_.empty() ? std::string()
+                                   : " except for radii " + uncalibratedTangential_ + ", whose are the cut-off model's") +
+                                  "; the stresslets within " + fmt(cutoffCells_) + " mesh cells)"
                             : fmt(cutoffCells_) + " mesh cells = " + fmt(cutoffCells_ * meshSize_) + " m") +
               (walls_.empty() ? std::string() : ", walls within " +
               fmt(wallCutoffCells_) + " mesh cells = " + fmt(wallCutoffCells_ * meshSize_) + " m") + "; viscosity " +

@@ -137,6 +137,7 @@ class PairFdmSubgrid : public Pair {
   std::unique_ptr<fdm::resistance::SubgridCalibration> calibration_;  // model calibrated
 
   double rangeGap_;            // largest surface gap with any pair interaction (contact or lubrication)
+  std::string uncalibratedTangential_;  // radius pairs whose sliding, rolling and twist the table lacks
   double rmin_, rmax_, distanceFactor_;
   class FixContactHistory *history_;
   class FixPropertyAtom *wallHistory_;

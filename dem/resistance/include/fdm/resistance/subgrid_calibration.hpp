@@ -26,8 +26,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
 #include <deque>
+#include <string>
 #include <vector>
 
 namespace fdm {
