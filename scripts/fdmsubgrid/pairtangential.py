@@ -43,6 +43,7 @@ from typing import Dict, List, Sequence
 import numpy as np
 
 from . import case, squeeze, theory
+from .wallcalibration import seen_gap
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
 OFFSETS = [(0.1, 0.2, 0.3), (0.35, 0.45, 0.55), (0.6, 0.7, 0.8), (0.85, 0.95, 0.05)]
@@ -219,37 +220,51 @@ def model_correction(ratio: float, xi: float, delta: float) -> tuple:
     return np.array([K[2, 2], K[2, 3], K[3, 3], K[1, 1]]), residual
 
 
-def measure(ratio: float, a_over_delta: float, workdir: str, gaps: Sequence[float] = GAPS,
-            boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS,
-            tol_lambda: float = 1e-5) -> Dict:
-    """Every offset in the first box, the first offset in the second; the summary the JSON keeps."""
-    t0 = time.time()
+def run_scenes(ratio: float, a_over_delta: float, workdir: str, gaps: Sequence[float], boxes: Sequence[float],
+               offsets: Sequence[Sequence[float]], tol_lambda: float, model: str | None = None) -> Dict[str, List[dict]]:
+    """Every offset in the first box, the first offset in the second (run_loaded_pair, `model` as there):
+    the raw results by box ("%g" % L); a step that did not converge stops it."""
     raw: Dict[str, List[dict]] = {}
     for k, L in enumerate(boxes):
         raw["%g" % L] = []
         for off in (offsets if k == 0 else offsets[:1]):
-            res = run_loaded_pair(workdir, ratio, gaps, a_over_delta, L, off, tol_lambda)
+            res = run_loaded_pair(workdir, ratio, gaps, a_over_delta, L, off, tol_lambda, model=model)
             if not res["converged"]:
                 raise RuntimeError("pair tangential: ratio %g a/Delta %g L %g offset %s: a step did not converge"
                                    % (ratio, a_over_delta, L, off))
             raw["%g" % L].append(res)
-            print("pair tangential: ratio %g a/Delta %g L %g offset %s done (%.0f s)"
-                  % (ratio, a_over_delta, L, off, res["wall_seconds"]), flush=True)
+            print("pair tangential: ratio %g a/Delta %g L %g offset %s%s done (%.0f s)"
+                  % (ratio, a_over_delta, L, off, "" if model is None else ", model " + model, res["wall_seconds"]),
+                  flush=True)
+    return raw
+
+
+def extrapolated_mobility(raw: Dict[str, List[dict]], ratio: float, boxes: Sequence[float]) -> tuple:
+    """(M, mobilities by box): the offset-averaged mobility in the first box plus the box correction
+    M_inf - M(L1) of the first offset, M = M_inf + c L^-3."""
+    by_box = {L: [internal_mobility(res, ratio) for res in runs] for L, runs in raw.items()}
+    L1, L2 = boxes
+    first, second = by_box["%g" % L1][0], by_box["%g" % L2][0]
+    box_correction = squeeze.extrapolate_box(first, second, L1, L2) - first
+    return np.mean(by_box["%g" % L1], axis=0) + box_correction, by_box
+
+
+def measure(ratio: float, a_over_delta: float, workdir: str, gaps: Sequence[float] = GAPS,
+            boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS,
+            tol_lambda: float = 1e-5) -> Dict:
+    """The solver alone (run_scenes); the summary the JSON keeps."""
+    t0 = time.time()
+    raw = run_scenes(ratio, a_over_delta, workdir, gaps, boxes, offsets, tol_lambda)
     return summarize(ratio, a_over_delta, list(gaps), list(boxes), [list(o) for o in offsets], raw,
                      sum(r["wall_seconds"] for runs in raw.values() for r in runs) or time.time() - t0)
 
 
 def summarize(ratio: float, a_over_delta: float, gaps: List[float], boxes: List[float], offsets: List[List[float]],
               raw: Dict[str, List[dict]], wall_seconds: float) -> Dict:
-    """Mobilities (offset-averaged in the first box plus the box correction M_inf - M(L1) of the first
-    offset, M = M_inf + c L^-3), the theory's, the scatter over offsets and the correction K."""
-    by_box = {L: [internal_mobility(res, ratio) for res in runs] for L, runs in raw.items()}
-    L1, L2 = boxes
-    first, second = by_box["%g" % L1][0], by_box["%g" % L2][0]
-    box_correction = squeeze.extrapolate_box(first, second, L1, L2) - first
-    m_fdm = np.mean(by_box["%g" % L1], axis=0) + box_correction
+    """Mobilities (extrapolated_mobility), the theory's, the scatter over offsets and the correction K."""
+    m_fdm, by_box = extrapolated_mobility(raw, ratio, boxes)
     m_th = np.array([theory_mobility(ratio, xi) for xi in gaps])
-    cells = np.array(by_box["%g" % L1])
+    cells = np.array(by_box["%g" % boxes[0]])
     spread = np.ptp(cells, axis=0) / np.abs(np.mean(cells, axis=0))
     cutoff = np.array([model_correction(ratio, xi, 1 / a_over_delta)[0] for xi in gaps])
     return dict(ratio=ratio, a_over_delta=a_over_delta, gaps=gaps, boxes=boxes, offsets=offsets,
@@ -260,7 +275,6 @@ def summarize(ratio: float, a_over_delta: float, gaps: List[float], boxes: List[
 
 
 ELEMENTS = ("K11", "K12", "K22", "Ktw")   # the table's kinds are pair_K11, ...: sliding, coupling, rolling, twist
-SCALE_POWER = (1, 2, 3, 3)               # K in eta a1^n (a1 the smaller sphere)
 
 
 @functools.lru_cache(maxsize=None)
@@ -277,11 +291,6 @@ def theory_resistance(ratio: float, xi) -> np.ndarray:
     """[R11, R12, R22, R_twist] of the theory at xi (1e-6 ... 3; any shape, the elements last)."""
     t = np.log(np.asarray(xi, dtype=float))
     return np.stack([s(t) for s in _theory_resistance_splines(ratio)], axis=-1)
-
-
-def seen_gap(xi, xi_c: float, p: float):
-    """The gap the solver sees: (xi^p + xi_c^p)^(1/p)."""
-    return (np.asarray(xi, dtype=float) ** p + xi_c ** p) ** (1 / p)
 
 
 def fit_elements(summary: Dict) -> List[Dict[str, float]]:
@@ -355,18 +364,11 @@ def add_fits(summary: Dict) -> Dict:
 def validate(ratio: float, a_over_delta: float, workdir: str, model: str, gaps: Sequence[float] = GAPS,
              boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS[:1],
              tol_lambda: float = 1e-5) -> Dict:
-    """The coupled solver with the sub-grid `model` on, loaded as in the measurement, in both boxes
-    (extrapolated the same way) at `offsets`: per gap the internal mobilities [M11, M12, M21, M22, M_twist]
-    and the errors of sliding, rolling and twist against the theory, M/M_th - 1."""
-    by_box = {}
-    for k, L in enumerate(boxes):
-        runs = [run_loaded_pair(workdir, ratio, gaps, a_over_delta, L, off, tol_lambda, model=model)
-                for off in (offsets if k == 0 else offsets[:1])]
-        if not all(r["converged"] for r in runs):
-            raise RuntimeError("pair tangential validation: a step did not converge (ratio %g, L %g)" % (ratio, L))
-        by_box[L] = [internal_mobility(r, ratio) for r in runs]
-    L1, L2 = boxes
-    m = np.mean(by_box[L1], axis=0) + squeeze.extrapolate_box(by_box[L1][0], by_box[L2][0], L1, L2) - by_box[L1][0]
+    """The coupled solver with the sub-grid `model` on, loaded and extrapolated as in the measurement, at
+    `offsets`: per gap the internal mobilities [M11, M12, M21, M22, M_twist] and the errors of sliding,
+    rolling and twist against the theory, M/M_th - 1."""
+    raw = run_scenes(ratio, a_over_delta, workdir, gaps, boxes, offsets, tol_lambda, model=model)
+    m, _ = extrapolated_mobility(raw, ratio, boxes)
     th = np.array([theory_mobility(ratio, xi) for xi in gaps])
     errors = m[:, [0, 3, 4]] / th[:, [0, 3, 4]] - 1
     return dict(ratio=ratio, a_over_delta=a_over_delta, model=model, gaps=list(gaps), offsets=[list(o) for o in offsets],
@@ -469,8 +471,9 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
             print("  %8.2g  %7.4f %7.4f %7.4f %+7.4f   %9.4g %9.4g %9.4g %9.4g   [%.4g %.4g %.4g %.4g]"
                   % (xi, f[0] / t[0], f[3] / t[3], f[4] / t[4], (0.5 * (f[1] + f[2]) - t[1]) / np.sqrt(t[0] * t[3]),
                      *k, *cut))
-        print("  seen-gap fits (xi_c in cells, p, rms, max): " + "; ".join(
-            "%s %.2f %.2f %.1f%% %.1f%%" % (f["element"], f["xi_c"] * s["a_over_delta"], f["p"], 100 * f["rms"],
+        surface_cells = (1 + s["ratio"]) / 2 * s["a_over_delta"]     # xi_c as a surface gap in mesh cells
+        print("  seen-gap fits (xi_c as a surface gap in cells, p, rms, max): " + "; ".join(
+            "%s %.2f %.2f %.1f%% %.1f%%" % (f["element"], f["xi_c"] * surface_cells, f["p"], 100 * f["rms"],
                                           100 * f["max"]) for f in s["fits"]) + "; clipped rows %d" % s["clipped_rows"])
     return out
 

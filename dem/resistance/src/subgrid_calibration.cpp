@@ -190,10 +190,28 @@ const SubgridCalibration::Stencil& SubgridCalibration::stencil(CalibratedFunctio
     return stencils_.back();
 }
 
+const SubgridCalibration::LastPair& SubgridCalibration::pairStencils(double a1, double a2, double delta) const
+{
+    const double small = std::min(a1, a2), large = std::max(a1, a2);
+    LastPair& last = lastPair_;
+    if (last.small != small || last.large != large || last.delta != delta) {
+        const CalibratedFunction internal[4] = {PairSliding, PairSlidingRolling, PairRolling, PairTwist};
+        last.squeeze = &stencil(PairSqueeze, small / delta, large / small);
+        last.range = last.squeeze->xiMax;
+        for (int j = 0; j < 4; ++j) {
+            last.internal[j] = &stencil(internal[j], small / delta, large / small);
+            last.range = std::max(last.range, last.internal[j]->xiMax);
+        }
+        last.small = small;
+        last.large = large;
+        last.delta = delta;
+    }
+    return last;
+}
+
 bool SubgridCalibration::coversPair(double a1, double a2, double delta) const
 {
-    const double small = std::min(a1, a2);
-    return stencil(PairSqueeze, small / delta, std::max(a1, a2) / small).covered;
+    return pairStencils(a1, a2, delta).squeeze->covered;
 }
 
 bool SubgridCalibration::coversWall(double a, double delta) const { return stencil(WallSqueeze, a / delta, 1.0).covered; }
@@ -201,7 +219,7 @@ bool SubgridCalibration::coversWall(double a, double delta) const { return stenc
 double SubgridCalibration::pairSHat(double a1, double a2, double delta, double xi) const
 {
     const double small = std::min(a1, a2);
-    const Stencil& st = stencil(PairSqueeze, small / delta, std::max(a1, a2) / small);
+    const Stencil& st = *pairStencils(a1, a2, delta).squeeze;
     if (!st.covered)
         throw std::runtime_error("sub-grid calibration " + path_ + ": no calibration for a pair of radii " + num(a1) +
                                  " and " + num(a2) + " at mesh size " + num(delta) + " (a1/Delta " +
@@ -226,29 +244,17 @@ double SubgridCalibration::wallSHat(double a, double delta, double eps) const
 
 double SubgridCalibration::pairRange(double a1, double a2, double delta) const
 {
-    const double small = std::min(a1, a2);
-    double range = 0;
-    for (int f = 0; f < NumCalibratedFunctions; ++f)
-        if (isPairFunction(CalibratedFunction(f)))
-            range = std::max(range, stencil(CalibratedFunction(f), small / delta, std::max(a1, a2) / small).xiMax);
-    return range;
+    return pairStencils(a1, a2, delta).range;
 }
 
 bool SubgridCalibration::pairInternalCorrection(double a1, double a2, double delta, double xi, double K[4]) const
 {
-    const double small = std::min(a1, a2), large = std::max(a1, a2);
-    LastInternal& last = lastInternal_;
-    if (last.small != small || last.large != large || last.delta != delta) {
-        const CalibratedFunction elements[4] = {PairSliding, PairSlidingRolling, PairRolling, PairTwist};
-        for (int j = 0; j < 4; ++j) last.st[j] = &stencil(elements[j], small / delta, large / small);
-        last.small = small;
-        last.large = large;
-        last.delta = delta;
-    }
+    const double small = std::min(a1, a2);
+    const LastPair& last = pairStencils(a1, a2, delta);
     const double t = std::log(std::max(xi, 1e-300));
     const double scale[4] = {small, small * small, small * small * small, small * small * small};  // eta a1^n
     for (int j = 0; j < 4; ++j) {
-        const Stencil& st = *last.st[j];
+        const Stencil& st = *last.internal[j];
         if (!st.covered) return false;
         double k = 0;
         for (int i = 0; i < st.n; ++i) k += st.weight[i] * st.block[i]->sHatAt(t, xi);

@@ -60,7 +60,7 @@ public:
         blocks_ = other.blocks_;
         path_ = other.path_;
         stencils_.clear();
-        lastInternal_ = LastInternal();
+        lastPair_ = LastPair();
         return *this;
     }
 
@@ -105,13 +105,16 @@ private:
     std::vector<Block> blocks_;
     std::string path_;
     mutable std::deque<Stencil> stencils_;  // a deque: references to its elements survive push_back
-    // the four stencils of the pair's internal-mode blocks for the last radius pair asked (a suspension
-    // asks for the same few pairs over and over: no search per block)
-    struct LastInternal {
+    // the pair's stencils (squeeze, then sliding, coupling, rolling, twist) and their range for the last
+    // radius pair asked: a suspension asks for the same few pairs over and over, so no search per block
+    struct LastPair {
         double small = -1, large = -1, delta = -1;
-        const Stencil* st[4] = {nullptr, nullptr, nullptr, nullptr};
+        const Stencil* squeeze = nullptr;
+        const Stencil* internal[4] = {nullptr, nullptr, nullptr, nullptr};
+        double range = 0;
     };
-    mutable LastInternal lastInternal_;
+    mutable LastPair lastPair_;
+    const LastPair& pairStencils(double a1, double a2, double delta) const;
 };
 
 // Appendix C.2's tangential base functions of the block P^T K P, K = [K11, K12, K22, K_twist] on the
