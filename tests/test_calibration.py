@@ -41,23 +41,8 @@ def test_taper_is_continuous_and_ends_the_correction():
     assert calibration.taper(mid) == pytest.approx(0.5, abs=1e-12)
 
 
-def read_table(path):
-    """The blocks of a calibration table: {(kind, a/Delta, ratio): (header floats, rows array)}."""
-    blocks = {}
-    with open(path) as f:
-        lines = [ln.split() for ln in f if ln.strip() and not ln.startswith("#")]
-    k = 0
-    while k < len(lines):
-        head = lines[k]
-        n = int(head[3])
-        rows = np.array([[float(x) for x in ln] for ln in lines[k + 1:k + 1 + n]])
-        blocks[(head[0], float(head[1]), float(head[2]))] = ([float(x) for x in head[4:]], rows)
-        k += 1 + n
-    return blocks
-
-
 def test_shipped_table_covers_the_suspension_runs_and_is_well_formed():
-    blocks = read_table(TABLE)
+    blocks = calibration.read_table(TABLE)
     for ad in (3.0, 4.0, 5.0):
         for key in (("pair", ad, 1.0), ("pair", ad, 1.4), ("wall", ad, 1.0)):
             assert key in blocks, key

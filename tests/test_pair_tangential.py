@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import PROJECT
-from fdmsubgrid import pairtangential as pt, squeeze
+from fdmsubgrid import calibration, pairtangential as pt, squeeze
 
 SHIPPED = os.path.join(PROJECT, "dem", "resistance", "data", "pair_tangential_calibration.json")
 
@@ -102,27 +102,10 @@ def test_shipped_fits_follow_the_seen_gap_and_reproduce_the_measurements(shipped
             assert fits["K12"].get("symmetric_zero")
 
 
-def _table_blocks(path):
-    """{(kind, a1/Delta, ratio): (xi, xi*K)} of the pair_K blocks of a calibration table."""
-    blocks, rows, key = {}, 0, None
-    with open(path) as f:
-        for line in f:
-            if line.startswith("#") or not line.strip():
-                continue
-            words = line.split()
-            if rows == 0:
-                key, rows = (words[0], float(words[1]), float(words[2])), int(words[3])
-                blocks[key] = []
-                continue
-            blocks[key].append((float(words[0]), float(words[1])))
-            rows -= 1
-    return {k: np.array(v) for k, v in blocks.items() if k[0].startswith("pair_K")}
-
-
 def test_shipped_table_holds_the_measured_corrections(shipped):
     # the C++ model reads these rows (linear in ln xi of xi K): at the measured gaps below the taper they
     # give the measured K within 4 % of the theory's internal resistance (sqrt(R11 R22) for K12)
-    blocks = _table_blocks(os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat"))
+    blocks = calibration.read_table(os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat"))
     for s in shipped:
         xi = np.array(s["gaps"])
         use = xi <= 0.3
@@ -130,7 +113,7 @@ def test_shipped_table_holds_the_measured_corrections(shipped):
         th = pt.internal_resistance(np.array(s["mobility_theory"]))[use]
         scale = np.column_stack([th[:, 0], np.sqrt(th[:, 0] * th[:, 2]), th[:, 2], th[:, 3]])
         for j, name in enumerate(pt.ELEMENTS):
-            rows = blocks[("pair_" + name, s["a_over_delta"], s["ratio"])]
+            rows = blocks[("pair_" + name, s["a_over_delta"], s["ratio"])][1]
             table = np.interp(np.log(xi[use]), np.log(rows[:, 0]), rows[:, 1]) / xi[use]
             err = np.abs(table - measured[:, j]) / scale[:, j]
             assert np.all(err < 0.04), (s["a_over_delta"], s["ratio"], name, err.max())

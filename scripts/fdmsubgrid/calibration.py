@@ -265,6 +265,22 @@ def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Seq
                     f.write("%.8e %.8e\n" % (xi, v))
 
 
+def read_table(path: str) -> Dict[tuple, tuple]:
+    """The blocks of a calibration table (write_table's format): {(kind, a/Delta, ratio): (header floats
+    after the row count, rows as an (n, 2) array of xi and xi * s_hat)}."""
+    blocks = {}
+    with open(path) as f:
+        lines = [ln.split() for ln in f if ln.strip() and not ln.startswith("#")]
+    k = 0
+    while k < len(lines):
+        head = lines[k]
+        n = int(head[3])
+        rows = np.array([[float(x) for x in ln] for ln in lines[k + 1:k + 1 + n]])
+        blocks[(head[0], float(head[1]), float(head[2]))] = ([float(x) for x in head[4:]], rows)
+        k += 1 + n
+    return blocks
+
+
 def write_block(f, c: SqueezeCalibration, fit: Dict[str, float], rows: List[tuple]) -> None:
     f.write("%s %.6g %.6g %d %.6g %.6g %.6g %.6g %.4g\n" % (c.kind, c.a_over_delta, c.ratio, len(rows), fit["r_0"],
                                                         fit["r_inf"], fit["xi_1"], fit["p"], fit["rms_rel"]))
