@@ -47,7 +47,7 @@ std::string fmt(double x)
 }  // namespace
 
 PairFdmSubgrid::PairFdmSubgrid(LAMMPS *lmp) :
-  Pair(lmp), computeflag(0), lubrication_(true), calibrated_(false), cutoffCells_(0.65), wallCutoffCells_(0.75), kn_(0), kt_(0), mu_(0), hr_(0),
+  Pair(lmp), computeflag(0), lubrication_(true), calibrated_(true), cutoffCells_(0.65), wallCutoffCells_(0.75), kn_(0), kt_(0), mu_(0), hr_(0),
   unstableStepIsError_(true), implicit_(true), viscosity_(0),
   meshSize_(0), rangeGap_(0), rmin_(0), rmax_(0), distanceFactor_(1.0), history_(nullptr), wallHistory_(nullptr),
   contactStressRequested_(false), nmaxStress_(0), contactStress_(nullptr), contactsLast_(0), reported_(false),
@@ -187,9 +187,9 @@ void PairFdmSubgrid::fluidParameters()
   meshSize_ = session.meshSize();
   // Two cut-offs: the solver resolves a wall gap less well than a pair gap of the same width
   // (measured with cases/pairSqueeze and cases/wallSqueeze, docs/validation.md)
-  if (calibrated_ && !model_) {
-    // the functions measured with the solver itself (Appendix B; subgrid_calibration.hpp): the squeeze
-    // functions and, where tabulated, the tangential wall functions
+  if (calibrated_ && lubrication_ && !model_) {
+    // the default: the functions measured with the solver itself (Appendix B; subgrid_calibration.hpp):
+    // the squeeze functions and, where tabulated, the tangential pair and wall functions
     const std::string path = calibrationFile_.empty() ? res::SubgridCalibration::defaultPath() : calibrationFile_;
     try {
       calibration_.reset(new res::SubgridCalibration(res::SubgridCalibration::read(path)));
@@ -363,8 +363,11 @@ void PairFdmSubgrid::init_style()
                                    : " except for radii " + uncalibratedTangential_ + ", whose are the cut-off model's") +
                                   "; the stresslets within " + fmt(cutoffCells_) + " mesh cells)"
                             : fmt(cutoffCells_) + " mesh cells = " + fmt(cutoffCells_ * meshSize_) + " m") +
-              (walls_.empty() ? std::string() : ", walls within " +
-              fmt(wallCutoffCells_) + " mesh cells = " + fmt(wallCutoffCells_ * meshSize_) + " m") + "; viscosity " +
+              (walls_.empty() ? std::string()
+               : calibration_ ? ", walls within a surface gap of up to " + fmt(wallModel_->wallRange(rmax_) * rmax_) +
+                                    " m (eps = " + fmt(wallModel_->wallRange(rmax_)) + ", the calibrated wall functions)"
+                              : ", walls within " + fmt(wallCutoffCells_) + " mesh cells = " +
+                                    fmt(wallCutoffCells_ * meshSize_) + " m") + "; viscosity " +
               fmt(viscosity_) + " Pa s; " + model_->describe() + ")";
     else
       line += std::string("sub-grid lubrication OFF (") + (model_ || !lubrication_ ? "lubrication no" :

@@ -3,8 +3,8 @@
    walls) and the frictional contact of section 6 (roughness height h_r, Coulomb friction mu_s).
 
    Syntax (docs/dem.md):
-     pair_style fdm/subgrid [lubrication yes|no] [cutoff k] [wall_cutoff k] [contact kn kt mu_s h_r]
-                            [wall FACE ux uy uz] ... [unstable_step error|warn]
+     pair_style fdm/subgrid [lubrication yes|no] [model calibrated|cutoff] [calibration FILE] [cutoff k]
+                            [wall_cutoff k] [contact kn kt mu_s h_r] [wall FACE ux uy uz] ... [unstable_step error|warn]
                             [contact_integration implicit|explicit]
      pair_coeff * *
 
@@ -122,7 +122,7 @@ class PairFdmSubgrid : public Pair {
 
   // settings
   bool lubrication_;
-  bool calibrated_;                 // model calibrated: the calibration of Appendix B
+  bool calibrated_;                 // model calibrated (the default): the calibration of Appendix B
   std::string calibrationFile_;     // its table (default: SubgridCalibration::defaultPath())
   double cutoffCells_, wallCutoffCells_;
   double kn_, kt_, mu_, hr_;

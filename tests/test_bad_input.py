@@ -276,6 +276,7 @@ def test_disk_full_stops_both_codes(tmp_path, env):
 # Two spheres of radius 1 at a gap of 0.05 in a periodic 6 x 4 x 4 box, Delta = 0.5 (a/Delta = 2),
 # viscosity 1 Pa s, contact at h_r = 0.01 m, kt = 0: the normal spring of the pair limits the step,
 # zeta = 3 pi eta a + the sub-grid squeeze resistance, from ~480 N s/m at h_r to ~5e5 at zero gap.
+# a/Delta = 2: outside the calibration table, so the scenes below ask for the cut-off model
 PAIR = [(1.5, 2.0, 2.0, 1.0), (3.55, 2.0, 2.0, 1.0)]
 PAIR_BOX = case.Box((0, 0, 0), (6, 4, 4), 0.5)
 
@@ -291,7 +292,7 @@ def pair_scene_log(tmp_path, env, pair_style):
 def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
     """Explicit springs, kn = 1e6 N/m, dt = 1 s: beyond dt k/zeta < 1 (ab2) even with the largest resistance a contact
     can have: an error at the start, with the limit and how it was computed; both codes stop."""
-    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid contact 1e6 0 0.5 0.01 contact_integration explicit")
+    root = make_case(tmp_path, spheres=PAIR, box=PAIR_BOX, pair_style="fdm/subgrid model cutoff contact 1e6 0 0.5 0.01 contact_integration explicit")
     status, out, wall = run_fdm(root, env)
     assert status != 0
     dem = open(os.path.join(root, "log.dem"), errors="replace").read()
@@ -308,7 +309,7 @@ def test_time_step_beyond_contact_stability_at_every_gap(tmp_path, env):
 def test_time_step_beyond_contact_stability_at_the_contact_gap(tmp_path, env):
     """Explicit springs, kn = 1e4 N/m, dt = 1 s: beyond the limit at h_r (~0.05 s), within it for contacts pressed
     deeper (~50 s at zero gap): a warning, and the run goes on."""
-    dem = pair_scene_log(tmp_path, env, "fdm/subgrid contact 1e4 0 0.5 0.01 contact_integration explicit")
+    dem = pair_scene_log(tmp_path, env, "fdm/subgrid model cutoff contact 1e4 0 0.5 0.01 contact_integration explicit")
     m = re.search(r"WARNING: pair_style fdm/subgrid: time step 1 s is beyond the stability limit (\S+) s of the normal "
                   r"spring of two spheres .* at the contact gap h_r = 0.01 m", dem)
     assert m and 0.01 < float(m.group(1)) < 0.1, dem[-3000:]
@@ -347,7 +348,7 @@ def test_particles_too_small_for_the_mesh(tmp_path, env):
 def test_time_step_beyond_explicit_limit_with_implicit_springs(tmp_path, env):
     """The same kn = 1e6 N/m, dt = 1 s with the implicit springs (the default): no error, a note of
     how far beyond the explicit springs' limit the step is, and the run goes on."""
-    dem = pair_scene_log(tmp_path, env, "fdm/subgrid contact 1e6 0 0.5 0.01")
+    dem = pair_scene_log(tmp_path, env, "fdm/subgrid model cutoff contact 1e6 0 0.5 0.01")
     m = re.search(r"pair fdm/subgrid: time step 1 s is (\S+) times the explicit springs' stability limit (\S+) s \(the "
                   r"normal spring of two spheres at the contact gap h_r\): stable with the implicit springs", dem)
     assert m and float(m.group(1)) > 1000 and 1e-4 < float(m.group(2)) < 1e-3, dem[-3000:]

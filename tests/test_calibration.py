@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from conftest import PROJECT
+from conftest import PROJECT, load_case_module
 from fdmsubgrid import calibration, squeeze, theory
 
 DATA = os.path.join(PROJECT, "dem", "resistance", "data")
@@ -84,10 +84,36 @@ def test_calibrated_pair_squeeze_against_theory(tmp_path, env, ratio):
 
 
 def test_calibrated_model_refuses_an_uncovered_resolution(tmp_path, env):
-    """a/Delta = 2 is not in the table: the run stops and names the radii, the mesh and the way out."""
+    """a/Delta = 2 is not in the table: a run with the pair style's default model (calibrated, nothing
+    asked) stops and names the radii, the mesh and the way out; asked for, the cut-off model runs."""
     with pytest.raises(RuntimeError) as failure:
-        squeeze.run_pair(str(tmp_path), 1.0, [0.01], True, a_over_delta=2.0, L_over_a=8.0, tol_lambda=1e-3,
-                         pair_options="model calibrated")
+        squeeze.run_pair(str(tmp_path / "default"), 1.0, [0.01], True, a_over_delta=2.0, L_over_a=8.0,
+                         tol_lambda=1e-3)
     message = str(failure.value)
     assert "no squeeze calibration for radii 1 and 1" in message
     assert "model cutoff" in message
+    run = squeeze.run_pair(str(tmp_path / "cutoff"), 1.0, [0.01], True, a_over_delta=2.0, L_over_a=8.0,
+                           tol_lambda=1e-3, pair_options="model cutoff")
+    assert np.isfinite(run["velocity"]).all() and run["velocity"][0] > 0
+
+
+def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
+    """`fdmResistance coverage` makes the pair style's test; the suspension cases ask it before they
+    write anything: a1/Delta = 4 with a2 = 1.4 a1 between walls has no wall calibration for a/Delta 5.6."""
+    from fdmsubgrid import case
+    covered = theory.resistance("coverage", "--a1", 1, "--a2", 1.4, "--delta", 1 / 3, "--wall")
+    assert covered["pair"] and covered["pair_tangential"] and covered["wall"]
+    assert not theory.resistance("coverage", "--a1", 1.4, "--delta", 0.25, "--wall")["wall"]
+    assert not theory.resistance("coverage", "--a1", 1, "--a2", 2, "--delta", 0.25)["pair"]
+    assert case.uncalibrated([1.0, 1.0, 1.4], 1 / 3, walls=True) == []
+    assert case.uncalibrated([1.0, 2.0], 0.25) != []
+    assert case.uncalibrated([1.0, 2.0], 0.25, model="cutoff") == []
+    # one sphere of a radius has no pair with itself: a2/Delta = 5.6 alone is fine without walls, two are not
+    assert case.uncalibrated([1.0, 1.0, 1.4], 0.25) == []
+    assert "the pair of radii 1.4 and 1.4" in case.uncalibrated([1.0, 1.4, 1.4], 0.25)[0]
+    couette = load_case_module("couette")
+    with pytest.raises(SystemExit) as refused:
+        couette.main(["--a-over-delta", "4", "--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
+    assert "no wall calibration for radius 1.4 at a/Delta 5.6" in str(refused.value)
+    assert "--model cutoff" in str(refused.value)
+    assert os.listdir(tmp_path) == []

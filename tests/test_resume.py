@@ -40,7 +40,8 @@ def make_scene(root, steps=STEPS, every=EVERY, spheres=None):
         spheres = [(5.0, 2.55, 3.0, 1.0), (3.0, 3.45, 3.0, 1.0), (1.0, 1.15, 1.2, 1.0)]
     case.write_fluid_case(os.path.join(root, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=1e-4, n_max=60,
                           first_step=(1e-5, 300), n_particles=len(spheres), tol_u=1e-7, tol_p=1e-6)
-    pair = "fdm/subgrid contact 400 200 0.5 0.05 wall ylo %r 0 0 wall yhi %r 0 0" % (-U, U)
+    # a mesh coarser than the calibration table (a/Delta 2): the cut-off model, asked for
+    pair = "fdm/subgrid model cutoff contact 400 200 0.5 0.05 wall ylo %r 0 0 wall yhi %r 0 0" % (-U, U)
     runs = output.dump_custom_command("particles", 1, "particles.dump") + [
         "thermo_style    custom step f_couple[1] f_couple[6] f_couple[7] f_couple[8]",  # contacts: column 5
         "thermo          1",

@@ -21,7 +21,9 @@ import pytest
 
 from fdmsubgrid import case, demonly, output, packing
 
-ETA, DELTA, HR, KN = 1.0, 0.2, 5e-3, 1e4
+# a1/Delta = 3, the suspensions' mesh: its pairs (a2/a1 = 1, 1.4) are in the calibration table that the pair
+# style's default model (calibrated) uses, whose range (xi up to 1) puts more pairs in R^SG than the cut-off's
+ETA, DELTA, HR, KN = 1.0, 1.0 / 3.0, 5e-3, 1e4
 CONTACT = (KN, KN, 0.5, HR)
 CG_CAP = 1000  # fix fdm/couple: CG stops after max(1000, 6N) iterations (N <= 166 here)
 

@@ -140,9 +140,10 @@ OFFSET_VERTEX, OFFSET_GENERIC = (0.0, 0.0), (0.25, 0.17)
 @pytest.fixture(scope="module")
 def scene(wall_shear, tmp_path_factory, env):
     # two offsets: the mesh vertex (the mesh has the flow's mirror symmetries there, so U_y, U_z, Omega_x,
-    # Omega_y vanish to the solvers' tolerance) and a generic one (the discretisation's drift)
+    # Omega_y vanish to the solvers' tolerance) and a generic one (the discretisation's drift); the
+    # cut-off model (the tests below compare it with the FDM alone and with the calibrated model)
     work = tmp_path_factory.mktemp("wallShear")
-    result = wall_shear.main(["--eps", "1", "0.1", "0.01", "--offset", *map(str, OFFSET_VERTEX),
+    result = wall_shear.main(["--eps", "1", "0.1", "0.01", "--model", "cutoff", "--offset", *map(str, OFFSET_VERTEX),
                               "--offset", *map(str, OFFSET_GENERIC), "--workdir", str(work),
                               "--out", str(work / "results.json")])
     rows = {(r["subgrid"], r["eps"]): r for r in result["rows"]}
@@ -227,10 +228,10 @@ def test_cutoff_model_free_sphere_within_two_percent_with_correction(scene):
 
 @pytest.fixture(scope="module")
 def calibrated(wall_shear, tmp_path_factory, env):
-    # the same offsets with pair_style fdm/subgrid model calibrated (the tangential wall functions measured
-    # with the solver, docs/resistance.md "Tangential wall calibration"), the correction on only
+    # the same offsets with pair_style fdm/subgrid's default model, calibrated (the tangential wall functions
+    # measured with the solver, docs/resistance.md "Tangential wall calibration"), the correction on only
     work = tmp_path_factory.mktemp("wallShearCalibrated")
-    result = wall_shear.main(["--eps", "0.1", "0.01", "--model", "calibrated", "--subgrid-only",
+    result = wall_shear.main(["--eps", "0.1", "0.01", "--subgrid-only",
                               "--offset", *map(str, OFFSET_VERTEX), "--offset", *map(str, OFFSET_GENERIC),
                               "--workdir", str(work), "--out", str(work / "results.json")])
     return {r["eps"]: r for r in result["rows"]}

@@ -19,8 +19,10 @@ averaged over positions of the centre in one mesh cell (mean and standard deviat
 oscillations of at most 3 % in Omega). The centre stays on the channel's mid-plane y = H/2 (so the
 walls are symmetric about it); it moves in x and z only. Both walls are declared to
 `pair_style fdm/subgrid` (`wall ylo -U 0 0 wall yhi U 0 0`), so the wall lubrication correction
-(Eq. D.6) acts once the gap eps = H/(2a) - 1 is below its cut-off (0.75 Delta/a, docs/dem.md);
---no-subgrid switches it off (`lubrication no`), --compare-subgrid runs the smallest H both ways.
+(Eq. D.6) acts once the gap eps = H/(2a) - 1 is below its range (eps = 1 with the default calibrated
+model, 0.75 Delta/a with --model cutoff; docs/dem.md); --no-subgrid switches it off (`lubrication no`),
+--compare-subgrid runs the smallest H both ways. The calibrated model covers a/Delta 3 to 5 against a
+wall: a scene outside it is refused before it runs (use --model cutoff).
 
   channelShear.py                        default: a1 = 1, H/a = 7/3 ... 20, 12a x 12a walls,
                                          a1/Delta = 3, 16 positions (4 computed), the smallest H also
@@ -28,8 +30,9 @@ walls are symmetric about it); it moves in x and z only. Both walls are declared
   channelShear.py --radius both          a1 = 1 and a2 = 1.4 (each radius its own default H/a list)
   channelShear.py --H-over-a 2.333333 4 --size 24 24 --positions 4
                                          chosen gaps, a wider box, 4 positions (1 computed)
-  channelShear.py --full                 the paper's: 60a x 40a walls, a1/Delta = 5, 16 positions, both
-                                         radii (hours; runnable, not run here)
+  channelShear.py --full --model cutoff  the paper's: 60a x 40a walls, a1/Delta = 5, 16 positions, both
+                                         radii (hours; runnable, not run here; a2/Delta = 7 has no
+                                         wall calibration)
   channelShear.py --help                 every option
 Writes results.json here (or --out) and results_channelShear.png next to it (docs/cases.md).
 
@@ -64,6 +67,8 @@ RADII = {"1": (1.0,), "1.4": (1.4,), "both": (1.0, 1.4)}
 # pair_style fdm/subgrid's default wall cut-off, in mesh cells (docs/dem.md, `wall_cutoff`): the wall
 # block acts on a gap below WALL_CUTOFF_CELLS * Delta. Used only to say in the output whether it acts.
 WALL_CUTOFF_CELLS = 0.75
+# the calibrated model's wall range (eps = h/a - 1 below which it corrects, docs/resistance.md)
+CALIBRATED_WALL_RANGE = 1.0
 
 # Default gaps H/a per radius at a1/Delta = 3: whole numbers of cells (H = n Delta, Delta = 1/3), from
 # the most confined one the mesh allows (eps = H/2a - 1 = 1/6 for a1, 1/14 for a2: inside the wall
@@ -131,10 +136,10 @@ def cell_offsets(n_positions: int) -> list[tuple[float, float]]:
 
 def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float], a_over_delta: float,
             offsets: Sequence[tuple[float, float]], subgrid: bool = True, tol_lambda: float = 1e-5,
-            np_fluid: int = 1, keep: bool = False) -> dict:
+            np_fluid: int = 1, keep: bool = False, model: str = "calibrated") -> dict:
     """One channel (radius, gap H/a, walls size = (L_x/a, L_z/a)), one coupled step per offset of the
     centre in its cell (x, z fractions of Delta from a vertex). Returns per-position lists and the
-    scene's description (module docstring)."""
+    scene's description (module docstring). model: pair_style fdm/subgrid's sub-grid model."""
     delta = A1 / a_over_delta
     a = float(radius)
     ny = int(round(cells(H_over_a * a, delta)))
@@ -166,7 +171,8 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
                          fix_options="move no stresslets yes", runs=runs,
                          # both no-slip walls at the fluid case's velocities (the pair style checks they agree
                          # with 0/U; docs/dem.md)
-                         pair_style=case.subgrid_pair_style((("ylo", (-U, 0, 0)), ("yhi", (U, 0, 0))), subgrid),
+                         pair_style=case.subgrid_pair_style((("ylo", (-U, 0, 0)), ("yhi", (U, 0, 0))), subgrid,
+                                                            model=model),
                          name="in.channelShear")
     wall = case.run(run_dir, np_fluid=np_fluid)
     rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"))
@@ -184,7 +190,9 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
     return dict(radius=a, H_over_a=H / a, H_cells=ny, centre_y_in_cell=0.5 * (ny % 2),
                 box=[Lx / a, H / a, Lz / a], cells=nx * ny * nz,
                 a_over_delta=a_over_delta, a_over_delta_sphere=a / delta, eps=H / (2 * a) - 1,
-                subgrid=subgrid, wall_block_acts=bool(H / 2 - a < WALL_CUTOFF_CELLS * delta),
+                subgrid=subgrid, model=model if subgrid else None,
+                wall_block_acts=bool(H / 2 - a < (CALIBRATED_WALL_RANGE * a if model == "calibrated"
+                                                  else WALL_CUTOFF_CELLS * delta)),
                 offsets=[list(o) for o in offsets],
                 Wz_norm=[float(w) for w in omega[:, 2] / (-0.5 * SHEAR_RATE)],
                 S_star=[float(s) for s in (s_fluid + s_subgrid) / stokes_s],
@@ -289,7 +297,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                           "radius)")
     p.add_argument("--full", action="store_true", help="the paper's: walls 60a x 40a, a1/Delta = 5, 16 positions, "
                    "both radii, FULL_H")
-    case.add_run_options(p, HERE, tol_lambda=1e-5)
+    case.add_run_options(p, HERE, tol_lambda=1e-5, model=True)
     args = p.parse_args(argv)
     if args.full:
         args.size, args.a_over_delta, args.positions, args.radius = [60.0, 40.0], 5.0, 16, "both"
@@ -309,6 +317,12 @@ def main(argv: Sequence[str] | None = None) -> dict:
             for h in gaps:
                 for subgrid in ([False] if args.no_subgrid else [True] + ([False] if h in again else [])):
                     plan.append((radius, h, subgrid))
+        if not args.no_subgrid:
+            # one sphere at a time: only each radius against the walls needs a calibration
+            missing = [m for radius in RADII[args.radius]
+                       for m in case.uncalibrated([radius], A1 / args.a_over_delta, walls=True, model=args.model)]
+            if missing:
+                raise ValueError("channelShear: " + "; ".join(dict.fromkeys(missing)))
     except ValueError as e:
         p.error(str(e))
     os.makedirs(args.workdir, exist_ok=True)
@@ -316,11 +330,12 @@ def main(argv: Sequence[str] | None = None) -> dict:
     rows = []
     for radius, h, subgrid in plan:
         scene = run_gap(args.workdir, radius, h, args.size, args.a_over_delta, offsets, subgrid, args.tol_lambda,
-                        args.np_fluid, args.keep)
+                        args.np_fluid, args.keep, args.model)
         rows.append(summarise(scene, args.positions))
         print_row(rows[-1])
     results = dict(case="channelShear", size_over_a=args.size, a_over_delta=args.a_over_delta,
-                   positions=args.positions, tol_lambda=args.tol_lambda, wall_cutoff_cells=WALL_CUTOFF_CELLS,
+                   positions=args.positions, tol_lambda=args.tol_lambda, model=args.model,
+                   wall_cutoff_cells=WALL_CUTOFF_CELLS,
                    rows=rows, wall_seconds=time.time() - t0)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with open(args.out, "w") as f:

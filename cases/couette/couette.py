@@ -91,7 +91,7 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
 
 def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
                strain: float, dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50,
-               write_every: int = 100000, text_dump: bool = False, model: str = "cutoff",
+               write_every: int = 100000, text_dump: bool = False, model: str = "calibrated",
                fluid_options: dict | None = None) -> dict:
     """fluid/ and dem/ of the run (suspension.write_case with the walls at -U and +U); returns the
     scene's description. fluid_options: more arguments of case.write_fluid_case."""
@@ -170,6 +170,9 @@ def main(argv: list[str] | None = None) -> dict:
     pack = packing.channel_packing(args.size, phi=None if n_particles else phi, n=n_particles, seed=args.seed,
                                    min_gap=2 * ROUGHNESS, wall_gap=2 * ROUGHNESS)
     print("packing:", pack.summary())
+    missing = case.uncalibrated(pack.radii, delta, walls=True, model=args.model)
+    if missing:
+        raise SystemExit("couette: " + "; ".join(missing))
     springs = choose_springs(pack.phi, dt, delta, args.kn, args.kt)
     print(springs.describe(dt))
     warning = time_step_warning(pack.phi, dt)
@@ -179,7 +182,7 @@ def main(argv: list[str] | None = None) -> dict:
     name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (pack.phi if n_particles is None else phi, *args.size,
                                                   args.a_over_delta, dt, args.seed,
                                                   ("" if args.acceleration == "anderson" else "_" + args.acceleration)
-                                                  + ("" if args.model == "cutoff" else "_" + args.model))
+                                                  + "_" + args.model)
     if args.table8 is not None:
         name = "table8_" + name
     run_dir = os.path.join(args.workdir, name)

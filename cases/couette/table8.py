@@ -39,10 +39,12 @@ PAPER_FIT = dict(zip(("alpha", "phi_m"), rheology.PAPER_MARON_PIERCE))   # paper
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
 
 
-def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int) -> Optional[str]:
-    """The run folder couette.py --table8 wrote for this row, if any."""
+def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int, model: str) -> Optional[str]:
+    """The run folder couette.py --table8 wrote for this row and sub-grid model, if any (a folder
+    without the model in its name is from before the name said it: the cut-off model's)."""
     pattern = os.path.join(workdir, "table8_phi%g_*_ad%g_dt%g_seed%d" % (phi, a_over_delta, dt, seed))
-    found = sorted(d for d in glob.glob(pattern) if os.path.isdir(d))
+    found = sorted(d for d in glob.glob(pattern + "_" + model) + (glob.glob(pattern) if model == "cutoff" else [])
+                   if os.path.isdir(d))
     return found[0] if found else None
 
 
@@ -75,7 +77,7 @@ def running_elsewhere(run_dir: str) -> bool:
 def run_row(phi: float, args: argparse.Namespace) -> str:
     """Write, start or resume the run of one phi_bulk until it finishes; returns its folder. A run
     that another process is running is waited for, never started a second time."""
-    run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed)
+    run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
     if run_dir is not None and running_elsewhere(run_dir):
         print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
         while running_elsewhere(run_dir):
@@ -84,8 +86,8 @@ def run_row(phi: float, args: argparse.Namespace) -> str:
         subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(args.dt),
                         "--strain", str(args.strain), "--a-over-delta", str(args.a_over_delta),
                         "--seed", str(args.seed), "--n-max", str(args.n_max), "--tol-lambda", str(args.tol_lambda),
-                        "--workdir", args.workdir], check=True)
-        run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed)
+                        "--model", args.model, "--workdir", args.workdir], check=True)
+        run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
     if steps_done(run_dir) >= steps_planned(run_dir):
         return run_dir
     fdmrun = [os.path.join(PROJECT, "scripts", "fdmRun"), "-f", str(args.np_fluid)]
@@ -175,6 +177,9 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--dt", type=float, default=0.02, help="time step in units of 1/gamma_dot_0")
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",
+                   help="pair_style fdm/subgrid's sub-grid model (docs/dem.md); the rows of docs/validation.md "
+                        "up to 2026-11-26 ran with cutoff")
     p.add_argument("--np-fluid", type=int, default=1, help="MPI ranks of fdmFoam per run")
     p.add_argument("--n-max", type=int, default=50, help="fdmFoam's innerIterations nMax for scenes written now "
                    "(the dense rows stop at 50 in most steps: docs/benchmarks.md, 'Stability map')")
@@ -196,7 +201,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
             print("table8: --session-hours reached; the next call continues", flush=True)
             break
         run_row(phi, args)
-    rows = [analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed), args)
+    rows = [analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model), args)
             for phi in args.phis]
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])

@@ -51,7 +51,7 @@ def paper_contact(a1=1.0, kn=2e4, kt=200.0):
 def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0, size=(12.0, 8.0, 6.0), dt=0.05,
                    tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True,
                    gap_update="log", integrator="ab2", r_x0=None, acceleration="anderson",
-                   mean_flow_correction=True, tol_velocity=0.0, model="cutoff"):
+                   mean_flow_correction=True, tol_velocity=0.0, model="calibrated"):
     """One coupled run from r_x = r_x0 (default -r_x_end) to +r_x_end (r_x_end = 6, the paper's, or
     less in a box shorter than 14 a1: the minimum image in the periodic x must stay unambiguous);
     returns the relative trajectory and the gaps."""

@@ -99,12 +99,15 @@ def main(argv: list[str] | None = None) -> dict:
     pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
                                    wall_gap=2 * suspension.ROUGHNESS)
     print("packing:", pack.summary())
+    missing = case.uncalibrated(pack.radii, delta, walls=True, model=args.model)
+    if missing:
+        raise SystemExit("poiseuille: " + "; ".join(missing))
     tau_w = abs(grad) * width / 2
     springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt)
     print(springs.describe(dt))
 
     name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (args.phi, *args.size, args.a_over_delta, args.dt, args.seed,
-                                                  "" if args.model == "cutoff" else "_" + args.model)
+                                                  "_" + args.model)
     run_dir = os.path.join(args.workdir, name)
     if os.path.exists(run_dir):
         if not args.overwrite:

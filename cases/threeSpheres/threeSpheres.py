@@ -7,7 +7,7 @@ sphere 1 pushed toward the centroid by a force F along +x (no torque), spheres 2
 rest at y = 0 and y = L_y (the paper's y = +-L_y/2, shifted), periodic in x and z. The triangle is
 held (fix fdm/couple ... move no): each configuration is one coupled time step whose velocities are
 those of the fixed configuration (quasi-static), warm-started from the previous one. Sub-grid
-lubrication of pairs (pair_style fdm/subgrid, cut-off model by default) as in the other cases; the
+lubrication of pairs (pair_style fdm/subgrid, calibrated model by default) as in the other cases; the
 walls are declared to it (they are far: no wall block acts). Units: F = 6 pi eta a, so that
 velocities come out in F/(6 pi eta a) and angular velocities in F/(6 pi eta a^2).
 

@@ -20,12 +20,12 @@ sphere from the exact wall resistance functions (bipolar-coordinate tables) and 
 (1967) fixed sphere in shear, S* from Sangani et al.'s (2011) fit, paper Eq. (46).
 
 The sub-grid wall correction (pair_style fdm/subgrid with both walls declared, Eq. D.6) is on; by default
-every scene is also run with it off (lubrication no), to show what it does. The cut-off model (the pair
-style's default) over-corrects the tangential wall functions: measured at a1/Delta = 3, the free sphere is
+every scene is also run with it off (lubrication no), to show what it does. The cut-off model (`--model
+cutoff`) over-corrects the tangential wall functions: measured at a1/Delta = 3, the free sphere is
 11-17 % too slow for eps 0.001-0.1 with the correction; without it U is within 3 % at eps = 0.1 (Omega 17 %
-too fast) and stops decreasing below eps ~ 0.03 (the mesh does not resolve the gap). With `--model
-calibrated` (the tangential wall functions measured with the solver, a/Delta 3, 4 and 5: docs/resistance.md)
-U is within -4.4 ... +2.2 % and Omega within -9 ... +5 % at eps 1e-3 ... 0.54, S* within 0.5 % near
+too fast) and stops decreasing below eps ~ 0.03 (the mesh does not resolve the gap). With the default
+calibrated model (the tangential wall functions measured with the solver, a/Delta 3, 4 and 5:
+docs/resistance.md) U is within -4.4 ... +2.2 % and Omega within -9 ... +5 % at eps 1e-3 ... 0.54, S* within 0.5 % near
 contact and 1-7 % at eps 0.07-0.3 (docs/validation.md).
 
 Offsets: the three quantities are unchanged by the mirror z -> -z and by x -> -x with the flow reversed
@@ -413,6 +413,12 @@ def main(argv: Sequence[str] | None = None) -> dict:
             check_scene(args.eps, args.radius, size, args.a_over_delta)
     except ValueError as e:
         p.error(str(e))
+    if True in subgrid_modes:
+        # one sphere at a time: each radius against the walls needs a calibration
+        missing = [m for a in args.radius
+                   for m in case.uncalibrated([a], A1 / args.a_over_delta, walls=True, model=args.model)]
+        if missing:
+            p.error("; ".join(dict.fromkeys(missing)))
 
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()

@@ -5,6 +5,7 @@
 #include "harness.h"
 
 #include "fdm/resistance/blocks.hpp"
+#include "fdm/resistance/subgrid_calibration.hpp"
 
 #include <Eigen/Dense>
 
@@ -15,7 +16,8 @@ namespace {
 // pair_style fdm/subgrid's default cut-off gaps, in mesh cells (docs/dem.md)
 const double defaultCutoffCells = 0.65, defaultWallCutoffCells = 0.75;
 
-// Two close unequal spheres (a2/a1 = 1.4, xi = 0.02 along a slanted line) and a third far away.
+// Two close unequal spheres (a2/a1 = 1.4, xi = 0.02 along a slanted line) and a third far away, with the
+// cut-off model (its radii and mesh, a1/Delta = 2.5, are outside the calibration table of the default model).
 Scene pairScene(double xi = 0.02)
 {
     Scene s;
@@ -24,7 +26,7 @@ Scene pairScene(double xi = 0.02)
     s.spheres = {{3.0, 4.0, 4.0, a1, 2500.0},
                  {3.0 + r * n[0], 4.0 + r * n[1], 4.0 + r * n[2], a2, 1500.0},
                  {6.5, 1.5, 6.8, 0.4, 4000.0}};
-    s.pairStyle = "fdm/subgrid";
+    s.pairStyle = "fdm/subgrid model cutoff";
     s.fixOptions = "move no";
     return s;
 }
@@ -36,14 +38,16 @@ struct Expected {
     std::vector<std::pair<int, int> > pairs;
 };
 
-// R^SG built here, independently of the pair style, from the resistance library.
-Expected subgridMatrix(const Scene& scene, const FakeFluid& fluid)
+// R^SG built here, independently of the pair style, from the resistance library (the cut-off model, or the
+// model given).
+Expected subgridMatrix(const Scene& scene, const FakeFluid& fluid, const res::SubgridModel* given = nullptr)
 {
     const int n = int(scene.spheres.size());
     Expected e;
     e.R = Eigen::MatrixXd::Zero(6 * n, 6 * n);
     e.wallRhs = Eigen::VectorXd::Zero(6 * n);
-    res::CutoffSubgridModel model(fluid.delta, defaultCutoffCells);
+    const res::CutoffSubgridModel cutoff(fluid.delta, defaultCutoffCells);
+    const res::SubgridModel& model = given ? *given : cutoff;
     for (int i = 0; i < n; ++i)
         for (int j = i + 1; j < n; ++j) {
             const Sphere &p = scene.spheres[i], &q = scene.spheres[j];
@@ -161,6 +165,30 @@ TEST(PairFdmSubgrid, SubgridBlocksEnterEq31AndObeyNewtonsThirdLaw)
         EXPECT_LT(std::fabs(rows[0][7 + d] + rows[1][7 + d]), roundOff) << "Newton's third law; force " << scale;
 }
 
+TEST(PairFdmSubgrid, DefaultModelIsTheCalibrationTable)
+{
+    // a1/Delta = 3 (the suspensions' mesh), a2/a1 = 1.4 and a third sphere of a1: every radius pair is in the
+    // shipped table, so `pair_style fdm/subgrid` with nothing asked uses it; R^SG is CalibratedSubgridModel's
+    const std::string dir = workDir("pairdefault");
+    Scene scene = pairScene(0.05);
+    scene.pairStyle = "fdm/subgrid";
+    scene.spheres[2].radius = 0.5;
+    FakeFluid fluid(dir);
+    fluid.delta = 0.5 / 3;
+    const DemRun run = runWithFluid(dir, scene, fluid);
+    ASSERT_EQ(run.status, 0) << run.output;
+    EXPECT_EQ(fluid.error, "");
+    expectContains(run.output, "calibrated (Appendix B");
+    const res::SubgridCalibration table = res::SubgridCalibration::read(res::SubgridCalibration::defaultPath());
+    const res::CalibratedSubgridModel calibrated(table, fluid.delta, defaultCutoffCells, defaultWallCutoffCells);
+    const Expected e = subgridMatrix(scene, fluid, &calibrated);
+    ASSERT_EQ(e.pairs.size(), 1u);
+    expectSolution(fluid, scene, e, 1e-8);
+    // not the cut-off model's matrix: the calibration changes the pair's block at xi = 0.05
+    const Expected cut = subgridMatrix(scene, fluid);
+    EXPECT_GT((cut.R - e.R).cwiseAbs().maxCoeff(), 0.05 * e.R.cwiseAbs().maxCoeff());
+}
+
 TEST(PairFdmSubgrid, LubricationNoGivesTheDiagonalSystem)
 {
     const std::string dir = workDir("lubno");
@@ -192,7 +220,7 @@ Scene wallScene()
     Scene s;
     s.boundary = "p f p";
     s.spheres = {{3.0, 0.55, 4.0, 0.5, 2500.0}, {6.0, 5.0, 3.5, 0.7, 1500.0}};
-    s.pairStyle = "fdm/subgrid wall ylo 0.3 0 0.1 wall yhi 0 0 0";
+    s.pairStyle = "fdm/subgrid model cutoff wall ylo 0.3 0 0.1 wall yhi 0 0 0";
     s.fixOptions = "move no";
     return s;
 }

@@ -355,6 +355,33 @@ def boxes_and_offsets(parser, args, default_boxes, cell_offsets):
     return boxes, offsets, represented
 
 
+def uncalibrated(radii, delta, walls=False, model="calibrated") -> list[str]:
+    """What the shipped calibration table lacks for a scene of these radii at mesh size delta (with
+    walls: also each radius against a wall), in pair_style fdm/subgrid's default model (calibrated):
+    empty when the run can start, else one line per missing radius pair or wall, to refuse the scene
+    before it is launched (the pair style refuses it anyway at its start; `fdmResistance coverage`
+    makes the same test). radii: every particle's (a radius held by one particle has no pair with
+    itself, as in the pair style); model cutoff needs nothing."""
+    from collections import Counter
+    from .theory import resistance
+    if model != "calibrated":
+        return []
+    counts = Counter(float(r) for r in radii)
+    sizes = sorted(counts)
+    missing = []
+    for i, a in enumerate(sizes):
+        for b in sizes[i:]:
+            r = resistance("coverage", "--a1", a, "--a2", b, "--delta", delta, *(["--wall"] if walls and b == a else []))
+            if not r["pair"] and (b != a or counts[a] > 1):
+                missing.append("no calibration for the pair of radii %g and %g at a1/Delta %g (a2/a1 %g)"
+                               % (a, b, a / delta, b / a))
+            if walls and b == a and not r["wall"]:
+                missing.append("no wall calibration for radius %g at a/Delta %g" % (a, a / delta))
+    if missing:
+        missing.append("the table (%s) has %s; use --model cutoff for this scene" % (r["table"], r["coverage"]))
+    return missing
+
+
 def add_run_options(parser, case_dir, tol_lambda, cutoff=False, model=False):
     """The options every coupled case's script shares: --tol-lambda, --acceleration, --np-fluid,
     --workdir, --out, --keep; with cutoff, --cutoff and --model (pair_style fdm/subgrid's cut-off and
@@ -363,9 +390,9 @@ def add_run_options(parser, case_dir, tol_lambda, cutoff=False, model=False):
         parser.add_argument("--cutoff", type=float, default=None,
                             help="pair_style fdm/subgrid cutoff (mesh cells; default: the pair style's)")
     if cutoff or model:
-        parser.add_argument("--model", choices=("cutoff", "calibrated"), default="cutoff",
-                            help="pair_style fdm/subgrid model: the cut-off model or the squeeze calibration "
-                                 "(docs/dem.md)")
+        parser.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",
+                            help="pair_style fdm/subgrid model: the calibration of what the solver resolves "
+                                 "(the default; a1/Delta 3-5, a2/a1 1 and 1.4) or the cut-off model (docs/dem.md)")
     parser.add_argument("--tol-lambda", type=float, default=tol_lambda, help="fdmFoam's innerIterations tolLambda")
     parser.add_argument("--acceleration", choices=("anderson", "none"), default="anderson",
                         help="fdmFoam's inner-iteration acceleration (none: the plain iteration of paper 4.3)")

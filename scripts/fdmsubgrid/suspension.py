@@ -81,13 +81,13 @@ def choose_springs(stress: float, dt: float, delta: float, kn: float | None = No
 
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, steps: int,
                dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
-               text_dump: bool = False, model: str = "cutoff", wall_velocities: tuple[float, float] = (0.0, 0.0),
+               text_dump: bool = False, model: str = "calibrated", wall_velocities: tuple[float, float] = (0.0, 0.0),
                grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension",
                fluid_options: dict | None = None) -> dict:
     """fluid/ and dem/ of the run; returns the scene's description. wall_velocities: the x velocities of
     the walls y = 0 and y = L_y; grad_p0: the uniform pressure gradient (Eq. 58) [Pa/m]. model:
-    pair_style fdm/subgrid's sub-grid model (cutoff, or calibrated: the squeeze calibration,
-    docs/dem.md). The particles are recorded every dump_every steps in dem/particles.records (fix
+    pair_style fdm/subgrid's sub-grid model (calibrated, the default: what the solver resolves, measured;
+    or cutoff: the cut-off model; docs/dem.md). The particles are recorded every dump_every steps in dem/particles.records (fix
     fdm/output), and written for ParaView with the fluid fields every write_every steps
     (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also the LIGGGHTS text dump
     dem/particles.dump of the same steps (for comparisons). fluid_options: more (or other) arguments

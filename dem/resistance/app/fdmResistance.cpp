@@ -4,7 +4,9 @@
 //   fdmResistance wall    --a A --eps E [--delta D] [--cutoff K]
 //   fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]
 //   fdmResistance squeeze --a A --eps E --wall
+//   fdmResistance coverage --a1 A [--a2 B] --delta D [--wall]
 #include "fdm/resistance/resistance.hpp"
+#include "fdm/resistance/subgrid_calibration.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -25,10 +27,13 @@ const char* usage =
     "  fdmResistance wall    --a A --eps E [--delta D] [--cutoff K]\n"
     "  fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]\n"
     "  fdmResistance squeeze --a A --eps E --wall\n"
+    "  fdmResistance coverage --a1 A [--a2 B] --delta D [--wall]\n"
     "xi = 2r/(a1+a2) - 2; eps = h/a - 1; --delta: mesh size (sub-grid output); --cutoff: k in xi_c = k*delta/a_mean\n"
     "--full: full-range X^A, Y^A, Y^B, X^C, Y^C (matched forms, every gap); --order: far-field powers kept (default 100)\n"
     "squeeze: closing velocity under equal and opposite forces F along the line of centres, in units of F/(6 pi eta a1)\n"
-    "  (full-range theory; --near: near-field forms); --wall: sphere pushed toward a plane wall, 1/X^A_wall\n";
+    "  (full-range theory; --near: near-field forms); --wall: sphere pushed toward a plane wall, 1/X^A_wall\n"
+    "coverage: whether the shipped calibration table (pair_style fdm/subgrid model calibrated) has the pair (a1, a2)\n"
+    "  and, with --wall, the sphere a1 against a wall at mesh size D\n";
 
 struct Arguments {
     std::string command;
@@ -317,6 +322,31 @@ int squeezeCommand(const Arguments& args)
     return 0;
 }
 
+// What pair_style fdm/subgrid's default model (calibrated) needs of the shipped table for a pair of
+// radii, or a radius against a wall, at mesh size delta: the same test the pair style makes at the start
+// of a run, for scripts that want to know before they launch one.
+int coverageCommand(const Arguments& args)
+{
+    const double a1 = args.number("a1"), delta = args.number("delta");
+    positive(a1, "--a1");
+    positive(delta, "--delta");
+    const SubgridCalibration table = SubgridCalibration::read(SubgridCalibration::defaultPath());
+    std::printf("{\n  \"command\": \"coverage\",\n  \"table\": \"%s\",\n  \"a1\": %s, \"delta\": %s,\n",
+                table.path().c_str(), number(a1).c_str(), number(delta).c_str());
+    if (args.has("a2")) {
+        const double a2 = args.number("a2");
+        positive(a2, "--a2");
+        double k[4];  // the pair's tangential correction at one gap: only whether the table has it
+        std::printf("  \"a2\": %s, \"pair\": %s, \"pair_tangential\": %s,\n", number(a2).c_str(),
+                    table.coversPair(a1, a2, delta) ? "true" : "false",
+                    table.pairInternalCorrection(a1, a2, delta, 0.1, k) ? "true" : "false");
+    }
+    if (args.flags.count("wall"))
+        std::printf("  \"wall\": %s,\n", table.coversWall(a1, delta) ? "true" : "false");
+    std::printf("  \"coverage\": \"%s\"\n}\n", table.coverage().c_str());
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -327,6 +357,7 @@ int main(int argc, char** argv)
         if (args.command == "matrix") return matrixCommand(args);
         if (args.command == "wall") return wallCommand(args);
         if (args.command == "squeeze") return squeezeCommand(args);
+        if (args.command == "coverage") return coverageCommand(args);
         if (args.command == "-h" || args.command == "--help") {
             std::fputs(usage, stdout);
             return 0;
