@@ -17,9 +17,9 @@ and the correction the coupled solver needs is X^G_11 - g_11 (C.2's base functio
 relabelled pair's). Box effect: g at L = 8 and 12 a1 extrapolated as g_inf + c L^-3 (the images of a force
 dipole), then averaged over the positions.
 
-The theory is the library's near-field X^G (lubrication terms and O(1) constants, `fdmResistance pair`):
-there is no full-range X^G yet. Its X^A counterpart is within 0.8 % of the full range at xi = 0.2, 1.6 %
-at 0.3 and 3.6 % at 0.5; beyond xi ~ 0.5 the comparison is not meaningful.
+The theory is the library's full-range X^G (`fdmResistance pair --theory --full`: Jeffrey 1992's series
+matched to the near-field forms, within 5.3e-4 of Townsend's exact values at s' >= 2.025). The cut-off
+model subtracts the near-field form, as the pair style does.
 
     python3 -m fdmsubgrid.pairstresslet --a-over-delta 3 --ratio 1 1.4 --out runs/pair_stresslet.json
 """
@@ -79,8 +79,8 @@ def kim_karrila_xx(S: np.ndarray) -> np.ndarray:
 
 @functools.lru_cache(maxsize=None)
 def theory_xg(a1: float, a2: float, xi: float) -> tuple:
-    """The library's X^G_11, X^G_12, X^G_21, X^G_22 (dimensional, eta = 1; near-field forms)."""
-    d = theory.resistance("pair", "--a1", a1, "--a2", a2, "--xi", xi)["dimensional_over_eta"]
+    """The library's X^G_11, X^G_12, X^G_21, X^G_22 (dimensional, eta = 1; full-range forms)."""
+    d = theory.resistance("pair", "--a1", a1, "--a2", a2, "--xi", xi, "--theory", "--full")["dimensional_over_eta"]
     return d["XG11"], d["XG12"], d["XG21"], d["XG22"]
 
 

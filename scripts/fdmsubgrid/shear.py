@@ -5,7 +5,7 @@ written as a JSON summary and a figure. cases/couette/couette.py calls it after 
 fdmProfiles (shear.main) calls it on any run folder, finished, resumed, stopped or still going.
 
     from fdmsubgrid import shear
-    run = shear.read_run("runs/phi0.3_10x12x8_ad3_dt0.02_seed1")
+    run = shear.read_run("runs/phi0.3_10x12x8_ad3_dt0.02_seed1_calibrated")
     results, figures = shear.analyse(run)
     results["eta_s"], results["eta_s_err"]
 

@@ -29,7 +29,7 @@ const char* usage =
     "  fdmResistance squeeze --a A --eps E --wall\n"
     "  fdmResistance coverage --a1 A [--a2 B] --delta D [--wall]\n"
     "xi = 2r/(a1+a2) - 2; eps = h/a - 1; --delta: mesh size (sub-grid output); --cutoff: k in xi_c = k*delta/a_mean\n"
-    "--full: full-range X^A, Y^A, Y^B, X^C, Y^C (matched forms, every gap); --order: far-field powers kept (default 100)\n"
+    "--full: full-range X^A, Y^A, Y^B, X^C, Y^C, X^G, Y^G, Y^H (matched forms, every gap); --order: far-field powers kept (default 100)\n"
     "squeeze: closing velocity under equal and opposite forces F along the line of centres, in units of F/(6 pi eta a1)\n"
     "  (full-range theory; --near: near-field forms); --wall: sphere pushed toward a plane wall, 1/X^A_wall\n"
     "coverage: whether the shipped calibration table (pair_style fdm/subgrid model calibrated) has the pair (a1, a2)\n"
@@ -170,8 +170,8 @@ int pairCommand(const Arguments& args)
     if (!subgrid && full) {
         const PairFullRangeForms forms = makeFullRangeForms(a1, a2, true, order);
         const PairFunctionValues v = fullRange(forms, xi);
-        std::printf("  \"kind\": \"theory, full range: XA, YA, YB, YC matched forms of Jeffrey & Onishi 1984 (near-field singular terms plus the far-field series to order %d with their expansion subtracted; Townsend 2023 constants), XC exact series (Jeffery 1915); XG, YG, YH, XM, YM, ZM, XP, XQ near-field forms\",\n", order);
-        std::printf("  \"full_range_functions\": [\"XA\", \"YA\", \"YB\", \"XC\", \"YC\"], \"order\": %d,\n", order);
+        std::printf("  \"kind\": \"theory, full range: XA, YA, YB, YC matched forms of Jeffrey & Onishi 1984 and XG, YG, YH the same way with Jeffrey 1992's series (near-field singular terms plus the far-field series to order %d with their expansion subtracted; Townsend 2023 constants), XC exact series (Jeffery 1915); XM, YM, ZM, XP, XQ near-field forms\",\n", order);
+        std::printf("  \"full_range_functions\": [\"XA\", \"YA\", \"YB\", \"XC\", \"YC\", \"XG\", \"YG\", \"YH\"], \"order\": %d,\n", order);
         printSizeRatioWarning(a2 / a1, order);
         std::printf("  \"normalisation\": \"%s\",\n", pairNormalisation);
         printPairValues("kim_karrila", v, &forms.nearField, true, false);

@@ -268,20 +268,26 @@ const FullRangeSeries& fullRangeSeries(int order)
         entry->ya = base.s[SeriesYA];
         entry->yb = base.s[SeriesYB];
         entry->yc = base.s[SeriesYC];
+        entry->xg = base.s[SeriesXG];
+        entry->yg = base.s[SeriesYG];
+        entry->yh = base.s[SeriesYH];
         return *entry;
     }
     {
         std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(order, 1);
         entry->xa = SeriesTriangle(t->P, 1, 1.0, false);     // J&O (3.15)
+        entry->xg = SeriesTriangle(t->P, 2, 0.75, false);    // Ichiki et al. (94)
     }
     {
         std::unique_ptr<RecurrenceTables> t = buildAsymmetric(order, TranslationStart1);
         entry->ya = SeriesTriangle(t->P, 1, 1.0, false);     // J&O (4.12)
         entry->yb = SeriesTriangle(t->Q, 1, 2.0, false);     // J&O (5.2)
+        entry->yg = SeriesTriangle(t->P, 2, 0.75, false);    // Ichiki et al. (115)
     }
     {
         std::unique_ptr<RecurrenceTables> t = buildAsymmetric(order, RotationStart1);
         entry->yc = SeriesTriangle(t->Q, 1, 1.0, true);      // J&O (7.6)
+        entry->yh = SeriesTriangle(t->P, 2, -0.375, true);   // Ichiki et al. (120)
     }
     return *entry;
 }

@@ -85,6 +85,7 @@ const SeriesStore& seriesStore(bool withM);
 // while building; the triangles kept afterwards are ~ order^2).
 struct FullRangeSeries {
     SeriesTriangle xa, ya, yb, yc;
+    SeriesTriangle xg, yg, yh;  // the stresslet series, from the same three recurrences
 };
 const FullRangeSeries& fullRangeSeries(int order);
 

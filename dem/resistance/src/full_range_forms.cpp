@@ -113,7 +113,10 @@ void exactRotationAboutLineOfCentres(double lambda, double xi, double& x11, doub
     x12 = -cschCubedSum(mu1, delta, delta);
 }
 
-bool hasFullRangeForm(PairFunction f) { return f == XA || f == YA || f == YB || f == XC || f == YC; }
+bool hasFullRangeForm(PairFunction f)
+{
+    return f == XA || f == YA || f == YB || f == XC || f == YC || f == XG || f == YG || f == YH;
+}
 
 FullRangeConstants computeFullRangeConstants(double lam, int order)
 {
@@ -149,6 +152,27 @@ FullRangeConstants computeFullRangeConstants(double lam, int order)
         const NearFieldForm& n12 = near.f12[YC];
         k.f11[YC] = matchedForm(series.yc, lam, order, false, 1, 0, n11.log, n11.xlog);
         k.f12[YC] = matchedForm(series.yc, lam, order, true, 1, 0, n12.log, n12.xlog);
+    }
+    // The stresslet functions, matched the same way to the near-field forms of near_field_constants.cpp
+    // (their O(1) constants are these sums at t = 1; no m = 0 term: a sphere's own motion gives it no
+    // stresslet). X^G: J92 (19)-(21), X11G = sum_odd, X12G = -sum_even (Kim-Karrila with a1).
+    {
+        const NearFieldForm& n = near.f11[XG];
+        k.f11[XG] = matchedForm(series.xg, lam, order, true, 1, n.inv, n.log, n.xlog);
+        k.f12[XG] = matchedForm(series.xg, lam, order, false, -1, n.inv, n.log, n.xlog);
+    }
+    // Y^G: J92 (27)-(29), Y11G = sum_odd, Y12G = -sum_even.
+    {
+        const NearFieldForm& n = near.f11[YG];
+        k.f11[YG] = matchedForm(series.yg, lam, order, true, 1, 0, n.log, n.xlog);
+        k.f12[YG] = matchedForm(series.yg, lam, order, false, -1, 0, n.log, n.xlog);
+    }
+    // Y^H: J92 (35)-(37), Y11H = sum_even (g2, g3), Y12H = +sum_odd (g5, g6), as Y^C.
+    {
+        const NearFieldForm& n11 = near.f11[YH];
+        const NearFieldForm& n12 = near.f12[YH];
+        k.f11[YH] = matchedForm(series.yh, lam, order, false, 1, 0, n11.log, n11.xlog);
+        k.f12[YH] = matchedForm(series.yh, lam, order, true, 1, 0, n12.log, n12.xlog);
     }
     return k;
 }

@@ -323,6 +323,51 @@ TEST(TwoSphereTheory, FullRangeMatchesTownsendTable)
     EXPECT_EQ(compared, 3 * 38 * 2 * 5);
 }
 
+// The stresslet functions X^G, Y^G, Y^H matched the same way (full_range_forms.cpp): every tabulated s' for
+// lambda = 0.1, 1, 10, 11 and 12, within the same bounds, and continuous with the near-field forms at contact.
+TEST(TwoSphereTheory, FullRangeStressletMatchesTownsendTable)
+{
+    const std::vector<std::vector<double> > rows =
+        reference::readTable("two_sphere_townsend/scalars_general_resistance.txt", 2);
+    const PairFunction stresslet[] = {XG, YG, YH};
+    const double lambdas[] = {0.1, 1, 10};
+    int compared = 0;
+    for (int l = 0; l < 3; ++l) {
+        const FullRangeConstants k = computeFullRangeConstants(lambdas[l]);
+        double worstLamb[NumPairFunctions] = {0}, worstNear[NumPairFunctions] = {0};
+        for (std::size_t r = 0; r < rows.size(); ++r) {
+            const std::vector<double>& row = rows[r];
+            if (std::fabs(row[1] - lambdas[l]) > 1e-12) continue;
+            const double sDash = row[0], xi = sDash - 2;
+            const bool twelve = int(row[2]) == 1;
+            for (PairFunction f : stresslet) {
+                const double mine = fullRangeScalar(k, f, twelve, xi), ref = row[3 + f];
+                const double error = std::fabs(mine - ref) / std::max(std::fabs(ref), 1.0);
+                EXPECT_LT(error, tableBound(lambdas[l], sDash)) << pairFunctionName(f) << (twelve ? "12" : "11") << " lambda "
+                                                                << lambdas[l] << " s' " << sDash << ": " << mine << " vs " << ref;
+                double& worst = sDash > 2.02 + 1e-12 ? worstLamb[f] : worstNear[f];
+                worst = std::max(worst, error);
+                ++compared;
+            }
+        }
+        std::printf("[worst] full-range stresslet vs Townsend, lambda %g: Lamb (s' >= 2.025) X^G %.1e Y^G %.1e Y^H %.1e; "
+                    "asymptotic (s' <= 2.02) %.1e %.1e %.1e\n", lambdas[l], worstLamb[XG], worstLamb[YG], worstLamb[YH],
+                    worstNear[XG], worstNear[YG], worstNear[YH]);
+    }
+    EXPECT_EQ(compared, 3 * 38 * 2 * 3);
+    // near contact the matched form is the near-field form (same singular terms and constant)
+    const double lambda = 1.4;
+    const FullRangeConstants k = computeFullRangeConstants(lambda);
+    const NearFieldConstants near = computeNearFieldConstants(lambda, false);
+    for (PairFunction f : stresslet)
+        for (int twelve = 0; twelve < 2; ++twelve) {
+            const double xi = 1e-6, L = std::log(1 / xi);
+            const NearFieldForm& n = twelve ? near.f12[f] : near.f11[f];
+            EXPECT_NEAR(fullRangeScalar(k, f, twelve != 0, xi), n(xi, L), 1e-4 * std::max(1.0, std::fabs(n(xi, L))))
+                << pairFunctionName(f) << (twelve ? "12" : "11");
+        }
+}
+
 // Eq. (A.4) through the pair machinery: the 21 and 22 functions of (1, 10) are Townsend's 12 and 11 at
 // lambda = 0.1 (in a2 units, minus sign for Y^B), and those of (1, 0.1) his lambda = 10 rows.
 TEST(TwoSphereTheory, FullRangeSwappedFunctionsMatchTownsendAtInverseLambda)

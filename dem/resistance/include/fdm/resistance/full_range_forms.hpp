@@ -1,6 +1,7 @@
 // Full-range forms of the two-sphere resistance scalars, valid at every gap (docs/resistance.md,
 // "Full-range forms"): J&O's matched forms (Jeffrey & Onishi, J. Fluid Mech. 139 (1984) 261) of X^A, Y^A, Y^B,
-// Y^C, with the singular coefficients and constants corrected by Townsend, Phys. Fluids 35 (2023) 127126
+// Y^C, and the same construction for the stresslet functions X^G, Y^G, Y^H (Jeffrey, Phys. Fluids A 4 (1992)
+// 16), with the singular coefficients and constants corrected by Townsend, Phys. Fluids 35 (2023) 127126
 // ("T23"), and the exact X^C series of Jeffery (1915).  Normalisation: Kim-Karrila with a1 (pair_functions.hpp).
 #ifndef FDM_RESISTANCE_FULL_RANGE_FORMS_HPP
 #define FDM_RESISTANCE_FULL_RANGE_FORMS_HPP
@@ -46,14 +47,14 @@ struct MatchedForm {
 // the NearFieldForm.  Used in place of a matched form (it needs no truncation).
 void exactRotationAboutLineOfCentres(double lambda, double xi, double& x11, double& x12);
 
-// The full-range forms of X^A, Y^A, Y^B, Y^C at one lambda (11 and 12, Kim-Karrila with a1).
-// hasFullRangeForm(f): XA, YA, YB, XC, YC; X^C is evaluated by exactRotationAboutLineOfCentres.
+// The full-range forms of X^A, Y^A, Y^B, Y^C, X^G, Y^G, Y^H at one lambda (11 and 12, Kim-Karrila with a1).
+// hasFullRangeForm(f): XA, YA, YB, XC, YC, XG, YG, YH; X^C is evaluated by exactRotationAboutLineOfCentres.
 const int fullRangeDefaultOrder = 100;
 bool hasFullRangeForm(PairFunction f);
 struct FullRangeConstants {
     double lambda = 1;
     int order = 0;
-    MatchedForm f11[NumPairFunctions];   // filled for XA, YA, YB, YC
+    MatchedForm f11[NumPairFunctions];   // filled for XA, YA, YB, YC, XG, YG, YH
     MatchedForm f12[NumPairFunctions];
 };
 // order: highest power of t kept.  Up to 100 the series of the near-field constants serve (no extra
