@@ -12,7 +12,7 @@ import pytest
 TESTS = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(TESTS)
 MODULES = ("calibration", "case", "checkpoint", "decomposition", "demonly", "environment", "output", "packing",
-           "pairtangential", "periodicarray", "poiseuille", "profiles", "rheology", "sbm", "shear", "squeeze",
+           "pairstresslet", "pairtangential", "periodicarray", "poiseuille", "profiles", "rheology", "sbm", "shear", "squeeze",
            "suspension", "theory", "timeseries", "validation", "wallcalibration")
 
 

@@ -5,7 +5,8 @@ write (output), compute the profiles of a wall-bounded suspension and its rheolo
 rheology, timeseries), and the analysis of a sheared-suspension run folder (shear, the fdmProfiles
 command); squeeze flows and the calibration of the solver's own resistance, the squeeze and the
 tangential wall functions (squeeze, calibration, wallcalibration), and the measurement of the tangential
-pair modes (pairtangential); the validation report (validation).
+pair modes (pairtangential); the probe of the pair's squeeze stresslet (pairstresslet); the validation
+report (validation).
 ./Allwmake installs the package (editable) so that a notebook can `import fdmsubgrid`;
 the programs it runs are found through the environment (environment.program). docs/profiles.md.
 
