@@ -189,6 +189,26 @@ TEST(PairFdmSubgrid, DefaultModelIsTheCalibrationTable)
     EXPECT_GT((cut.R - e.R).cwiseAbs().maxCoeff(), 0.05 * e.R.cwiseAbs().maxCoeff());
 }
 
+TEST(PairFdmSubgrid, PairStyleGivenAgainStartsFromTheDefaults)
+{
+    // the second pair_style line says nothing of the model or of contact: the run has the default model
+    // (the calibration) and no contact, not the first line's cut-off model and springs
+    const std::string dir = workDir("pairagain");
+    Scene scene = pairScene(0.05);
+    scene.pairStyle = "fdm/subgrid model cutoff contact 100 80 0.5 0.1 unstable_step warn";
+    scene.spheres[2].radius = 0.5;
+    scene.runs = "pair_style      fdm/subgrid\npair_coeff      * *\nrun             1";
+    FakeFluid fluid(dir);
+    fluid.delta = 0.5 / 3;
+    const DemRun run = runWithFluid(dir, scene, fluid);
+    ASSERT_EQ(run.status, 0) << run.output;
+    expectContains(run.output, "calibrated (Appendix B");
+    expectContains(run.output, "contact OFF");
+    const res::SubgridCalibration table = res::SubgridCalibration::read(res::SubgridCalibration::defaultPath());
+    const res::CalibratedSubgridModel calibrated(table, fluid.delta, defaultCutoffCells, defaultWallCutoffCells);
+    expectSolution(fluid, scene, subgridMatrix(scene, fluid, &calibrated), 1e-8);
+}
+
 TEST(PairFdmSubgrid, LubricationNoGivesTheDiagonalSystem)
 {
     const std::string dir = workDir("lubno");

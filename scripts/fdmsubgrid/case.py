@@ -3,6 +3,7 @@ import os
 import shutil
 import subprocess
 import time
+from typing import Iterable
 
 import numpy as np
 
@@ -355,7 +356,7 @@ def boxes_and_offsets(parser, args, default_boxes, cell_offsets):
     return boxes, offsets, represented
 
 
-def uncalibrated(radii, delta, walls=False, model="calibrated") -> list[str]:
+def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, model: str = "calibrated") -> list[str]:
     """What the shipped calibration table lacks for a scene of these radii at mesh size delta (with
     walls: also each radius against a wall), in pair_style fdm/subgrid's default model (calibrated):
     empty when the run can start, else one line per missing radius pair or wall, to refuse the scene
