@@ -165,23 +165,38 @@ TEST(PairFdmSubgrid, SubgridBlocksEnterEq31AndObeyNewtonsThirdLaw)
         EXPECT_LT(std::fabs(rows[0][7 + d] + rows[1][7 + d]), roundOff) << "Newton's third law; force " << scale;
 }
 
+namespace {
+// The pair scene at a1/Delta = 3 (the suspensions' mesh; set fluid.delta = calibratedDelta), a2/a1 = 1.4 and a
+// third sphere of a1: every radius pair is in the shipped calibration table.
+const double calibratedDelta = 0.5 / 3;
+Scene calibratedScene(const std::string& pairStyle)
+{
+    Scene scene = pairScene(0.05);
+    scene.pairStyle = pairStyle;
+    scene.spheres[2].radius = 0.5;
+    return scene;
+}
+// R^SG with the shipped table's CalibratedSubgridModel
+Expected calibratedMatrix(const Scene& scene, const FakeFluid& fluid)
+{
+    static const res::SubgridCalibration table = res::SubgridCalibration::read(res::SubgridCalibration::defaultPath());
+    const res::CalibratedSubgridModel calibrated(table, fluid.delta, defaultCutoffCells, defaultWallCutoffCells);
+    return subgridMatrix(scene, fluid, &calibrated);
+}
+}  // namespace
+
 TEST(PairFdmSubgrid, DefaultModelIsTheCalibrationTable)
 {
-    // a1/Delta = 3 (the suspensions' mesh), a2/a1 = 1.4 and a third sphere of a1: every radius pair is in the
-    // shipped table, so `pair_style fdm/subgrid` with nothing asked uses it; R^SG is CalibratedSubgridModel's
+    // `pair_style fdm/subgrid` with nothing asked uses the table; R^SG is CalibratedSubgridModel's
     const std::string dir = workDir("pairdefault");
-    Scene scene = pairScene(0.05);
-    scene.pairStyle = "fdm/subgrid";
-    scene.spheres[2].radius = 0.5;
+    const Scene scene = calibratedScene("fdm/subgrid");
     FakeFluid fluid(dir);
-    fluid.delta = 0.5 / 3;
+    fluid.delta = calibratedDelta;
     const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     EXPECT_EQ(fluid.error, "");
     expectContains(run.output, "calibrated (Appendix B");
-    const res::SubgridCalibration table = res::SubgridCalibration::read(res::SubgridCalibration::defaultPath());
-    const res::CalibratedSubgridModel calibrated(table, fluid.delta, defaultCutoffCells, defaultWallCutoffCells);
-    const Expected e = subgridMatrix(scene, fluid, &calibrated);
+    const Expected e = calibratedMatrix(scene, fluid);
     ASSERT_EQ(e.pairs.size(), 1u);
     expectSolution(fluid, scene, e, 1e-8);
     // not the cut-off model's matrix: the calibration changes the pair's block at xi = 0.05
@@ -194,19 +209,15 @@ TEST(PairFdmSubgrid, PairStyleGivenAgainStartsFromTheDefaults)
     // the second pair_style line says nothing of the model or of contact: the run has the default model
     // (the calibration) and no contact, not the first line's cut-off model and springs
     const std::string dir = workDir("pairagain");
-    Scene scene = pairScene(0.05);
-    scene.pairStyle = "fdm/subgrid model cutoff contact 100 80 0.5 0.1 unstable_step warn";
-    scene.spheres[2].radius = 0.5;
+    Scene scene = calibratedScene("fdm/subgrid model cutoff contact 100 80 0.5 0.1 unstable_step warn");
     scene.runs = "pair_style      fdm/subgrid\npair_coeff      * *\nrun             1";
     FakeFluid fluid(dir);
-    fluid.delta = 0.5 / 3;
+    fluid.delta = calibratedDelta;
     const DemRun run = runWithFluid(dir, scene, fluid);
     ASSERT_EQ(run.status, 0) << run.output;
     expectContains(run.output, "calibrated (Appendix B");
     expectContains(run.output, "contact OFF");
-    const res::SubgridCalibration table = res::SubgridCalibration::read(res::SubgridCalibration::defaultPath());
-    const res::CalibratedSubgridModel calibrated(table, fluid.delta, defaultCutoffCells, defaultWallCutoffCells);
-    expectSolution(fluid, scene, subgridMatrix(scene, fluid, &calibrated), 1e-8);
+    expectSolution(fluid, scene, calibratedMatrix(scene, fluid), 1e-8);
 }
 
 TEST(PairFdmSubgrid, LubricationNoGivesTheDiagonalSystem)
