@@ -50,14 +50,35 @@ std::string fmt(double x)
 }  // namespace
 
 PairFdmSubgrid::PairFdmSubgrid(LAMMPS *lmp) :
-  Pair(lmp), computeflag(0), lubrication_(true), calibrated_(true), cutoffCells_(defaultCutoffCells), wallCutoffCells_(defaultWallCutoffCells), kn_(0), kt_(0), mu_(0), hr_(0),
-  unstableStepIsError_(true), implicit_(true), viscosity_(0),
+  Pair(lmp), computeflag(0), viscosity_(0),
   meshSize_(0), rangeGap_(0), rmin_(0), rmax_(0), distanceFactor_(1.0), history_(nullptr), wallHistory_(nullptr),
   contactStressRequested_(false), nmaxStress_(0), contactStress_(nullptr), contactsLast_(0), reported_(false),
   checkedTimeStep_(0)
 {
   single_enable = 0;
   no_virial_fdotr_compute = 1;
+  defaultSettings();
+}
+
+void PairFdmSubgrid::defaultSettings()
+{
+  // The keywords' defaults (docs/dem.md). A pair_style line given again (LAMMPS calls settings() on the
+  // same object) starts from them too: what it does not say is not kept from the earlier line, and the
+  // sub-grid model is built anew.
+  lubrication_ = true;
+  calibrated_ = true;
+  calibrationFile_.clear();
+  cutoffCells_ = defaultCutoffCells;
+  wallCutoffCells_ = defaultWallCutoffCells;
+  kn_ = kt_ = mu_ = hr_ = 0;
+  walls_.clear();
+  unstableStepIsError_ = true;
+  implicit_ = true;
+  model_.reset();
+  wallModel_.reset();
+  calibration_.reset();
+  uncalibratedTangential_.clear();
+  reported_ = false;
 }
 
 PairFdmSubgrid::~PairFdmSubgrid()
@@ -86,22 +107,7 @@ void PairFdmSubgrid::settings(int narg, char **arg)
   auto need = [&](int i, int n, const char *what) {
     if (i + n >= narg) error->all(FLERR, (std::string("pair_style fdm/subgrid: ") + what).c_str());
   };
-  // A pair_style line given again (LAMMPS calls settings() on the same object) starts from the defaults:
-  // what it does not say is not kept from the earlier line, and the sub-grid model is built anew.
-  lubrication_ = true;
-  calibrated_ = true;
-  calibrationFile_.clear();
-  cutoffCells_ = defaultCutoffCells;
-  wallCutoffCells_ = defaultWallCutoffCells;
-  kn_ = kt_ = mu_ = hr_ = 0;
-  walls_.clear();
-  unstableStepIsError_ = true;
-  implicit_ = true;
-  model_.reset();
-  wallModel_.reset();
-  calibration_.reset();
-  uncalibratedTangential_.clear();
-  reported_ = false;
+  defaultSettings();
   for (int i = 0; i < narg; i++) {
     const std::string key = arg[i];
     if (key == "lubrication") {

@@ -117,6 +117,7 @@ class PairFdmSubgrid : public Pair {
   void checkResolution();
   // Resistances of the contact modes at surface gap h (Stokes drag + sub-grid lubrication): two free
   // spheres of radius a (normal, and slip of the contact points), a sphere and a wall.
+  void defaultSettings();  // every keyword at its default (constructor, and settings() before parsing)
   void pairResistance(double a, double h, double &normal, double &slip) const;
   void wallResistance(double a, double h, double &normal, double &slip) const;
 
