@@ -108,6 +108,9 @@ def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
     assert case.uncalibrated([1.0, 1.0, 1.4], 1 / 3, walls=True) == []
     assert case.uncalibrated([1.0, 2.0], 0.25) != []
     assert case.uncalibrated([1.0, 2.0], 0.25, model="cutoff") == []
+    # one sphere per scene (wallShear, channelShear): only each radius against the walls
+    alone = case.uncalibrated([1.0, 1.4], 0.2, walls=True, pairs=False)
+    assert alone[0] == "no wall calibration for radius 1.4 at a/Delta 7" and len(alone) == 2
     # one sphere of a radius has no pair with itself: a2/Delta = 5.6 alone is fine without walls, two are not
     assert case.uncalibrated([1.0, 1.0, 1.4], 0.25) == []
     assert "the pair of radii 1.4 and 1.4" in case.uncalibrated([1.0, 1.4, 1.4], 0.25)[0]

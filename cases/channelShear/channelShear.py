@@ -319,10 +319,10 @@ def main(argv: Sequence[str] | None = None) -> dict:
                     plan.append((radius, h, subgrid))
         if not args.no_subgrid:
             # one sphere at a time: only each radius against the walls needs a calibration
-            missing = [m for radius in RADII[args.radius]
-                       for m in case.uncalibrated([radius], A1 / args.a_over_delta, walls=True, model=args.model)]
+            missing = case.uncalibrated(RADII[args.radius], A1 / args.a_over_delta, walls=True, model=args.model,
+                                        pairs=False)
             if missing:
-                raise ValueError("channelShear: " + "; ".join(dict.fromkeys(missing)))
+                raise ValueError("channelShear: " + "; ".join(missing))
     except ValueError as e:
         p.error(str(e))
     os.makedirs(args.workdir, exist_ok=True)

@@ -415,10 +415,9 @@ def main(argv: Sequence[str] | None = None) -> dict:
         p.error(str(e))
     if True in subgrid_modes:
         # one sphere at a time: each radius against the walls needs a calibration
-        missing = [m for a in args.radius
-                   for m in case.uncalibrated([a], A1 / args.a_over_delta, walls=True, model=args.model)]
+        missing = case.uncalibrated(args.radius, A1 / args.a_over_delta, walls=True, model=args.model, pairs=False)
         if missing:
-            p.error("; ".join(dict.fromkeys(missing)))
+            p.error("; ".join(missing))
 
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()

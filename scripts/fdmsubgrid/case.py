@@ -356,13 +356,15 @@ def boxes_and_offsets(parser, args, default_boxes, cell_offsets):
     return boxes, offsets, represented
 
 
-def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, model: str = "calibrated") -> list[str]:
+def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, model: str = "calibrated",
+                 pairs: bool = True) -> list[str]:
     """What the shipped calibration table lacks for a scene of these radii at mesh size delta (with
     walls: also each radius against a wall), in pair_style fdm/subgrid's default model (calibrated):
     empty when the run can start, else one line per missing radius pair or wall, to refuse the scene
     before it is launched (the pair style refuses it anyway at its start; `fdmResistance coverage`
     makes the same test). radii: every particle's (a radius held by one particle has no pair with
-    itself, as in the pair style); model cutoff needs nothing."""
+    itself, as in the pair style); pairs=False: the spheres are never in one scene together (one per
+    run), so only each radius against the walls counts; model cutoff needs nothing."""
     from collections import Counter
     from .theory import resistance
     if model != "calibrated":
@@ -373,7 +375,7 @@ def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, mode
     for i, a in enumerate(sizes):
         for b in sizes[i:]:
             r = resistance("coverage", "--a1", a, "--a2", b, "--delta", delta, *(["--wall"] if walls and b == a else []))
-            if not r["pair"] and (b != a or counts[a] > 1):
+            if pairs and not r["pair"] and (b != a or counts[a] > 1):
                 missing.append("no calibration for the pair of radii %g and %g at a1/Delta %g (a2/a1 %g)"
                                % (a, b, a / delta, b / a))
             if walls and b == a and not r["wall"]:
