@@ -200,25 +200,35 @@ SeriesTriangle SeriesTriangle::pressureMoment(const TripleTable& table, double s
     return s;
 }
 
-SeriesStore::SeriesStore(bool withM)
+namespace {
+// The first-order series, X^A, X^G (and X^P) from the axisymmetric translation problem, Y^A, Y^B, Y^G from
+// the transverse translation, Y^C, Y^H from the rotation, at `order`: the one builder of the base store
+// (order 100) and of the full-range forms' longer series.
+void buildFirstOrderSeries(int order, bool withPressure, SeriesTriangle s[NumSeries])
 {
     {
-        std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(100, 1);
+        std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(order, 1);
         s[SeriesXA] = SeriesTriangle(t->P, 1, 1.0, false);      // J&O (3.15), T23 (9)
         s[SeriesXG] = SeriesTriangle(t->P, 2, 0.75, false);     // Ichiki et al. (94)
-        s[SeriesXP] = SeriesTriangle::pressureMoment(t->P);     // every n: pressure at the other centre
+        if (withPressure) s[SeriesXP] = SeriesTriangle::pressureMoment(t->P);  // every n: pressure at the other centre
     }
     {
-        std::unique_ptr<RecurrenceTables> t = buildAsymmetric(100, TranslationStart1);
+        std::unique_ptr<RecurrenceTables> t = buildAsymmetric(order, TranslationStart1);
         s[SeriesYA] = SeriesTriangle(t->P, 1, 1.0, false);      // J&O (4.12)
         s[SeriesYB] = SeriesTriangle(t->Q, 1, 2.0, false);      // J&O (5.2), T23 (21)
         s[SeriesYG] = SeriesTriangle(t->P, 2, 0.75, false);     // Ichiki et al. (115)
     }
     {
-        std::unique_ptr<RecurrenceTables> t = buildAsymmetric(100, RotationStart1);
+        std::unique_ptr<RecurrenceTables> t = buildAsymmetric(order, RotationStart1);
         s[SeriesYC] = SeriesTriangle(t->Q, 1, 1.0, true);       // J&O (7.6), T23 (29)
         s[SeriesYH] = SeriesTriangle(t->P, 2, -0.375, true);    // Ichiki et al. (120)
     }
+}
+}  // namespace
+
+SeriesStore::SeriesStore(bool withM)
+{
+    buildFirstOrderSeries(100, true, s);
     if (withM) addM();
 }
 
@@ -262,33 +272,19 @@ const FullRangeSeries& fullRangeSeries(int order)
     std::unique_ptr<FullRangeSeries>& entry = cache[order];
     if (entry) return *entry;
     entry.reset(new FullRangeSeries);
-    if (order <= 100) {
-        const SeriesStore& base = seriesStore(false);
-        entry->xa = base.s[SeriesXA];
-        entry->ya = base.s[SeriesYA];
-        entry->yb = base.s[SeriesYB];
-        entry->yc = base.s[SeriesYC];
-        entry->xg = base.s[SeriesXG];
-        entry->yg = base.s[SeriesYG];
-        entry->yh = base.s[SeriesYH];
-        return *entry;
+    SeriesTriangle longer[NumSeries];
+    const SeriesTriangle* series = seriesStore(false).s;
+    if (order > 100) {
+        buildFirstOrderSeries(order, false, longer);
+        series = longer;
     }
-    {
-        std::unique_ptr<RecurrenceTables> t = buildAxisymmetric(order, 1);
-        entry->xa = SeriesTriangle(t->P, 1, 1.0, false);     // J&O (3.15)
-        entry->xg = SeriesTriangle(t->P, 2, 0.75, false);    // Ichiki et al. (94)
-    }
-    {
-        std::unique_ptr<RecurrenceTables> t = buildAsymmetric(order, TranslationStart1);
-        entry->ya = SeriesTriangle(t->P, 1, 1.0, false);     // J&O (4.12)
-        entry->yb = SeriesTriangle(t->Q, 1, 2.0, false);     // J&O (5.2)
-        entry->yg = SeriesTriangle(t->P, 2, 0.75, false);    // Ichiki et al. (115)
-    }
-    {
-        std::unique_ptr<RecurrenceTables> t = buildAsymmetric(order, RotationStart1);
-        entry->yc = SeriesTriangle(t->Q, 1, 1.0, true);      // J&O (7.6)
-        entry->yh = SeriesTriangle(t->P, 2, -0.375, true);   // Ichiki et al. (120)
-    }
+    entry->xa = series[SeriesXA];
+    entry->ya = series[SeriesYA];
+    entry->yb = series[SeriesYB];
+    entry->yc = series[SeriesYC];
+    entry->xg = series[SeriesXG];
+    entry->yg = series[SeriesYG];
+    entry->yh = series[SeriesYH];
     return *entry;
 }
 
