@@ -37,8 +37,6 @@ namespace res = fdm::resistance;
 namespace {
 const char *faceNames[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
 
-// the cut-off gaps of the cut-off model, in mesh cells (docs/dem.md; chosen from the squeeze flows)
-const double defaultCutoffCells = 0.65, defaultWallCutoffCells = 0.75;
 
 std::string fmt(double x)
 {
@@ -68,8 +66,8 @@ void PairFdmSubgrid::defaultSettings()
   lubrication_ = true;
   calibrated_ = true;
   calibrationFile_.clear();
-  cutoffCells_ = defaultCutoffCells;
-  wallCutoffCells_ = defaultWallCutoffCells;
+  cutoffCells_ = res::defaultPairCutoffCells;
+  wallCutoffCells_ = res::defaultWallCutoffCells;
   kn_ = kt_ = mu_ = hr_ = 0;
   walls_.clear();
   unstableStepIsError_ = true;

@@ -58,17 +58,12 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output  # noqa: E402
+from fdmsubgrid import case, output, theory  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0
 A1 = 1.0
 RADII = {"1": (1.0,), "1.4": (1.4,), "both": (1.0, 1.4)}
-# pair_style fdm/subgrid's default wall cut-off, in mesh cells (docs/dem.md, `wall_cutoff`): the wall
-# block acts on a gap below WALL_CUTOFF_CELLS * Delta. Used only to say in the output whether it acts.
-WALL_CUTOFF_CELLS = 0.75
-# the calibrated model's wall range (eps = h/a - 1 below which it corrects, docs/resistance.md)
-CALIBRATED_WALL_RANGE = 1.0
 
 # Default gaps H/a per radius at a1/Delta = 3: whole numbers of cells (H = n Delta, Delta = 1/3), from
 # the most confined one the mesh allows (eps = H/2a - 1 = 1/6 for a1, 1/14 for a2: inside the wall
@@ -187,12 +182,13 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
     velocity = np.array(rec["U"][:, 0], dtype=float)
     if not keep:
         case.delete_fields(run_dir)
+    wall_range = theory.wall_subgrid_range(a, delta, model)     # eps below which the wall block acts
     return dict(radius=a, H_over_a=H / a, H_cells=ny, centre_y_in_cell=0.5 * (ny % 2),
                 box=[Lx / a, H / a, Lz / a], cells=nx * ny * nz,
                 a_over_delta=a_over_delta, a_over_delta_sphere=a / delta, eps=H / (2 * a) - 1,
                 subgrid=subgrid, model=model if subgrid else None,
-                wall_block_acts=bool(H / 2 - a < (CALIBRATED_WALL_RANGE * a if model == "calibrated"
-                                                  else WALL_CUTOFF_CELLS * delta)),
+                wall_block_acts=bool(subgrid and H / (2 * a) - 1 < wall_range),
+                wall_subgrid_range=wall_range,
                 offsets=[list(o) for o in offsets],
                 Wz_norm=[float(w) for w in omega[:, 2] / (-0.5 * SHEAR_RATE)],
                 S_star=[float(s) for s in (s_fluid + s_subgrid) / stokes_s],
@@ -219,6 +215,7 @@ def summarise(scene: dict, n_positions: int) -> dict:
                 box=scene["box"], cells=scene["cells"], a_over_delta=scene["a_over_delta"],
                 a_over_delta_sphere=scene["a_over_delta_sphere"], n_positions=n_positions,
                 n_computed=len(scene["offsets"]), subgrid=scene["subgrid"], wall_block_acts=scene["wall_block_acts"],
+                wall_subgrid_range=scene["wall_subgrid_range"],
                 inner_iterations=scene["inner_iterations"], converged=scene["converged"],
                 wall_seconds=scene["wall_seconds"],
                 per_position=dict(offsets=scene["offsets"], Wz_norm=scene["Wz_norm"], S_star=scene["S_star"]))
@@ -335,7 +332,6 @@ def main(argv: Sequence[str] | None = None) -> dict:
         print_row(rows[-1])
     results = dict(case="channelShear", size_over_a=args.size, a_over_delta=args.a_over_delta,
                    positions=args.positions, tol_lambda=args.tol_lambda, model=args.model,
-                   wall_cutoff_cells=WALL_CUTOFF_CELLS,
                    rows=rows, wall_seconds=time.time() - t0)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     with open(args.out, "w") as f:

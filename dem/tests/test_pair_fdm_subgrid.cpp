@@ -14,7 +14,7 @@ namespace res = fdm::resistance;
 namespace {
 
 // pair_style fdm/subgrid's default cut-off gaps, in mesh cells (docs/dem.md)
-const double defaultCutoffCells = 0.65, defaultWallCutoffCells = 0.75;
+const double defaultCutoffCells = res::defaultPairCutoffCells, defaultWallCutoffCells = res::defaultWallCutoffCells;
 
 // Two close unequal spheres (a2/a1 = 1.4, xi = 0.02 along a slanted line) and a third far away, with the
 // cut-off model (its radii and mesh, a1/Delta = 2.5, are outside the calibration table of the default model).

@@ -1,27 +1,36 @@
-"""The solver's own squeeze stresslet of a pair (paper section 2.2, Appendix B): how much of the stresslet
-X^G the fictitious-domain solver resolves when two spheres approach along their line of centres, and what
-the cut-off model adds to it. A probe, not yet a calibration: `model calibrated` takes its stresslet
-functions (X^G, Y^G, Y^H, X^P) from the cut-off model (docs/resistance.md).
+"""The squeeze stresslet of a pair (paper section 2.2, Appendix B): how much of the stresslet X^G the
+fictitious-domain solver resolves when two spheres approach along their line of centres, what each sub-grid
+model adds to it, and the coupled result.
 
-What is run: the squeeze scene of calibration.py (spheres of radii 1 and `ratio` along x in a periodic
-cube, pushed together by +-F, the sub-grid lubrication off), held at each gap for one coupled step with
-`stresslets yes`, at the calibration's 4 positions in the cell and 2 box sizes. Each sphere's fluid
-stresslet S (fix fdm/output's S_fluid, the force the fluid exerts; Kim-Karrila's S is its opposite) has
-the traceless part S_xx - tr S/3 = (2/3) (g_11 U1 + g_12 U2) for motion along the line of centres x.
-One loading cannot split g_11 from g_12: the solver's response to a rigid translation of the pair,
-g_11 + g_12, is taken as the theory's X^G_11 + X^G_12 (the far field, which the solver resolves), so
+What is run: the squeeze scene of calibration.py (squeeze.run_pair: spheres of radii 1 and `ratio` along x in
+a periodic cube, pushed together by +-F), held at each gap for one coupled step with `stresslets yes`, at the
+calibration's 4 positions in the cell and 2 box sizes; the sub-grid lubrication off (the solver alone), or on
+with `--model` (the coupled solver, stresslet = fluid + sub-grid parts). Each sphere's stresslet S (fix
+fdm/output's S_fluid + S_subgrid, the force the fluid exerts; Kim-Karrila's S is its opposite) has the
+traceless part S_xx - tr S/3 = (2/3) (g_11 U1 + g_12 U2) for motion along the line of centres x. One loading
+cannot split g_11 from g_12: the response to a rigid translation of the pair, g_11 + g_12, is taken as the
+theory's X^G_11 + X^G_12 (the far field, which the solver resolves, and which the frame-invariant sub-grid
+matrix leaves alone), so
 
     g_11 = (S_1 - (X^G_11 + X^G_12) U2) / (U1 - U2),
 
-and the correction the coupled solver needs is X^G_11 - g_11 (C.2's base function X11G; sphere 2 gives the
-relabelled pair's). Box effect: g at L = 8 and 12 a1 extrapolated as g_inf + c L^-3 (the images of a force
-dipole), then averaged over the positions.
+compared with the theory's X^G_11 (sphere 2 gives the relabelled pair's). Box effect: g at L = 8 and 12 a1
+extrapolated as g_inf + c L^-3 (the images of a force dipole), then averaged over the positions.
+
+What the models add. The sub-grid stresslet is not the base function X11G alone: Appendix C.2's frame
+invariance ties X^G_21 = -X^G_11 - r X^A_21, and pair_style fdm/subgrid averages the two labellings
+(subgridPairFunctions), so the X^G_11 it applies is (X11G(a1, a2) - X11G(a2, a1) - r X^A_21)/2: for equal
+spheres exactly -r X^A_21/2, each sphere taking half of the force dipole r F^SG of the squeeze correction,
+whatever X11G is. The probe takes the applied value from `fdmResistance pair --subgrid [--calibrated]`
+(dimensional_over_eta XG11) and, from the solver-alone runs, predicts the coupled error of each model; a run
+with `--model` measures it.
 
 The theory is the library's full-range X^G (`fdmResistance pair --theory --full`: Jeffrey 1992's series
-matched to the near-field forms, within 5.3e-4 of Townsend's exact values at s' >= 2.025). The cut-off
-model subtracts the near-field form, as the pair style does.
+matched to the near-field forms, within 5.3e-4 of Townsend's exact values at s' >= 2.025).
 
     python3 -m fdmsubgrid.pairstresslet --a-over-delta 3 --ratio 1 1.4 --out runs/pair_stresslet.json
+    python3 -m fdmsubgrid.pairstresslet --a-over-delta 3 --ratio 1 --model calibrated --out runs/coupled.json
+    python3 -m fdmsubgrid.pairstresslet --reanalyse runs/pair_stresslet.json    (the models' columns again)
 """
 from __future__ import annotations
 
@@ -34,41 +43,25 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import case, theory
+from . import squeeze, theory
 from .calibration import BOXES, GAPS, OFFSETS
-from .pairtangential import centres
 from .squeeze import extrapolate_box
+
+MODELS = ("cutoff", "calibrated")   # pair_style fdm/subgrid's sub-grid models
 
 FORCE = 6 * math.pi   # eta = a1 = 1: velocities in F/(6 pi eta a1)
 
 
 def run_squeeze(workdir: str, ratio: float, a_over_delta: float, L_over_a: float, offset: Sequence[float],
-                gaps: Sequence[float] = GAPS, np_fluid: int = 1) -> Dict[str, np.ndarray]:
-    """One coupled run of the squeeze scene held at each gap (largest first) with the lubrication off and
-    the stresslets on; returns U1, U2 (velocities along x) and S1, S2 (S_fluid, xx xy xz yy yz zz) per gap."""
-    delta = 1.0 / a_over_delta
-    L = L_over_a
-    run_dir = os.path.join(workdir, "ratio%g_ad%g_L%g_offset%g" % (ratio, a_over_delta, L_over_a, offset[0]))
-    box = case.Box((0, 0, 0), (L, L, L), delta)
-    middle = [L / 2 + o * delta for o in offset]
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=1e-5, n_max=3000,
-                          n_particles=2)
-    p1, p2 = centres(ratio, gaps[0], middle)
-    runs = ["fix             output all fdm/output records 1 particles.records"]
-    runs += case.held_step_runs([centres(ratio, xi, middle) for xi in gaps])
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
-                         fix_options="move no stresslets yes", pair_style="fdm/subgrid lubrication no",
-                         before_run="group           one id 1\ngroup           two id 2\n"
-                                    "fix             push1 one addforce %r 0 0\n"
-                                    "fix             push2 two addforce %r 0 0" % (FORCE, -FORCE),
-                         runs=runs, name="in.pairStresslet")
-    case.run(run_dir, np_fluid=np_fluid)
-    records, _ = case.read_held_steps(run_dir, len(gaps), "pairstresslet")
-    n = len(gaps)
-    U = np.array(records["U"][-n:, :, 0], dtype=float)
-    S = np.array(records["S_fluid"][-n:], dtype=float)
-    case.delete_fields(run_dir)
-    return dict(U1=U[:, 0], U2=U[:, 1], S1=S[:, 0], S2=S[:, 1])
+                gaps: Sequence[float] = GAPS, np_fluid: int = 1, model: str | None = None) -> Dict[str, np.ndarray]:
+    """One coupled run of the squeeze scene held at each gap (largest first) with the stresslets on, the
+    sub-grid lubrication off (model None) or on with `model`; returns U1, U2 (velocities along x) and S1, S2
+    (S_fluid + S_subgrid, xx xy xz yy yz zz) per gap."""
+    run = squeeze.run_pair(os.path.join(workdir, model or "solver"), ratio, gaps, subgrid=model is not None,
+                           a_over_delta=a_over_delta, L_over_a=L_over_a, tol_lambda=1e-5, np_fluid=np_fluid,
+                           offset=offset, pair_options="model %s" % model if model else "", stresslets=True)
+    return dict(U1=run["U1"], U2=run["U2"], S1=run["S1_fluid"] + run["S1_subgrid"],
+                S2=run["S2_fluid"] + run["S2_subgrid"])
 
 
 def kim_karrila_xx(S: np.ndarray) -> np.ndarray:
@@ -85,10 +78,12 @@ def theory_xg(a1: float, a2: float, xi: float) -> tuple:
 
 
 @functools.lru_cache(maxsize=None)
-def cutoff_x11g(a1: float, a2: float, xi: float, delta: float) -> float:
-    """The cut-off model's base X11G (sphere 1 of radius a1) at pair_style fdm/subgrid's default cut-off."""
+def applied_x11g(a1: float, a2: float, xi: float, delta: float, model: str) -> float:
+    """The X^G_11 (sphere 1 of radius a1) that pair_style fdm/subgrid applies with `model` at its default
+    cut-offs: Appendix C.2's expansion averaged over the labellings (module docstring)."""
+    options = ("--calibrated",) if model == "calibrated" else ("--cutoff", theory.PAIR_CUTOFF)
     return theory.resistance("pair", "--a1", a1, "--a2", a2, "--xi", xi, "--subgrid", "--delta", delta,
-                             "--cutoff", theory.PAIR_CUTOFF)["base"]["X11G"]
+                             *options)["dimensional_over_eta"]["XG11"]
 
 
 def solver_x11g(run: Dict[str, np.ndarray], ratio: float, gaps: Sequence[float]) -> tuple:
@@ -105,50 +100,91 @@ def solver_x11g(run: Dict[str, np.ndarray], ratio: float, gaps: Sequence[float])
 
 
 def measure(ratio: float, a_over_delta: float, workdir: str, gaps: Sequence[float] = GAPS,
-            boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS) -> Dict:
-    """The solver's X11G (both labellings) at every gap, box-extrapolated and averaged over the offsets,
-    beside the theory and the cut-off model's correction."""
+            boxes: Sequence[float] = BOXES, offsets: Sequence[Sequence[float]] = OFFSETS,
+            model: str | None = None) -> Dict:
+    """g_11 (both labellings) at every gap, box-extrapolated and averaged over the offsets, of the solver alone
+    (model None) or of the coupled solver with `model`, beside the theory (analyse() adds the comparisons)."""
     per_box = {}
     for L in boxes:
-        g = [solver_x11g(run_squeeze(workdir, ratio, a_over_delta, L, o, gaps), ratio, gaps) for o in offsets]
+        g = [solver_x11g(run_squeeze(workdir, ratio, a_over_delta, L, o, gaps, model=model), ratio, gaps)
+             for o in offsets]
         per_box[L] = np.array(g)        # (offsets, 2 labellings, gaps)
     L1, L2 = boxes[0], boxes[-1]
-    solver = extrapolate_box(per_box[L1], per_box[L2], L1, L2)
-    mean, spread = solver.mean(axis=0), solver.std(axis=0)
-    delta = 1.0 / a_over_delta
-    rows = []
-    for k, xi in enumerate(gaps):
-        th = (theory_xg(1.0, ratio, xi)[0], theory_xg(ratio, 1.0, xi)[0])
-        cut = (cutoff_x11g(1.0, ratio, xi, delta), cutoff_x11g(ratio, 1.0, xi, delta))
-        rows.append(dict(xi=xi, theory=list(th), solver=mean[:, k].tolist(), solver_spread=spread[:, k].tolist(),
-                         needed=[th[j] - mean[j, k] for j in range(2)], cutoff=list(cut),
-                         cutoff_total_error=[(mean[j, k] + cut[j] - th[j]) / th[j] for j in range(2)]))
-    return dict(ratio=ratio, a_over_delta=a_over_delta, boxes=list(boxes), offsets=[list(o) for o in offsets],
-                rows=rows)
+    measured = extrapolate_box(per_box[L1], per_box[L2], L1, L2)
+    mean, spread = measured.mean(axis=0), measured.std(axis=0)
+    rows = [dict(xi=xi, measured=mean[:, k].tolist(), measured_spread=spread[:, k].tolist())
+            for k, xi in enumerate(gaps)]
+    return analyse(dict(ratio=ratio, a_over_delta=a_over_delta, model=model, boxes=list(boxes),
+                        offsets=[list(o) for o in offsets], rows=rows))
+
+
+def analyse(result: Dict) -> Dict:
+    """Adds to each row the theory, and: for the solver alone, what it misses ('needed') and what each model
+    applies with the coupled error that predicts; for a coupled run, its error. (The first version of the probe
+    stored the solver's values as 'solver' and compared the base function X11G alone, not what the pair style
+    applies; such a result is read and analysed anew.)"""
+    ratio, delta = result["ratio"], 1.0 / result["a_over_delta"]
+    model = result.get("model")
+    for r in result["rows"]:
+        if "solver" in r:                 # the first version's keys
+            r["measured"], r["measured_spread"] = r.pop("solver"), r.pop("solver_spread")
+            for old in ("needed", "cutoff", "cutoff_total_error"):
+                r.pop(old, None)
+        xi, g = r["xi"], r["measured"]
+        th = [theory_xg(1.0, ratio, xi)[0], theory_xg(ratio, 1.0, xi)[0]]
+        r["theory"] = th
+        if model:
+            r["coupled_error"] = [(g[j] - th[j]) / th[j] for j in range(2)]
+            continue
+        r["needed"] = [th[j] - g[j] for j in range(2)]
+        r["applied"], r["predicted_error"] = {}, {}
+        for m in MODELS:
+            applied = [applied_x11g(1.0, ratio, xi, delta, m), applied_x11g(ratio, 1.0, xi, delta, m)]
+            r["applied"][m] = applied
+            r["predicted_error"][m] = [(g[j] + applied[j] - th[j]) / th[j] for j in range(2)]
+    return result
 
 
 def print_summary(result: Dict) -> None:
-    print("a1/Delta %g, a2/a1 %g: X11G of sphere 1 | sphere 2 relabelled; coupled error with the cut-off model"
-          % (result["a_over_delta"], result["ratio"]))
-    print("%-7s %10s %10s %10s %10s | %10s %10s %10s %10s  %8s %8s" % (
-        "xi", "theory", "solver", "needed", "cut-off", "theory", "solver", "needed", "cut-off", "err 1", "err 2"))
+    model = result.get("model")
+    print("a1/Delta %g, a2/a1 %g, %s: X11G of sphere 1 | sphere 2 relabelled"
+          % (result["a_over_delta"], result["ratio"], "coupled with model %s" % model if model else "solver alone"))
+    if model:
+        print("%-7s %10s %10s | %10s %10s  %8s %8s" % ("xi", "theory", "coupled", "theory", "coupled", "err 1", "err 2"))
+        for r in result["rows"]:
+            print("%-7g %10.3f %10.3f | %10.3f %10.3f  %+7.1f%% %+7.1f%%" % (
+                r["xi"], r["theory"][0], r["measured"][0], r["theory"][1], r["measured"][1],
+                100 * r["coupled_error"][0], 100 * r["coupled_error"][1]))
+        return
+    print("%-7s %9s %9s %9s | %9s %9s %9s | predicted error: %-15s %-15s" % (
+        "xi", "theory", "solver", "needed", "theory", "solver", "needed", "cut-off", "calibrated"))
     for r in result["rows"]:
-        print("%-7g %10.3f %10.3f %10.3f %10.3f | %10.3f %10.3f %10.3f %10.3f  %+7.1f%% %+7.1f%%" % (
-            r["xi"], r["theory"][0], r["solver"][0], r["needed"][0], r["cutoff"][0], r["theory"][1], r["solver"][1],
-            r["needed"][1], r["cutoff"][1], 100 * r["cutoff_total_error"][0], 100 * r["cutoff_total_error"][1]))
+        e = r["predicted_error"]
+        print("%-7g %9.3f %9.3f %9.3f | %9.3f %9.3f %9.3f | %+6.1f%% %+6.1f%%  %+6.1f%% %+6.1f%%" % (
+            r["xi"], r["theory"][0], r["measured"][0], r["needed"][0], r["theory"][1], r["measured"][1],
+            r["needed"][1], 100 * e["cutoff"][0], 100 * e["cutoff"][1], 100 * e["calibrated"][0],
+            100 * e["calibrated"][1]))
 
 
 def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--ratio", type=float, nargs="+", default=[1.0, 1.4])
+    p.add_argument("--model", choices=MODELS, default=None,
+                   help="run the coupled solver with this sub-grid model (default: the solver alone, lubrication off)")
     p.add_argument("--workdir", default=os.path.join("runs", "pairstresslet"))
     p.add_argument("--out", default=None, help="JSON of the results")
+    p.add_argument("--reanalyse", metavar="JSON", default=None,
+                   help="analyse the results of an earlier call again (written back to --out, default the same file)")
     args = p.parse_args(argv)
-    results = []
-    for ratio in args.ratio:
-        results.append(measure(ratio, args.a_over_delta, args.workdir))
-        print_summary(results[-1])
+    if args.reanalyse:
+        with open(args.reanalyse) as f:
+            results = [analyse(r) for r in json.load(f)]
+        args.out = args.out or args.reanalyse
+    else:
+        results = [measure(ratio, args.a_over_delta, args.workdir, model=args.model) for ratio in args.ratio]
+    for result in results:
+        print_summary(result)
     if args.out:
         with open(args.out, "w") as f:
             json.dump(results, f, indent=1)

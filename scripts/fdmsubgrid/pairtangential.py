@@ -43,6 +43,7 @@ from typing import Dict, List, Sequence
 import numpy as np
 
 from . import case, squeeze, theory
+from .squeeze import pair_centres
 from .wallcalibration import seen_gap
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
@@ -50,13 +51,6 @@ OFFSETS = [(0.1, 0.2, 0.3), (0.35, 0.45, 0.55), (0.6, 0.7, 0.8), (0.85, 0.95, 0.
 BOXES = (8.0, 12.0)
 FORCE = 6 * math.pi          # eta = a1 = 1
 TORQUE = 8 * math.pi
-
-
-def centres(ratio: float, xi: float, centre: Sequence[float]) -> tuple:
-    """Sphere centres (radii 1 and ratio) along x with the gap's middle at `centre`, reduced gap xi."""
-    a1, a2 = 1.0, ratio
-    gap = xi * (a1 + a2) / 2
-    return ((centre[0] - gap / 2 - a1, centre[1], centre[2]), (centre[0] + gap / 2 + a2, centre[1], centre[2]))
 
 
 def separation(ratio: float, xi: float) -> float:
@@ -109,10 +103,10 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
         if k > 0:
             runs += ["unfix           push1", "unfix           turn1", "unfix           push2", "unfix           turn2"]
             runs += ["set             atom %d x %r y %r z %r" % (i + 1, *map(float, c))
-                     for i, c in enumerate(centres(ratio, xi, centre))]
+                     for i, c in enumerate(pair_centres(ratio, xi, centre))]
         runs += _load_lines(separation(ratio, xi))
         runs.append("run             1")
-    p1, p2 = centres(ratio, xis[0], centre)
+    p1, p2 = pair_centres(ratio, xis[0], centre)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
                          pair_style="fdm/subgrid " + ("lubrication no" if model is None else "model " + model),
                          before_run="group           one id 1\ngroup           two id 2", runs=runs,

@@ -4,7 +4,8 @@ and a sphere pushed toward a plane wall, held at a list of gaps (one coupled ste
 
 The one runner of these scenes: cases/pairSqueeze and cases/wallSqueeze compare them with theory,
 the calibration of the solver's own squeeze resistance (calibration.py, paper Appendix B) measures
-them with the sub-grid lubrication switched off.
+them with the sub-grid lubrication switched off, and the stresslet probe (pairstresslet.py) reads
+the spheres' stresslets from them.
 
 Velocities are returned in units of F/(6 pi eta a1) (pair: the closing velocity (U1 - U2).d; wall:
 the velocity toward the wall).
@@ -88,32 +89,43 @@ def _tag(subgrid: bool, offset: Sequence[float]) -> str:
     return name
 
 
+def pair_centres(ratio: float, xi: float, centre: Sequence[float]) -> tuple:
+    """The centres of spheres of radii 1 and `ratio` along x at the reduced gap xi = 2r/(a1+a2) - 2, the
+    middle of their gap at `centre` (the pair scenes of this module and of pairtangential.py)."""
+    a1, a2 = 1.0, ratio
+    gap = xi * (a1 + a2) / 2
+    return ((centre[0] - gap / 2 - a1, centre[1], centre[2]), (centre[0] + gap / 2 + a2, centre[1], centre[2]))
+
+
 def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_over_delta: float = 4.0,
              L_over_a: float = 8.0, tol_lambda: float = 1e-5, cutoff: float | None = None, np_fluid: int = 1,
-             keep: bool = False, offset: Sequence[float] = DEFAULT_OFFSET, pair_options: str = "") -> dict:
+             keep: bool = False, offset: Sequence[float] = DEFAULT_OFFSET, pair_options: str = "",
+             stresslets: bool = False) -> dict:
     """Spheres of radii 1 and `ratio` in a periodic cube of side L_over_a, pushed together by forces
     F = 6 pi eta a1 along x, at the reduced gaps `xis` (xi = 2r/(a1+a2) - 2, largest first).
     `offset`: the centre of the gap inside its mesh cell (fractions of Delta); `pair_options`: more
     pair_style fdm/subgrid keywords. Returns dict(velocity=[closing velocity / (F/(6 pi eta a1))],
-    wall_seconds, cells, inner_iterations, converged)."""
+    wall_seconds, cells, inner_iterations, converged). With `stresslets` (fix fdm/couple ... stresslets
+    yes, the particle records of fix fdm/output read) also, per gap, U1 and U2 (velocities along x,
+    eta = a1 = 1) and the stresslets S1_fluid, S2_fluid, S1_subgrid, S2_subgrid (xx xy xz yy yz zz, the
+    records' sign: the force the fluid exerts)."""
     a1, a2 = 1.0, ratio
     delta = a1 / a_over_delta
     L = L_over_a * a1
     eta = 1.0
     F = 6 * math.pi * eta * a1
-    run_dir = _fresh_run_dir(workdir, "lambda%g_ad%g_L%g_%s" % (ratio, a_over_delta, L_over_a, _tag(subgrid, offset)))
+    run_dir = _fresh_run_dir(workdir, "lambda%g_ad%g_L%g_%s%s" % (ratio, a_over_delta, L_over_a, _tag(subgrid, offset),
+                                                                  "_stresslets" if stresslets else ""))
     box = case.Box((0, 0, 0), (L, L, L), delta)
     centre = [L / 2 + o * delta for o in offset]
-
-    def positions(xi: float):
-        gap = xi * (a1 + a2) / 2
-        return ((centre[0] - gap / 2 - a1, centre[1], centre[2]), (centre[0] + gap / 2 + a2, centre[1], centre[2]))
-
     case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
                           n_particles=2)
-    runs = case.held_step_runs([positions(xi) for xi in xis])
-    p1, p2 = positions(xis[0])
+    runs = case.held_step_runs([pair_centres(ratio, xi, centre) for xi in xis])
+    if stresslets:
+        runs = ["fix             output all fdm/output records 1 particles.records"] + runs
+    p1, p2 = pair_centres(ratio, xis[0], centre)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0,
+                         fix_options="move no stresslets yes" if stresslets else "move no",
                          pair_style=_pair_style(subgrid, cutoff, pair_options),
                          before_run="group           one id 1\ngroup           two id 2\n"
                                     "fix             push1 one addforce %r 0 0\n"
@@ -122,7 +134,16 @@ def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_
     wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     U1 = parts["Ux"][parts["tag"] == 1]
     U2 = parts["Ux"][parts["tag"] == 2]
-    return _result((U1 - U2) / (F / (6 * math.pi * eta * a1)), wall, box, steps)
+    result = _result((U1 - U2) / (F / (6 * math.pi * eta * a1)), wall, box, steps)
+    if stresslets:
+        n = len(xis)
+        records, _ = case.read_held_steps(run_dir, n, "squeeze.run_pair")
+        U = np.array(records["U"][-n:, :, 0], dtype=float)
+        fluid = np.array(records["S_fluid"][-n:], dtype=float)
+        subgrid_part = np.array(records["S_subgrid"][-n:], dtype=float)
+        result.update(U1=U[:, 0], U2=U[:, 1], S1_fluid=fluid[:, 0], S2_fluid=fluid[:, 1],
+                      S1_subgrid=subgrid_part[:, 0], S2_subgrid=subgrid_part[:, 1])
+    return result
 
 
 def run_wall_scene(run_dir: str, epss: Sequence[float], a_over_delta: float, L_over_a: float, H_over_a: float,

@@ -1,7 +1,7 @@
 // fdmResistance: prints resistance functions and blocks as JSON (docs/resistance.md, "Command line").
-//   fdmResistance pair    --a1 A --a2 B --xi X [--theory [--full [--order N]]|--subgrid] [--delta D] [--cutoff K]
-//   fdmResistance matrix  --x1 x y z --x2 x y z --a1 A --a2 B [--delta D] [--eta E] [--cutoff K]
-//   fdmResistance wall    --a A --eps E [--delta D] [--cutoff K]
+//   fdmResistance pair    --a1 A --a2 B --xi X [--theory [--full [--order N]]|--subgrid [--calibrated]] [--delta D] [--cutoff K]
+//   fdmResistance matrix  --x1 x y z --x2 x y z --a1 A --a2 B [--delta D [--calibrated]] [--eta E] [--cutoff K]
+//   fdmResistance wall    --a A --eps E [--delta D [--calibrated]] [--cutoff K]
 //   fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]
 //   fdmResistance squeeze --a A --eps E --wall
 //   fdmResistance coverage --a1 A [--a2 B] --delta D [--wall]
@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -22,13 +23,15 @@ namespace {
 
 const char* usage =
     "usage:\n"
-    "  fdmResistance pair    --a1 A --a2 B --xi X [--theory [--full [--order N]]|--subgrid] [--delta D] [--cutoff K]\n"
-    "  fdmResistance matrix  --x1 x y z --x2 x y z --a1 A --a2 B [--delta D] [--eta E] [--cutoff K]\n"
-    "  fdmResistance wall    --a A --eps E [--delta D] [--cutoff K]\n"
+    "  fdmResistance pair    --a1 A --a2 B --xi X [--theory [--full [--order N]]|--subgrid [--calibrated]] [--delta D] [--cutoff K]\n"
+    "  fdmResistance matrix  --x1 x y z --x2 x y z --a1 A --a2 B [--delta D [--calibrated]] [--eta E] [--cutoff K]\n"
+    "  fdmResistance wall    --a A --eps E [--delta D [--calibrated]] [--cutoff K]\n"
     "  fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]\n"
     "  fdmResistance squeeze --a A --eps E --wall\n"
     "  fdmResistance coverage --a1 A [--a2 B] --delta D [--wall]\n"
     "xi = 2r/(a1+a2) - 2; eps = h/a - 1; --delta: mesh size (sub-grid output); --cutoff: k in xi_c = k*delta/a_mean\n"
+    "  (cut-off model, default 1); --calibrated: the sub-grid model pair_style fdm/subgrid uses by default (the shipped\n"
+    "  calibration table, the other functions from the cut-off model at the pair style's cut-offs, 0.65 and 0.75 cells)\n"
     "--full: full-range X^A, Y^A, Y^B, X^C, Y^C, X^G, Y^G, Y^H (matched forms, every gap); --order: far-field powers kept (default 100)\n"
     "squeeze: closing velocity under equal and opposite forces F along the line of centres, in units of F/(6 pi eta a1)\n"
     "  (full-range theory; --near: near-field forms); --wall: sphere pushed toward a plane wall, 1/X^A_wall\n"
@@ -74,7 +77,8 @@ Arguments parse(int argc, char** argv)
         std::string key = argv[i];
         if (key.compare(0, 2, "--") != 0) throw std::runtime_error("unexpected argument '" + key + "'");
         key = key.substr(2);
-        if (key == "theory" || key == "subgrid" || key == "full" || key == "near" || key == "wall") {
+        if (key == "theory" || key == "subgrid" || key == "full" || key == "near" || key == "wall" ||
+            key == "calibrated") {
             a.flags[key] = true;
             continue;
         }
@@ -92,6 +96,26 @@ Arguments parse(int argc, char** argv)
 void positive(double v, const char* name)
 {
     if (!(v > 0)) throw std::runtime_error(std::string(name) + " must be positive");
+}
+
+// The sub-grid model the options ask for: the cut-off model at --cutoff cells (default 1), or with
+// --calibrated the one pair_style fdm/subgrid builds by default (the shipped table; its functions that the
+// table lacks from the cut-off model at the pair style's cut-offs, 0.65 cells for pairs and 0.75 for walls;
+// --cutoff replaces the one the command is about: the wall's for `wall`, the pair's otherwise).
+double cutoffCells(const Arguments& args, bool wall)
+{
+    if (!args.flags.count("calibrated")) return args.number("cutoff", 1.0);
+    return args.number("cutoff", wall ? defaultWallCutoffCells : defaultPairCutoffCells);
+}
+
+std::unique_ptr<SubgridModel> subgridModel(const Arguments& args, double delta, bool wall = false)
+{
+    if (!args.flags.count("calibrated"))
+        return std::unique_ptr<SubgridModel>(new CutoffSubgridModel(delta, cutoffCells(args, wall)));
+    const SubgridCalibration table = SubgridCalibration::read(SubgridCalibration::defaultPath());
+    return std::unique_ptr<SubgridModel>(new CalibratedSubgridModel(
+        table, delta, wall ? defaultPairCutoffCells : cutoffCells(args, false),
+        wall ? cutoffCells(args, true) : defaultWallCutoffCells));
 }
 
 std::string number(double v)
@@ -162,6 +186,7 @@ int pairCommand(const Arguments& args)
     const bool subgrid = args.flags.count("subgrid") > 0, full = args.flags.count("full") > 0;
     if (subgrid && args.flags.count("theory")) throw std::runtime_error("choose one of --theory and --subgrid");
     if (subgrid && full) throw std::runtime_error("--full belongs to --theory, not --subgrid");
+    if (args.flags.count("calibrated") && !subgrid) throw std::runtime_error("--calibrated belongs to --subgrid");
     if (args.has("order") && !full) throw std::runtime_error("--order needs --full");
     const int order = fullRangeOrder(args);
     std::printf("{\n  \"command\": \"pair\",\n  \"a1\": %s, \"a2\": %s, \"lambda\": %s, \"xi\": %s, \"xi_used\": %s,\n",
@@ -186,18 +211,18 @@ int pairCommand(const Arguments& args)
     } else {
         const double delta = args.number("delta");
         positive(delta, "--delta");
-        const CutoffSubgridModel model(delta, args.number("cutoff", 1.0));
+        const std::unique_ptr<SubgridModel> model = subgridModel(args, delta);
         const double r = 0.5 * (a1 + a2) * (xi + 2);
-        const PairSubgridBase base = model.pair(a1, a2, xi);
-        std::printf("  \"kind\": \"sub-grid (%s)\",\n", model.describe());
+        const PairSubgridBase base = model->pair(a1, a2, xi);
+        std::printf("  \"kind\": \"sub-grid (%s)\",\n", model->describe());
         std::printf("  \"delta\": %s, \"cutoff_cells\": %s, \"xi_cut\": %s, \"r\": %s,\n", number(delta).c_str(),
-                    number(model.cutoffCells()).c_str(), number(model.pairRange(a1, a2)).c_str(), number(r).c_str());
+                    number(cutoffCells(args, false)).c_str(), number(model->pairRange(a1, a2)).c_str(), number(r).c_str());
         std::printf("  \"normalisation\": \"dimensional_over_eta: dimensional sub-grid function divided by the viscosity. base: the 10 independent functions of paper Appendix C.2 in this labelling; dimensional_over_eta: every function from the C.2 relations, averaged over the two labellings of the pair as the blocks use them (YB: torque from translation; force from rotation uses YBtilde_ab = -YB_ba, Eq. A.3).\",\n");
         std::printf("  \"base\": {");
         for (int i = 0; i < NumSubgridBase; ++i)
             std::printf("%s\n    \"%s\": %s", i ? "," : "", subgridBaseName(SubgridBaseFunction(i)), number(base.f[i]).c_str());
         std::printf("\n  },\n");
-        printPairValues("dimensional_over_eta", subgridPairFunctions(model, a1, a2, xi, r), nullptr, false, true);
+        printPairValues("dimensional_over_eta", subgridPairFunctions(*model, a1, a2, xi, r), nullptr, false, true);
     }
     std::printf("}\n");
     return 0;
@@ -218,10 +243,13 @@ int matrixCommand(const Arguments& args)
     if (args.has("delta")) {
         const double delta = args.number("delta");
         positive(delta, "--delta");
-        const CutoffSubgridModel model(delta, args.number("cutoff", 1.0));
-        const bool active = subgridPairBlock(model, x1, x2, a1, a2, eta, block);
-        kind = active ? "sub-grid, frame invariant (paper Eq. 21, Appendix C.2)" : "sub-grid: pair beyond the cut-off, block is zero";
+        const std::unique_ptr<SubgridModel> model = subgridModel(args, delta);
+        const bool active = subgridPairBlock(*model, x1, x2, a1, a2, eta, block);
+        kind = std::string(active ? "sub-grid, frame invariant (paper Eq. 21, Appendix C.2)"
+                                  : "sub-grid: pair beyond the model's range, block is zero") +
+               "; " + model->describe();
     } else {
+        if (args.flags.count("calibrated")) throw std::runtime_error("--calibrated needs --delta");
         TwoSphereTheory theory;
         theoryPairBlock(theory, x1, x2, a1, a2, eta, block);
         kind = "theory (near-field forms)";
@@ -241,6 +269,7 @@ int wallCommand(const Arguments& args)
 {
     const double a = args.number("a"), eps = args.number("eps");
     positive(a, "--a");
+    if (args.flags.count("calibrated") && !args.has("delta")) throw std::runtime_error("--calibrated needs --delta");
     const WallScalars kk = wallTheory(eps);
     const WallScalars dim = wallTheoryDimensional(a, eps);
     std::printf("{\n  \"command\": \"wall\",\n  \"a\": %s, \"eps\": %s, \"eps_used\": %s,\n", number(a).c_str(), number(eps).c_str(),
@@ -256,10 +285,10 @@ int wallCommand(const Arguments& args)
     if (args.has("delta")) {
         const double delta = args.number("delta");
         positive(delta, "--delta");
-        const CutoffSubgridModel model(delta, args.number("cutoff", 1.0));
-        const WallScalars sg = model.wall(a, eps);
-        std::printf(",\n  \"delta\": %s, \"eps_cut\": %s,\n  \"subgrid_dimensional_over_eta\": {", number(delta).c_str(),
-                    number(model.wallRange(a)).c_str());
+        const std::unique_ptr<SubgridModel> model = subgridModel(args, delta, true);
+        const WallScalars sg = model->wall(a, eps);
+        std::printf(",\n  \"delta\": %s, \"eps_cut\": %s,\n  \"subgrid_kind\": \"%s\",\n  \"subgrid_dimensional_over_eta\": {",
+                    number(delta).c_str(), number(model->wallRange(a)).c_str(), model->describe());
         for (int i = 0; i < NumWallFunctions; ++i)
             std::printf("%s\n    \"%s\": %s", i ? "," : "", wallFunctionName(WallFunction(i)), number(sg.f[i]).c_str());
         std::printf("\n  }");

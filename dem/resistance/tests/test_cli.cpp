@@ -1,5 +1,6 @@
 // The command-line tool prints JSON with a normalisation field and rejects bad input.
 #include "fdm/resistance/resistance.hpp"
+#include "fdm/resistance/subgrid_calibration.hpp"
 
 #include <gtest/gtest.h>
 
@@ -95,6 +96,35 @@ TEST(Cli, PairSubgridMatrixAndWall)
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("\"XA\": 1002.35"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("\"subgrid_dimensional_over_eta\""), std::string::npos);
+}
+
+// --calibrated: the sub-grid model pair_style fdm/subgrid builds by default (the shipped table, the other
+// functions from the cut-off model at the pair style's cut-offs), so a user sees what a run applies
+TEST(Cli, CalibratedIsThePairStylesDefaultModel)
+{
+    namespace res = fdm::resistance;
+    const double delta = 1.0 / 3, xi = 0.3, a2 = 1.4, r = 0.5 * (1 + a2) * (2 + xi);
+    const res::SubgridCalibration table = res::SubgridCalibration::read(res::SubgridCalibration::defaultPath());
+    const res::CalibratedSubgridModel model(table, delta, res::defaultPairCutoffCells, res::defaultWallCutoffCells);
+    Result out = run("pair --a1 1 --a2 1.4 --xi 0.3 --subgrid --calibrated --delta 0.33333333333333333");
+    ASSERT_EQ(out.status, 0) << out.output;
+    const res::PairSubgridBase base = model.pair(1, a2, xi);
+    EXPECT_LT(base.f[res::BaseX21A], 0);  // beyond the cut-off model's range, the calibrated squeeze acts
+    EXPECT_NEAR(field(out.output, "X21A"), base.f[res::BaseX21A], 1e-12 * std::fabs(base.f[res::BaseX21A]));
+    const double xg = res::subgridPairFunctions(model, 1, a2, xi, r).f[res::XG][0][0];
+    EXPECT_NEAR(field(out.output, "XG11"), xg, 1e-12 * std::fabs(xg));
+    out = run("wall --a 1 --eps 0.3 --delta 0.33333333333333333 --calibrated");
+    ASSERT_EQ(out.status, 0) << out.output;
+    const std::string subgrid = out.output.substr(out.output.find("\"subgrid_dimensional_over_eta\""));
+    const double ya = model.wall(1, 0.3).f[res::WallYA];
+    EXPECT_NE(ya, 0);
+    EXPECT_NEAR(field(subgrid, "YA"), ya, 1e-12 * std::fabs(ya));
+    EXPECT_EQ(run("pair --a1 1 --a2 1 --xi 0.3 --calibrated").status, 2);                     // needs --subgrid
+    EXPECT_EQ(run("matrix --x1 0 0 0 --x2 2.3 0 0 --a1 1 --a2 1 --calibrated").status, 2);    // needs --delta
+    EXPECT_EQ(run("wall --a 1 --eps 0.1 --calibrated").status, 2);                           // needs --delta
+    out = run("pair --a1 1 --a2 1 --xi 0.3 --subgrid --calibrated --delta 0.5");             // a/Delta 2: no table
+    EXPECT_EQ(out.status, 2);
+    EXPECT_NE(out.output.find("no calibration for a pair of radii 1 and 1"), std::string::npos) << out.output;
 }
 
 TEST(Cli, RejectsBadInput)

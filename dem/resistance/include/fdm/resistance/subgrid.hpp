@@ -61,6 +61,10 @@ public:
 // r = |x2 - x1|.
 PairFunctionValues subgridPairFunctions(const SubgridModel& model, double a1, double a2, double xi, double r);
 
+// pair_style fdm/subgrid's default cut-off gaps, in mesh cells (docs/dem.md; chosen from the squeeze
+// flows): the cut-off model, and the functions the calibrated model takes from it
+const double defaultPairCutoffCells = 0.65, defaultWallCutoffCells = 0.75;
+
 // Placeholder for the calibration of Appendix B: the solver is assumed to resolve the theory down to a
 // cut-off gap of k mesh cells, xi_c = k Delta / a_mean (a_mean = (a1 + a2)/2), eps_c = k Delta / a,
 // and nothing below:
