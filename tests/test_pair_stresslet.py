@@ -44,9 +44,8 @@ def test_the_applied_squeeze_stresslets_add_up_to_the_dipole_of_the_squeeze_forc
     delta = 1.0 / 3
     for xi in (0.01, 0.1, 0.2, 0.3, 0.5):
         r = (1 + ratio) / 2 * (2 + xi)
-        options = ("--calibrated",) if model == "calibrated" else ("--cutoff", 0.65)
         xa21 = ps.theory.resistance("pair", "--a1", 1.0, "--a2", ratio, "--xi", xi, "--subgrid", "--delta", delta,
-                                    *options)["dimensional_over_eta"]["XA21"]
+                                    *ps.theory.subgrid_options(model))["dimensional_over_eta"]["XA21"]
         xg1, xg2 = ps.applied_x11g(1.0, ratio, xi, delta, model), ps.applied_x11g(ratio, 1.0, xi, delta, model)
         assert xg1 + xg2 == pytest.approx(-r * xa21, rel=1e-9, abs=1e-12)
         if ratio == 1.0:

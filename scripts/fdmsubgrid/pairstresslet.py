@@ -81,9 +81,8 @@ def theory_xg(a1: float, a2: float, xi: float) -> tuple:
 def applied_x11g(a1: float, a2: float, xi: float, delta: float, model: str) -> float:
     """The X^G_11 (sphere 1 of radius a1) that pair_style fdm/subgrid applies with `model` at its default
     cut-offs: Appendix C.2's expansion averaged over the labellings (module docstring)."""
-    options = ("--calibrated",) if model == "calibrated" else ("--cutoff", theory.PAIR_CUTOFF)
     return theory.resistance("pair", "--a1", a1, "--a2", a2, "--xi", xi, "--subgrid", "--delta", delta,
-                             *options)["dimensional_over_eta"]["XG11"]
+                             *theory.subgrid_options(model))["dimensional_over_eta"]["XG11"]
 
 
 def solver_x11g(run: Dict[str, np.ndarray], ratio: float, gaps: Sequence[float]) -> tuple:

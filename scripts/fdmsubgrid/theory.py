@@ -39,12 +39,19 @@ PAIR_CUTOFF = 0.65   # pair_style fdm/subgrid's default cut-off (mesh cells), do
 WALL_CUTOFF = 0.75   # and its default wall cut-off (mesh cells)
 
 
+def subgrid_options(model: str, wall: bool = False) -> tuple:
+    """The fdmResistance options (with --subgrid or --delta) that give pair_style fdm/subgrid's sub-grid
+    `model` ('calibrated' or 'cutoff') at its default cut-offs, for a pair or (wall) a sphere and a wall."""
+    if model == "calibrated":
+        return ("--calibrated",)
+    return ("--cutoff", WALL_CUTOFF if wall else PAIR_CUTOFF)
+
+
 def wall_subgrid_range(a: float, delta: float, model: str = "calibrated") -> float:
     """eps = h/a - 1 below which pair_style fdm/subgrid's wall block acts on a sphere of radius a at mesh size
     delta, with its default cut-offs: the cut-off model's wall_cutoff Delta/a, or the calibrated model's range
     (the larger of its table's and the cut-off's; fdmResistance wall --calibrated)."""
-    options = ("--calibrated",) if model == "calibrated" else ("--cutoff", WALL_CUTOFF)
-    return resistance("wall", "--a", a, "--eps", 1.0, "--delta", delta, *options)["eps_cut"]
+    return resistance("wall", "--a", a, "--eps", 1.0, "--delta", delta, *subgrid_options(model, wall=True))["eps_cut"]
 
 
 @functools.lru_cache(maxsize=4096)
