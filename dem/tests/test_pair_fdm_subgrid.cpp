@@ -13,9 +13,6 @@ namespace res = fdm::resistance;
 
 namespace {
 
-// pair_style fdm/subgrid's default cut-off gaps, in mesh cells (docs/dem.md)
-const double defaultCutoffCells = res::defaultPairCutoffCells, defaultWallCutoffCells = res::defaultWallCutoffCells;
-
 // Two close unequal spheres (a2/a1 = 1.4, xi = 0.02 along a slanted line) and a third far away, with the
 // cut-off model (its radii and mesh, a1/Delta = 2.5, are outside the calibration table of the default model).
 Scene pairScene(double xi = 0.02)
@@ -46,7 +43,7 @@ Expected subgridMatrix(const Scene& scene, const FakeFluid& fluid, const res::Su
     Expected e;
     e.R = Eigen::MatrixXd::Zero(6 * n, 6 * n);
     e.wallRhs = Eigen::VectorXd::Zero(6 * n);
-    const res::CutoffSubgridModel cutoff(fluid.delta, defaultCutoffCells);
+    const res::CutoffSubgridModel cutoff(fluid.delta, res::defaultPairCutoffCells);
     const res::SubgridModel& model = given ? *given : cutoff;
     for (int i = 0; i < n; ++i)
         for (int j = i + 1; j < n; ++j) {
@@ -180,7 +177,7 @@ Scene calibratedScene(const std::string& pairStyle)
 Expected calibratedMatrix(const Scene& scene, const FakeFluid& fluid)
 {
     static const res::SubgridCalibration table = res::SubgridCalibration::read(res::SubgridCalibration::defaultPath());
-    const res::CalibratedSubgridModel calibrated(table, fluid.delta, defaultCutoffCells, defaultWallCutoffCells);
+    const res::CalibratedSubgridModel calibrated(table, fluid.delta, res::defaultPairCutoffCells, res::defaultWallCutoffCells);
     return subgridMatrix(scene, fluid, &calibrated);
 }
 }  // namespace
@@ -277,7 +274,7 @@ TEST(PairFdmSubgrid, MovingWallBlockEntersEq31)
     expectContains(run.output, "0 sub-grid pair blocks, 1 wall blocks");
 
     Expected e = subgridMatrix(scene, fluid);
-    res::CutoffSubgridModel model(fluid.delta, defaultWallCutoffCells);
+    res::CutoffSubgridModel model(fluid.delta, res::defaultWallCutoffCells);
     const double x[3] = {3.0, 0.55, 4.0}, point[3] = {0, 0, 0}, normal[3] = {0, -1, 0}, wallU[3] = {0.3, 0, 0.1};
     res::WallBlock b;
     ASSERT_TRUE(res::subgridWallBlock(model, x, 0.5, point, normal, fluid.viscosity, b));
