@@ -44,6 +44,10 @@ class CouplingSession {
   const std::string &resumeFile() const { return resumeFile_; }
   void setResumeStep(long long step) { resumeStep_ = step; }
   long long resumeStep() const { return resumeStep_; }
+  // fdmDEM -until L: the resumed run was extended (or cut) to end at step L, so its input's `run L upto`
+  // differs from the checkpoint's last step on purpose (0: it must not differ)
+  void setResumeUntil(long long lastStep) { resumeUntil_ = lastStep; }
+  long long resumeUntil() const { return resumeUntil_; }
 
   // fix fdm/couple's constructor registers its request, its destructor withdraws it.
   void attach(const void *fix, const Request &request);
@@ -97,6 +101,7 @@ class CouplingSession {
   Request request_;
   std::string resumeFile_;
   long long resumeStep_ = 0;
+  long long resumeUntil_ = 0;
   std::unique_ptr<fdm::coupler::Transport> connection_;  // rank 0
   bool connected_;                                       // every rank: handshake done
   int particles_;

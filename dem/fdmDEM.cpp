@@ -16,6 +16,7 @@
 #include <mpi.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -24,6 +25,8 @@ const char usage[] =
     "usage: fdmDEM -in INPUT [-var NAME VALUE ...] [-echo screen] [-log FILE] [other LIGGGHTS options]\n"
     "       mpirun -np N fdmDEM -in INPUT ...\n"
     "       fdmDEM -in INPUT -resume CHECKPOINT   continue from a checkpoint of fix fdm/couple (fdmRun --resume)\n"
+    "       fdmDEM -in INPUT -resume CHECKPOINT -until L   ... to step L, where the input's 'run L upto' was\n"
+    "                                             changed from the checkpoint's last step (fdmRun --resume --until L)\n"
     "LIGGGHTS 3.8 with fix fdm/couple (coupling to the fluid solver fdmFoam) and pair_style fdm/subgrid\n"
     "(sub-grid lubrication and frictional contact); see docs/dem.md.\n";
 }
@@ -41,7 +44,8 @@ int main(int argc, char **argv)
   MPI_Init(&argc, &argv);
 
   // LIGGGHTS writes log.liggghts unless told otherwise: off by default, -log FILE to have one
-  // -resume FILE is fdmDEM's own (fix fdm/couple restores the particles from FILE); the rest is LIGGGHTS's
+  // -resume FILE and -until L are fdmDEM's own (fix fdm/couple restores the particles from FILE, and
+  // accepts an input that runs to L rather than to the checkpoint's last step); the rest is LIGGGHTS's
   std::vector<char *> args(argv, argv + 1);
   bool haveLog = false;
   for (int i = 1; i < argc; i++) {
@@ -51,6 +55,18 @@ int main(int argc, char **argv)
         MPI_Abort(MPI_COMM_WORLD, 2);
       }
       LAMMPS_NS::CouplingSession::instance().setResumeFile(argv[++i]);
+      continue;
+    }
+    if (!std::strcmp(argv[i], "-until")) {
+      char *end = nullptr;
+      const long long last = i + 1 < argc ? std::strtoll(argv[i + 1], &end, 10) : 0;
+      if (i + 1 >= argc || *end != '\0' || last <= 0) {
+        std::fputs("fdmDEM: -until needs the last step of the resumed run, a positive integer (fdmRun --resume --until L)\n",
+                   stderr);
+        MPI_Abort(MPI_COMM_WORLD, 2);
+      }
+      LAMMPS_NS::CouplingSession::instance().setResumeUntil(last);
+      i++;
       continue;
     }
     if (!std::strcmp(argv[i], "-log") || !std::strcmp(argv[i], "-l")) haveLog = true;

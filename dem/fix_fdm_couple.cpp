@@ -371,12 +371,22 @@ void FixFdmCouple::setup(int)
   // Called before every run (not with 'run N pre no'): connect once, then check the particles
   // wherever the input has put them since (set atom ... between runs).
   const bool firstSetup = !session_.connected();
-  if (resume_ && update->laststep != resume_->lastStep)
+  // `run N` instead of `run L upto` would run N steps more: the last step is checked against the
+  // checkpoint's, or against -until's where the run was extended on purpose
+  const long long until = session_.resumeUntil();
+  if (resume_ && until > 0 && update->laststep != until)
+    allAgree(comm->me != 0 ? std::string() :
+             "resuming at step " + std::to_string(resume_->step) + " from " + resumeFile_ + " to step " +
+             std::to_string(until) + " (-until) but this run command ends at step " +
+             std::to_string((long long) update->laststep) + ": write it 'run " + std::to_string(until) +
+             " upto' (fdmRun --resume --until does; docs/coupling.md)");
+  if (resume_ && until == 0 && update->laststep != resume_->lastStep)
     allAgree(comm->me != 0 ? std::string() :
              "resuming at step " + std::to_string(resume_->step) + " from " + resumeFile_ + ": the run it belongs "
              "to ends at step " + std::to_string(resume_->lastStep) + " but this run command ends at step " +
              std::to_string((long long) update->laststep) + ": write it 'run " + std::to_string(resume_->lastStep) +
-             " upto' (a resumed input runs to the same last step; docs/coupling.md)");
+             " upto' (a resumed input runs to the same last step; fdmRun --resume --until L extends it to L; "
+             "docs/coupling.md)");
   resume_.reset();
   // the count of init(): LIGGGHTS may have dropped an atom since, which gather() must name
   session_.ensureConnected(lmp, atomsAtInit_);

@@ -374,3 +374,24 @@ def test_time_step_beyond_the_measured_limit_is_warned(couette):
     assert "0.08" in couette.time_step_warning(0.29, 0.09)
     assert "0.02" in couette.time_step_warning(0.37, 0.04)
     assert "denser than any measured" in couette.time_step_warning(0.54, 0.15)
+
+
+def test_table8_extends_a_run_whose_averaging_window_is_short():
+    """table8.py's rule: a finished run averaged over fewer than --min-average strain units after its
+    transient is continued by the shortfall (in whole steps), never beyond --max-strain."""
+    import argparse
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("table8", os.path.join(os.path.dirname(case.__file__), "..", "..",
+                                                                         "cases", "couette", "table8.py"))
+    table8 = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(table8)
+    args = argparse.Namespace(min_average=20.0, max_strain=60.0, dt=0.04)
+    # 25 strain units (625 steps), transient to strain 12.1: 12.9 averaged, 7.1 short = 177.5 -> 178 steps
+    assert table8.extension(dict(steps_done=625, strain_averaged=12.9), args) == 625 + 178
+    assert table8.extension(dict(steps_done=625, strain_averaged=20.0), args) is None
+    assert table8.extension(dict(steps_done=625, strain_averaged=21.3), args) is None
+    # capped at --max-strain, and not extended once there
+    assert table8.extension(dict(steps_done=1450, strain_averaged=2.0), args) == 1500
+    assert table8.extension(dict(steps_done=1500, strain_averaged=2.0), args) is None
+    # a run too short to be analysed yet counts as averaged over nothing
+    assert table8.extension(dict(steps_done=25), args) == 25 + 500

@@ -257,3 +257,56 @@ def test_resume_step_mismatch_at_the_handshake(tmp_path, env, reference):
     assert fluid.returncode != 0 and dem.returncode != 0
     message = "fdmFoam resumes from its checkpoint of step 45 (checkpoint/fluid.45) but fdmDEM from step 50"
     assert message in out and message in dem.stdout, out[-2000:] + dem.stdout[-2000:]
+
+
+def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, reference):
+    """A run planned to 32 steps, finished, then continued with `fdmRun --resume --until 50` (from the
+    checkpoint written at its last step): the 50-step run's trajectory and records, every step once,
+    and the input now says `run 50 upto`."""
+    root = make_scene(str(tmp_path), steps=32)
+    r = fdm_run(root, env)
+    assert r.returncode == 0, r.stdout
+    assert steps_done(root) == 32
+    r = fdm_run(root, env, "--resume", "--until", str(STEPS))
+    assert r.returncode == 0, r.stdout
+    assert "run             %d upto" % STEPS in open(os.path.join(root, "dem", "in.couette")).read()
+    assert "resume from step 32, to step 50 (--until; the input ran to 32)" in open(os.path.join(root, "log.fluid")).read()
+    records_once(root)
+    assert_same_trajectory(root, reference)
+    assert_same_records(root, reference)
+
+
+def test_until_that_cannot_be_done_leaves_the_run_as_it_was(tmp_path, env, reference):
+    root = str(tmp_path / "run")
+    shutil.copytree(reference, root)
+    demInput = os.path.join(root, "dem", "in.couette")
+    stepsFile = os.path.join(root, "fluid", "postProcessing", "fdm", "steps.dat")
+    before = open(demInput).read(), open(stepsFile).read()
+    cases = [(("--resume", "--until", "50"), "the run resumes from step 50, so it cannot end at step 50"),
+             (("--resume", "--until", "4O"), "--until takes a step number, got '4O'"),
+             (("--until", "60"), "--until 60 goes with --resume")]
+    for options, message in cases:
+        r = fdm_run(root, env, *options)
+        assert r.returncode != 0 and message in r.stdout, (options, r.stdout)
+        assert (open(demInput).read(), open(stepsFile).read()) == before
+    with open(demInput, "w") as f:
+        f.write(before[0].replace("run             50 upto", "run             50"))
+    r = fdm_run(root, env, "--resume", "--until", "60")
+    assert r.returncode != 0 and "its run command 'run             50' is not 'run N upto'" in r.stdout, r.stdout
+    assert open(stepsFile).read() == before[1]
+
+
+def test_set_last_step_rewrites_only_the_run_command(tmp_path):
+    """checkpoint.set_last_step on input text (no codes run): the one `run N upto` line changes, its
+    trailing keywords and every other line stay; two run commands are refused."""
+    from fdmsubgrid import checkpoint
+    path = str(tmp_path / "in.scene")
+    text = "# run 10 upto in a comment\nrun_style verlet\nfix out all print 1 \"run\"\n  run 625 upto every 0 NULL\n"
+    with open(path, "w") as f:
+        f.write(text)
+    assert checkpoint.set_last_step(path, 830, 625) == 625
+    assert open(path).read() == text.replace("run 625 upto", "run 830 upto")
+    with open(path, "a") as f:
+        f.write("run 5\n")
+    with pytest.raises(checkpoint.CheckpointError, match="has 2 run commands"):
+        checkpoint.set_last_step(path, 900, 830)

@@ -8,11 +8,17 @@ run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq
                                             strain they reached), nothing run
   table8.py --sessions-hours 2.5            stop launching runs after this long (a run in progress is
                                             checkpointed every strain unit; the next call resumes it)
+  table8.py --min-average 20                each finished run whose averaging window (after the transient
+                                            its MSER rule finds) is shorter is extended (fdmRun --resume
+                                            --until) until it holds 20 strain units, up to --max-strain
 
 Each run is `couette.py --table8 PHI` (the paper's box and particle count, this project's time step
 and a1/Delta), in <workdir>/table8_phi..., run with fdmRun; a call finds each folder again: a
 finished run is analysed, one with a checkpoint is resumed (`fdmRun --resume`), one without is
-started again. Killing this script (or the session ending) loses at most one checkpoint interval.
+started again; a finished run averaged over fewer than --min-average strain units (default 20, the
+paper's "a few tens of strain units") is extended from its last checkpoint, so that no row is reported
+over a silently shortened window (a row still short, at --max-strain, says so). Killing this script (or
+the session ending) loses at most one checkpoint interval.
 
 Writes --out (default docs/table8.json): per phi_bulk the paper's row, this project's phi_core,
 gamma_core/gamma_0, eta_s, N1_hat, N2_hat, Sigma_c_hat with error bars, the stress balance, the strain
@@ -21,6 +27,7 @@ phi_m = 0.59 (with 3 or more analysed runs); and the figure beside it (Fig. 21 w
 """
 import argparse
 import glob
+import math
 import json
 import os
 import subprocess
@@ -74,9 +81,37 @@ def running_elsewhere(run_dir: str) -> bool:
     return False
 
 
+def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None) -> None:
+    """Start the run in run_dir, or resume it from its checkpoint (to step `until` if given)."""
+    fdmrun = [os.path.join(PROJECT, "scripts", "fdmRun"), "-f", str(args.np_fluid)]
+    try:
+        checkpoint.select(run_dir)
+        cmd = fdmrun + ["--resume"] + (["--until", str(until)] if until else []) + [run_dir]
+    except checkpoint.CheckpointError:
+        if until:
+            raise
+        cmd = fdmrun + (["--overwrite"] if steps_done(run_dir) else []) + [run_dir]
+    log = run_dir + ".log"
+    print("table8: %s (log %s)" % (" ".join(cmd), log), flush=True)
+    with open(log, "a") as f:
+        subprocess.run(cmd, check=True, stdout=f, stderr=subprocess.STDOUT)
+
+
+def extension(row: Dict, args: argparse.Namespace) -> Optional[int]:
+    """The step a finished run must be continued to so that its averaging window (after the
+    transient) holds --min-average strain units, at most --max-strain; None if it holds them, or
+    if it has reached --max-strain."""
+    short = args.min_average - row.get("strain_averaged", 0.0)
+    last = int(round(args.max_strain / args.dt))
+    if short <= 1e-9 or row["steps_done"] >= last:
+        return None
+    return min(row["steps_done"] + int(math.ceil(short / args.dt - 1e-9)), last)
+
+
 def run_row(phi: float, args: argparse.Namespace) -> str:
-    """Write, start or resume the run of one phi_bulk until it finishes; returns its folder. A run
-    that another process is running is waited for, never started a second time."""
+    """Write, start or resume the run of one phi_bulk until it finishes, then extend it while its
+    averaging window is short of --min-average; returns its folder. A run that another process is
+    running is waited for, never started a second time."""
     run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
     if run_dir is not None and running_elsewhere(run_dir):
         print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
@@ -88,18 +123,18 @@ def run_row(phi: float, args: argparse.Namespace) -> str:
                         "--seed", str(args.seed), "--n-max", str(args.n_max), "--tol-lambda", str(args.tol_lambda),
                         "--model", args.model, "--workdir", args.workdir], check=True)
         run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
-    if steps_done(run_dir) >= steps_planned(run_dir):
-        return run_dir
-    fdmrun = [os.path.join(PROJECT, "scripts", "fdmRun"), "-f", str(args.np_fluid)]
-    try:
-        checkpoint.select(run_dir)
-        cmd = fdmrun + ["--resume", run_dir]
-    except checkpoint.CheckpointError:
-        cmd = fdmrun + (["--overwrite"] if steps_done(run_dir) else []) + [run_dir]
-    log = run_dir + ".log"
-    print("table8: phi_bulk %g: %s (log %s)" % (phi, " ".join(cmd), log), flush=True)
-    with open(log, "a") as f:
-        subprocess.run(cmd, check=True, stdout=f, stderr=subprocess.STDOUT)
+    if steps_done(run_dir) < steps_planned(run_dir):
+        print("table8: phi_bulk %g:" % phi, end=" ", flush=True)
+        _fdmrun(run_dir, args)
+    while args.min_average > 0:
+        row = analyse_row(phi, run_dir, args)
+        until = extension(row, args)
+        if until is None:
+            break
+        print("table8: phi_bulk %g: averaged over %.1f strain units after the transient, short of --min-average "
+              "%g: extended to strain %g" % (phi, row.get("strain_averaged", 0.0), args.min_average, until * args.dt),
+              flush=True)
+        _fdmrun(run_dir, args, until=until)
     return run_dir
 
 
@@ -125,6 +160,7 @@ def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) ->
     row.update({k: r.get(k) for k in keep})
     row["status"] = "finished" if done >= planned else "partial"
     row["strain_averaged"] = r["strain_units"] - r["steady_from_strain"]
+    row["window_short"] = row["strain_averaged"] < args.min_average
     return row
 
 
@@ -151,19 +187,20 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
 
 
 def print_table(summary: Dict) -> None:
-    print("%-6s %-9s %-16s %-16s %-14s %-14s %-14s %-9s %-8s %s" % (
+    print("%-6s %-9s %-16s %-16s %-14s %-14s %-14s %-9s %-8s %-15s %s" % (
         "phi_b", "status", "phi_core (paper)", "g_core (paper)", "eta_s", "N1_hat", "N2_hat", "balance", "strain",
-        "core-s/strain"))
+        "averaged", "core-s/strain"))
     for r in summary["rows"]:
         if "eta_s" not in r:
             print("%-6g %-9s (strain %.2f)" % (r["phi_bulk_table8"], r["status"], r.get("strain_reached", 0)))
             continue
         t = r["table8"] or {}
-        print("%-6g %-9s %.3f (%.3f)    %.3f (%.3f)    %.2f ± %.2f    %+.3f ± %.3f %+.3f ± %.3f %5.1f %%  %-8.1f %.0f" % (
+        averaged = "%.1f%s" % (r["strain_averaged"], " (short)" if r.get("window_short") else "")
+        print("%-6g %-9s %.3f (%.3f)    %.3f (%.3f)    %.2f ± %.2f    %+.3f ± %.3f %+.3f ± %.3f %5.1f %%  %-8.1f %-15s %.0f" % (
             r["phi_bulk_table8"], r["status"], r["phi_core"], t.get("phi_core", float("nan")),
             r["gamma_core_over_gamma0"], t.get("gamma_core_over_gamma0", float("nan")), r["eta_s"], r["eta_s_err"],
             r["N1_hat"], r["N1_hat_err"], r["N2_hat"], r["N2_hat_err"], 100 * r["stress_balance_rel_error"],
-            r["strain_units"], r["core_seconds_per_strain_unit"]))
+            r["strain_units"], averaged, r["core_seconds_per_strain_unit"]))
     if "fit" in summary:
         f = summary["fit"]
         print("Maron-Pierce fit: alpha = %.3f ± %.3f, phi_m = %.3f ± %.3f (chi2 %.2f for %d dof); paper 0.803, 0.59"
@@ -186,6 +223,11 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--tol-lambda", type=float, default=1e-3, help="fdmFoam's innerIterations tolLambda for scenes "
                    "written now (1e-2 keeps eta_s within its error bar at 2.4 times fewer fluid solves: "
                    "docs/benchmarks.md, 'Sheared suspension: run time against error')")
+    p.add_argument("--min-average", type=float, default=20.0,
+                   help="strain units a row is averaged over after its transient: a finished run short of it is "
+                        "extended from its last checkpoint (0: never extended)")
+    p.add_argument("--max-strain", type=float, default=60.0,
+                   help="the strain a run is extended to at most (a row still short there is reported as short)")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(PROJECT, "docs", "table8.json"))
     p.add_argument("--analyse-only", action="store_true", help="report the runs as they stand; run nothing")

@@ -14,6 +14,9 @@ each code keeps its two newest.
                                                  the steps up to STEP, the DEM's dumps the frames before
                                                  STEP (the resumed run writes STEP's frame again), and
                                                  time directories and checkpoints after STEP go
+    python3 -m fdmsubgrid.checkpoint until INPUT L STEP  the run resumed from STEP to end at step L: the
+                                                 LIGGGHTS input's `run N upto` becomes `run L upto`
+                                                 (prints N; fdmRun --resume --until L)
 """
 import os
 import re
@@ -137,6 +140,43 @@ def select(case_dir):
     raise CheckpointError("%s has no checkpoint that both codes completed%s: was the run started with "
                           "'checkpoint N' in fix fdm/couple? (docs/coupling.md)"
                           % (case_dir, " (" + "; ".join(notes) + ")" if notes else ""))
+
+
+# the run command a resumable input ends with (docs/coupling.md): `run L upto`, maybe more keywords
+_RUN_COMMAND = re.compile(r"^[ \t]*run[ \t]+.*$", re.M)
+_RUN_UPTO = re.compile(r"^([ \t]*run[ \t]+)(\d+)([ \t]+upto\b.*)$")
+
+
+def set_last_step(dem_input: str, last_step: int, resume_step: int) -> int:
+    """Make a run resumed from `resume_step` end at `last_step` instead of where it was planned to (a
+    finished run extended, a long one cut short): its LIGGGHTS input's one `run N upto` command becomes
+    `run last_step upto`, the rest of the file unchanged (written to a temporary file, then renamed).
+    Returns N. CheckpointError, with nothing changed, if the input has no run command or more than one,
+    if its run is not `run N upto`, or if last_step is not after resume_step."""
+    try:
+        with open(dem_input) as f:
+            text = f.read()
+    except OSError as e:
+        raise CheckpointError("%s cannot be read (%s)" % (dem_input, e.strerror))
+    commands = list(_RUN_COMMAND.finditer(text))
+    if len(commands) != 1:
+        raise CheckpointError("%s has %d run commands: a run can be extended only if its input has one, "
+                              "'run N upto'" % (dem_input, len(commands)))
+    found = _RUN_UPTO.match(commands[0].group(0))
+    if not found:
+        raise CheckpointError("%s: its run command '%s' is not 'run N upto', which a resumed run needs "
+                              "(docs/coupling.md)" % (dem_input, commands[0].group(0).strip()))
+    if last_step <= resume_step:
+        raise CheckpointError("the run resumes from step %d, so it cannot end at step %d: give a later step"
+                              % (resume_step, last_step))
+    planned = int(found.group(2))
+    start, end = commands[0].span()
+    line = found.group(1) + str(last_step) + found.group(3)
+    tmp = dem_input + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text[:start] + line + text[end:])
+    os.replace(tmp, dem_input)
+    return planned
 
 
 def _is_time(name):
@@ -272,6 +312,13 @@ def main(argv):
     if len(argv) >= 3 and argv[0] == "truncate":
         for line in truncate(argv[1], int(argv[2])):
             print(line)
+        return 0
+    if len(argv) >= 4 and argv[0] == "until":
+        try:
+            print(set_last_step(argv[1], int(argv[2]), int(argv[3])))
+        except CheckpointError as e:
+            print(e, file=sys.stderr)
+            return 1
         return 0
     print(__doc__, file=sys.stderr)
     return 2
