@@ -41,7 +41,7 @@ using fdm::text::point;
 }  // namespace
 
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
-  Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), holdContactGaps_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), directSolver_(true), tolerance_(1e-10), pair_(nullptr),
+  Fix(lmp, narg, arg), session_(CouplingSession::instance()), hasFluid_(true), move_(true), adamsBashforth_(true), gapUpdate_(true), holdContactGaps_(true), haveVelocities_(false), havePlan_(false), stresslets_(false), solver_(fdm::ParticleVelocitySystem::cholmod), tolerance_(1e-10), pair_(nullptr),
   atomsAtInit_(0), natoms_(0), lastIterations_(0), lastResidual_(0.0), notConverged_(0), runStart_(0.0),
   nmax_(0), perAtom_(nullptr), perAtomColumns_(12), solverIterations_(0), pairBlocks_(0),
   wallBlocks_(0), contacts_(0), wallOut_(nullptr), checkpointEvery_(0), checkpointSeconds_(0), resumed_(false)
@@ -117,8 +117,10 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       i++;
     } else if (key == "solver") {
       const std::string v = value(1);
-      if (v != "cg" && v != "ldlt") error->all(FLERR, "fix fdm/couple: solver must be cg or ldlt");
-      directSolver_ = (v == "ldlt");
+      if (v != "cholmod" && v != "ldlt" && v != "cg")
+        error->all(FLERR, "fix fdm/couple: solver must be cholmod, ldlt or cg");
+      solver_ = v == "cholmod" ? fdm::ParticleVelocitySystem::cholmod
+                               : v == "ldlt" ? fdm::ParticleVelocitySystem::ldlt : fdm::ParticleVelocitySystem::cg;
       i++;
     } else if (key == "checkpoint") {
       checkpointEvery_ = force->inumeric(FLERR, value(1));
@@ -551,7 +553,7 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
   try {
     if (!system_) {
       fdm::ParticleVelocitySystem::Settings settings;
-      settings.solver = directSolver_ ? fdm::ParticleVelocitySystem::ldlt : fdm::ParticleVelocitySystem::cg;
+      settings.solver = solver_;
       settings.tolerance = tolerance_;
       settings.alphaLambda = session_.alphaLambda();
       settings.rhoFluid = session_.rhoFluid();
@@ -641,6 +643,8 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
   subgrid_ = system_->subgridForces();
   run_.contactSlides += system_->slidingSwitches();
+  run_.factorisations += system_->factorisations() - factorisationsCounted_;
+  factorisationsCounted_ = system_->factorisations();
   // the implicit part of the contact forces (Eq. C2) and of their stresslet (Eq. 52)
   std::vector<double> springStress(size_t(6) * natoms_, 0.0);
   springs_ = system_->springForces(stresslets_ ? &springStress : nullptr,
@@ -1034,12 +1038,15 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
   std::snprintf(line, sizeof line,
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
-                "%s iterations mean %.1f max %ld; last step %ld sub-grid pair blocks, %ld wall blocks, %ld contacts; "
+                "%s iterations mean %.1f max %ld, %ld factorisations; last step %ld sub-grid pair blocks, %ld wall "
+                "blocks, %ld contacts; "
                 "%ld contacts began to slide within their step; position update %s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
-                directSolver_ ? "LDLT" : "CG", t.solves ? double(t.solverIterations) / t.solves : 0.0,
-                t.solverIterationsMax, pairBlocks_, wallBlocks_, contacts_, t.contactSlides,
+                solver_ == fdm::ParticleVelocitySystem::cholmod ? "CHOLMOD"
+                : solver_ == fdm::ParticleVelocitySystem::ldlt  ? "LDLT" : "CG",
+                t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations,
+                pairBlocks_, wallBlocks_, contacts_, t.contactSlides,
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");
   if (screen) fputs(line, screen);

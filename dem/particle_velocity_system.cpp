@@ -4,6 +4,7 @@
 #include "particle_velocity_system.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -32,8 +33,16 @@ struct ParticleVelocitySystem::Matrices {
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double> > ldlt;
-  bool analysed = false;                // LDLT's symbolic analysis of this step's pattern
+  // the same factorisation in supernodes (dense blocks, BLAS): the one that scales to dense packings
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double> > cholmod;
+  bool analysed = false;                // the direct solver's symbolic analysis of this step's pattern
   bool ready = false;                   // factorised (or preconditioned) for this step's rigid-body blocks
+
+  // x = (the factorised matrix)^-1 b
+  Eigen::VectorXd directSolve(Solver solver, const Eigen::VectorXd &b) const
+  {
+    return solver == ParticleVelocitySystem::cholmod ? Eigen::VectorXd(cholmod.solve(b)) : Eigen::VectorXd(ldlt.solve(b));
+  }
 };
 
 ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
@@ -256,7 +265,17 @@ void ParticleVelocitySystem::setVolumes(const std::vector<RigidVolume> &volumes)
 void ParticleVelocitySystem::factorise(const std::string &when)
 {
   Matrices &m = *m_;
-  if (settings_.solver == ldlt) {
+  if (settings_.solver == cholmod) {
+    if (!m.analysed) {
+      m.cholmod.analyzePattern(m.matrix);
+      m.analysed = true;
+    }
+    m.cholmod.factorize(m.matrix);
+    factorisations_++;
+    if (m.cholmod.info() != Eigen::Success)
+      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (Cholesky, "
+                                        "CHOLMOD)" + when);
+  } else if (settings_.solver == ldlt) {
     if (!m.analysed) {
       m.ldlt.analyzePattern(m.matrix);
       m.analysed = true;
@@ -300,8 +319,8 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
   // one solve of the linear system for the right-hand side `total`, into u_
   auto solveLinear = [&](const Eigen::VectorXd &total) {
     Eigen::VectorXd u;
-    if (settings_.solver == ldlt) {
-      u = m.ldlt.solve(total);  // the factorisation of this step
+    if (settings_.solver != cg) {
+      u = m.directSolve(settings_.solver, total);  // the factorisation of this step
       iterations_ = 1;
     } else {
       const Eigen::Map<const Eigen::VectorXd> guess(u_.data(), 6 * N);  // warm start: the previous solution

@@ -60,10 +60,12 @@ const int wallRecord = wallFriction + 15;
 
 class ParticleVelocitySystem {
  public:
-  enum Solver { ldlt, cg };
+  enum Solver { cholmod, ldlt, cg };
 
   struct Settings {
-    Solver solver = ldlt;              // sparse LDLT (factorised once per step) or Jacobi-preconditioned CG
+    // sparse Cholesky factorised once per step (and when contacts begin to slide): CHOLMOD's
+    // supernodal LL^T, or Eigen's simplicial LDL^T; or Jacobi-preconditioned CG
+    Solver solver = cholmod;
     double tolerance = 1e-10;          // relative residual of CG
     double alphaLambda = 0;            // direct-forcing penalty [s] (Eq. 29)
     double rhoFluid = 0;               // [kg/m3]
