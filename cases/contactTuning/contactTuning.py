@@ -51,7 +51,6 @@ PI = math.pi
 # the scene: every length in units of a = 1 m, eta = 1 Pa s (the velocity scale F/(6 pi eta a))
 BASE = dict(a=1.0, eta=1.0, delta=0.2, hr=0.01, kn=2000.0, kt=2000.0, mu=0.5)
 LOAD = 10.0                      # N: F/k_n = h_r/2 at the base k_n
-DEFAULT_CUTOFFS = (0.65, 0.75)   # pair_style fdm/subgrid cutoff, wall_cutoff [mesh cells] if the log does not say
 MIN_GAP = 1e-5                   # the resistance functions are frozen below this reduced gap (docs/resistance.md)
 
 
@@ -105,7 +104,8 @@ def probe_cutoffs(workdir):
     r = run_scene("wall", dict(steps=1), workdir, name="probe")
     if not r["ok"]:
         raise RuntimeError("fdmDEM -in in.wall failed:\n" + r["log"])
-    return (r["cutoff"] or DEFAULT_CUTOFFS[0], r["wall_cutoff"] or DEFAULT_CUTOFFS[1])
+    pair_default, wall_default = theory.pair_style_cutoffs()   # if the log does not say
+    return (r["cutoff"] or pair_default, r["wall_cutoff"] or wall_default)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@ import functools
 import json
 import math
 import subprocess
+from typing import Optional
 
 import numpy as np
 
@@ -35,8 +36,12 @@ def relative_errors(values, reference):
     return [(v - r) / r for v, r in zip(values, reference)]
 
 
-PAIR_CUTOFF = 0.65   # pair_style fdm/subgrid's default cut-off (mesh cells), docs/dem.md
-WALL_CUTOFF = 0.75   # and its default wall cut-off (mesh cells)
+@functools.lru_cache(maxsize=1)
+def pair_style_cutoffs() -> tuple[float, float]:
+    """pair_style fdm/subgrid's default cut-offs in mesh cells, (pair, wall), as the resistance library
+    defines them (`fdmResistance defaults`; docs/dem.md)."""
+    out = resistance("defaults")
+    return float(out["pair_cutoff_cells"]), float(out["wall_cutoff_cells"])
 
 
 def subgrid_options(model: str, wall: bool = False) -> tuple:
@@ -44,7 +49,7 @@ def subgrid_options(model: str, wall: bool = False) -> tuple:
     `model` ('calibrated' or 'cutoff') at its default cut-offs, for a pair or (wall) a sphere and a wall."""
     if model == "calibrated":
         return ("--calibrated",)
-    return ("--cutoff", WALL_CUTOFF if wall else PAIR_CUTOFF)
+    return ("--cutoff", pair_style_cutoffs()[1 if wall else 0])
 
 
 def wall_subgrid_range(a: float, delta: float, model: str = "calibrated") -> float:
@@ -56,7 +61,7 @@ def wall_subgrid_range(a: float, delta: float, model: str = "calibrated") -> flo
 
 @functools.lru_cache(maxsize=4096)
 def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta: float = 1.0,
-                          cutoff: float = PAIR_CUTOFF, subgrid: bool = True,
+                          cutoff: Optional[float] = None, subgrid: bool = True,
                           contact_in_mid_gap: bool = False) -> tuple[float, float]:
     """(zeta_n, zeta_t) of two free spheres at surface gap `gap`: the force per unit closing speed
     under equal and opposite loads along the line of centres, and per unit slip speed of the contact
@@ -65,7 +70,10 @@ def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta:
     fdmResistance (Eq. 21) at mesh size delta: Eq. (31) without the fluid's resolved part
     (docs/contact.md, 3c). The contact points sit on the spheres' surfaces (a_i, a_j from the
     centres), or with contact_in_mid_gap in the middle of the gap (docs/contact.md 2). Without the
-    sub-grid block, zeta_t of two equal spheres is 12/7 pi eta a."""
+    sub-grid block, zeta_t of two equal spheres is 12/7 pi eta a. cutoff: the cut-off model's k in mesh
+    cells (None: the pair style's default)."""
+    if cutoff is None:
+        cutoff = pair_style_cutoffs()[0]
     drag = [6 * math.pi * eta * a_i] * 3 + [8 * math.pi * eta * a_i ** 3] * 3 \
         + [6 * math.pi * eta * a_j] * 3 + [8 * math.pi * eta * a_j ** 3] * 3
     resistance_matrix = np.diag(drag)

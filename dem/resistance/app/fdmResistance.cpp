@@ -5,6 +5,7 @@
 //   fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]
 //   fdmResistance squeeze --a A --eps E --wall
 //   fdmResistance coverage --a1 A [--a2 B] --delta D [--wall]
+//   fdmResistance defaults
 #include "fdm/resistance/resistance.hpp"
 #include "fdm/resistance/subgrid_calibration.hpp"
 
@@ -29,6 +30,7 @@ const char* usage =
     "  fdmResistance squeeze --a1 A --a2 B --xi X [--near] [--order N]\n"
     "  fdmResistance squeeze --a A --eps E --wall\n"
     "  fdmResistance coverage --a1 A [--a2 B] --delta D [--wall]\n"
+    "  fdmResistance defaults\n"
     "xi = 2r/(a1+a2) - 2; eps = h/a - 1; --delta: mesh size (sub-grid output); --cutoff: k in xi_c = k*delta/a_mean\n"
     "  (cut-off model, default 1); --calibrated: the sub-grid model pair_style fdm/subgrid uses by default (the shipped\n"
     "  calibration table, the other functions from the cut-off model at the pair style's cut-offs, 0.65 and 0.75 cells)\n"
@@ -36,7 +38,8 @@ const char* usage =
     "squeeze: closing velocity under equal and opposite forces F along the line of centres, in units of F/(6 pi eta a1)\n"
     "  (full-range theory; --near: near-field forms); --wall: sphere pushed toward a plane wall, 1/X^A_wall\n"
     "coverage: whether the shipped calibration table (pair_style fdm/subgrid model calibrated) has the pair (a1, a2)\n"
-    "  and, with --wall, the sphere a1 against a wall at mesh size D\n";
+    "  and, with --wall, the sphere a1 against a wall at mesh size D\n"
+    "defaults: pair_style fdm/subgrid's default cut-offs (mesh cells) and the calibration table it reads\n";
 
 struct Arguments {
     std::string command;
@@ -376,6 +379,17 @@ int coverageCommand(const Arguments& args)
     return 0;
 }
 
+// pair_style fdm/subgrid's defaults that scripts need to reproduce its blocks with this tool (--cutoff K),
+// from the library's constants, so that no script repeats them
+int defaultsCommand()
+{
+    std::printf("{\n  \"command\": \"defaults\",\n  \"pair_cutoff_cells\": %s,\n  \"wall_cutoff_cells\": %s,\n"
+                "  \"calibration_table\": \"%s\"\n}\n",
+                number(defaultPairCutoffCells).c_str(), number(defaultWallCutoffCells).c_str(),
+                SubgridCalibration::defaultPath().c_str());
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -387,6 +401,7 @@ int main(int argc, char** argv)
         if (args.command == "wall") return wallCommand(args);
         if (args.command == "squeeze") return squeezeCommand(args);
         if (args.command == "coverage") return coverageCommand(args);
+        if (args.command == "defaults") return defaultsCommand();
         if (args.command == "-h" || args.command == "--help") {
             std::fputs(usage, stdout);
             return 0;

@@ -127,6 +127,15 @@ TEST(Cli, CalibratedIsThePairStylesDefaultModel)
     EXPECT_NE(out.output.find("no calibration for a pair of radii 1 and 1"), std::string::npos) << out.output;
 }
 
+// the pair style's default cut-offs, which scripts read here rather than repeat (fdmsubgrid.theory)
+TEST(Cli, DefaultsAreThePairStylesCutoffs)
+{
+    const Result out = run("defaults");
+    ASSERT_EQ(out.status, 0) << out.output;
+    EXPECT_EQ(field(out.output, "pair_cutoff_cells"), fdm::resistance::defaultPairCutoffCells);
+    EXPECT_EQ(field(out.output, "wall_cutoff_cells"), fdm::resistance::defaultWallCutoffCells);
+}
+
 TEST(Cli, RejectsBadInput)
 {
     EXPECT_EQ(run("pair --a1 -1 --a2 1 --xi 0.1").status, 2);
