@@ -267,10 +267,16 @@ def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, re
     r = fdm_run(root, env)
     assert r.returncode == 0, r.stdout
     assert steps_done(root) == 32
+    # an extension killed before its first checkpoint leaves the input at 50 and the newest checkpoint
+    # of the 32-step run: a plain resume is refused with the advice, --until (table8.py passes it) goes on
+    from fdmsubgrid import checkpoint
+    assert checkpoint.set_last_step(os.path.join(root, "dem", "in.couette"), STEPS, 32) == 32
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode != 0 and "fdmRun --resume --until L extends it to L" in r.stdout, r.stdout
     r = fdm_run(root, env, "--resume", "--until", str(STEPS))
     assert r.returncode == 0, r.stdout
     assert "run             %d upto" % STEPS in open(os.path.join(root, "dem", "in.couette")).read()
-    assert "resume from step 32, to step 50 (--until; the input ran to 32)" in open(os.path.join(root, "log.fluid")).read()
+    assert "resume from step 32, to step 50 (--until; the input ran to 50)" in open(os.path.join(root, "log.fluid")).read()
     records_once(root)
     assert_same_trajectory(root, reference)
     assert_same_records(root, reference)

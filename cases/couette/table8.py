@@ -88,8 +88,8 @@ def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None)
         checkpoint.select(run_dir)
         cmd = fdmrun + ["--resume"] + (["--until", str(until)] if until else []) + [run_dir]
     except checkpoint.CheckpointError:
-        if until:
-            raise
+        if until and steps_done(run_dir) >= steps_planned(run_dir):
+            raise   # a finished run without a checkpoint cannot be extended
         cmd = fdmrun + (["--overwrite"] if steps_done(run_dir) else []) + [run_dir]
     log = run_dir + ".log"
     print("table8: %s (log %s)" % (" ".join(cmd), log), flush=True)
@@ -125,7 +125,9 @@ def run_row(phi: float, args: argparse.Namespace) -> str:
         run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
     if steps_done(run_dir) < steps_planned(run_dir):
         print("table8: phi_bulk %g:" % phi, end=" ", flush=True)
-        _fdmrun(run_dir, args)
+        # to the input's last step: an extension killed before its first checkpoint resumes from one
+        # written for the shorter run, which fdmDEM accepts only with -until
+        _fdmrun(run_dir, args, until=steps_planned(run_dir))
     while args.min_average > 0:
         row = analyse_row(phi, run_dir, args)
         until = extension(row, args)
