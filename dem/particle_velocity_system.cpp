@@ -19,6 +19,19 @@ namespace {
 using fdm::text::number;
 using fdm::text::particleId;
 using fdm::text::point;
+
+// A direct solver's factorisation of matrix, its pattern analysed once per step (sliding contacts
+// change values only); false if it failed.
+template <class Factorisation>
+bool factoriseDirect(Factorisation &factorisation, const Eigen::SparseMatrix<double> &matrix, bool &analysed)
+{
+  if (!analysed) {
+    factorisation.analyzePattern(matrix);
+    analysed = true;
+  }
+  factorisation.factorize(matrix);
+  return factorisation.info() == Eigen::Success;
+}
 }  // namespace
 
 struct ParticleVelocitySystem::Matrices {
@@ -265,25 +278,13 @@ void ParticleVelocitySystem::setVolumes(const std::vector<RigidVolume> &volumes)
 void ParticleVelocitySystem::factorise(const std::string &when)
 {
   Matrices &m = *m_;
-  if (settings_.solver == cholmod) {
-    if (!m.analysed) {
-      m.cholmod.analyzePattern(m.matrix);
-      m.analysed = true;
-    }
-    m.cholmod.factorize(m.matrix);
+  if (settings_.solver != cg) {
+    const bool factorised = settings_.solver == cholmod ? factoriseDirect(m.cholmod, m.matrix, m.analysed)
+                                                        : factoriseDirect(m.ldlt, m.matrix, m.analysed);
     factorisations_++;
-    if (m.cholmod.info() != Eigen::Success)
-      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (Cholesky, "
-                                        "CHOLMOD)" + when);
-  } else if (settings_.solver == ldlt) {
-    if (!m.analysed) {
-      m.ldlt.analyzePattern(m.matrix);
-      m.analysed = true;
-    }
-    m.ldlt.factorize(m.matrix);
-    factorisations_++;
-    if (m.ldlt.info() != Eigen::Success)
-      throw Error(Error::notSolved, -1, "the particle velocity system (Eq. 31) could not be factorised (LDLT)" + when);
+    if (!factorised)
+      throw Error(Error::notSolved, -1, std::string("the particle velocity system (Eq. 31) could not be factorised (") +
+                                            (settings_.solver == cholmod ? "Cholesky, CHOLMOD" : "LDLT") + ")" + when);
   } else {
     m.cg.setTolerance(settings_.tolerance);
     m.cg.setMaxIterations(std::max(1000, 6 * n_));

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from conftest import FULL, PROJECT
-from fdmsubgrid import case, output
+from fdmsubgrid import case, checkpoint, output
 
 STEPS = 50
 EVERY = 5
@@ -151,6 +151,13 @@ def assert_same_trajectory(root, reference):
     return worst
 
 
+def assert_same_run(root, reference):
+    """A resumed (or extended) run holds each step once and is the uninterrupted reference run."""
+    records_once(root)
+    assert_same_trajectory(root, reference)
+    assert_same_records(root, reference)
+
+
 def test_checkpoint_interval_and_contact(reference):
     """The scene exercises what a checkpoint must carry: contacts (history) and the AB2 plan."""
     names = sorted(os.listdir(os.path.join(reference, "dem", "checkpoint")))
@@ -176,9 +183,7 @@ def test_killed_run_resumes_to_the_same_trajectory(tmp_path, env, reference, tri
     r = fdm_run(root, env, "--resume")
     assert r.returncode == 0, r.stdout
     print("trial %d: %s killed after %d steps recorded; resumed in %.1f s" % (trial, who, done, time.time() - t0))
-    records_once(root)
-    assert_same_trajectory(root, reference)
-    assert_same_records(root, reference)
+    assert_same_run(root, reference)
 
 
 def test_truncated_checkpoint_falls_back_to_the_previous_one(tmp_path, env, reference):
@@ -269,7 +274,6 @@ def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, re
     assert steps_done(root) == 32
     # an extension killed before its first checkpoint leaves the input at 50 and the newest checkpoint
     # of the 32-step run: a plain resume is refused with the advice, --until (table8.py passes it) goes on
-    from fdmsubgrid import checkpoint
     assert checkpoint.set_last_step(os.path.join(root, "dem", "in.couette"), STEPS, 32) == 32
     r = fdm_run(root, env, "--resume")
     assert r.returncode != 0 and "fdmRun --resume --until L extends it to L" in r.stdout, r.stdout
@@ -277,9 +281,7 @@ def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, re
     assert r.returncode == 0, r.stdout
     assert "run             %d upto" % STEPS in open(os.path.join(root, "dem", "in.couette")).read()
     assert "resume from step 32, to step 50 (--until; the input ran to 50)" in open(os.path.join(root, "log.fluid")).read()
-    records_once(root)
-    assert_same_trajectory(root, reference)
-    assert_same_records(root, reference)
+    assert_same_run(root, reference)
 
 
 def test_until_that_cannot_be_done_leaves_the_run_as_it_was(tmp_path, env, reference):
@@ -305,7 +307,6 @@ def test_until_that_cannot_be_done_leaves_the_run_as_it_was(tmp_path, env, refer
 def test_set_last_step_rewrites_only_the_run_command(tmp_path):
     """checkpoint.set_last_step on input text (no codes run): the one `run N upto` line changes, its
     trailing keywords and every other line stay; two run commands are refused."""
-    from fdmsubgrid import checkpoint
     path = str(tmp_path / "in.scene")
     text = "# run 10 upto in a comment\nrun_style verlet\nfix out all print 1 \"run\"\n  run 625 upto every 0 NULL\n"
     with open(path, "w") as f:
