@@ -15,9 +15,11 @@ sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 FULL = os.environ.get("FDM_FULL") == "1"
 
 
-def load_case_module(name):
-    path = os.path.join(PROJECT, "cases", name, name + ".py")
-    spec = importlib.util.spec_from_file_location(name, path)
+def load_case_module(name, script=None):
+    """cases/<name>/<script>.py (default <name>.py) as a module."""
+    script = script or name
+    path = os.path.join(PROJECT, "cases", name, script + ".py")
+    spec = importlib.util.spec_from_file_location(script, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module

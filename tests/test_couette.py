@@ -380,11 +380,7 @@ def test_table8_extends_a_run_whose_averaging_window_is_short():
     """table8.py's rule: a finished run averaged over fewer than --min-average strain units after its
     transient is continued by the shortfall (in whole steps), never beyond --max-strain."""
     import argparse
-    import importlib.util
-    spec = importlib.util.spec_from_file_location("table8", os.path.join(os.path.dirname(case.__file__), "..", "..",
-                                                                         "cases", "couette", "table8.py"))
-    table8 = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(table8)
+    table8 = load_case_module("couette", "table8")
     args = argparse.Namespace(min_average=20.0, max_strain=60.0, dt=0.04)
     # 25 strain units (625 steps), transient to strain 12.1: 12.9 averaged, 7.1 short = 177.5 -> 178 steps
     assert table8.extension(dict(steps_done=625, strain_averaged=12.9), args) == 625 + 178

@@ -27,8 +27,8 @@ phi_m = 0.59 (with 3 or more analysed runs); and the figure beside it (Fig. 21 w
 """
 import argparse
 import glob
-import math
 import json
+import math
 import os
 import subprocess
 import sys
@@ -108,10 +108,11 @@ def extension(row: Dict, args: argparse.Namespace) -> Optional[int]:
     return min(row["steps_done"] + int(math.ceil(short / args.dt - 1e-9)), last)
 
 
-def run_row(phi: float, args: argparse.Namespace) -> str:
+def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
     """Write, start or resume the run of one phi_bulk until it finishes, then extend it while its
-    averaging window is short of --min-average; returns its folder. A run that another process is
-    running is waited for, never started a second time."""
+    averaging window is short of --min-average; returns the analysis of the run as it ends (analyse_row),
+    or None if none was made (--min-average 0). A run that another process is running is waited for,
+    never started a second time."""
     run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
     if run_dir is not None and running_elsewhere(run_dir):
         print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
@@ -128,6 +129,7 @@ def run_row(phi: float, args: argparse.Namespace) -> str:
         # to the input's last step: an extension killed before its first checkpoint resumes from one
         # written for the shorter run, which fdmDEM accepts only with -until
         _fdmrun(run_dir, args, until=steps_planned(run_dir))
+    row = None
     while args.min_average > 0:
         row = analyse_row(phi, run_dir, args)
         until = extension(row, args)
@@ -137,7 +139,7 @@ def run_row(phi: float, args: argparse.Namespace) -> str:
               "%g: extended to strain %g" % (phi, row.get("strain_averaged", 0.0), args.min_average, until * args.dt),
               flush=True)
         _fdmrun(run_dir, args, until=until)
-    return run_dir
+    return row
 
 
 def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) -> Dict:
@@ -238,14 +240,18 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     args = p.parse_args(argv)
     os.makedirs(args.workdir, exist_ok=True)
     start = time.time()
+    analysed: Dict[float, Dict] = {}   # the rows run_row analysed as their runs ended
     for phi in args.phis:
         if args.analyse_only:
             break
         if args.session_hours is not None and time.time() - start > 3600 * args.session_hours:
             print("table8: --session-hours reached; the next call continues", flush=True)
             break
-        run_row(phi, args)
-    rows = [analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model), args)
+        row = run_row(phi, args)
+        if row is not None:
+            analysed[phi] = row
+    rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed,
+                                                            args.model), args)
             for phi in args.phis]
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
