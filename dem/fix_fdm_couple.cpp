@@ -272,7 +272,7 @@ void FixFdmCouple::gather(std::vector<Particle> &particles)
            ")");
 }
 
-std::string FixFdmCouple::checkConfiguration(const std::vector<Particle> &particles, bool checkOverlaps) const
+std::string FixFdmCouple::checkConfiguration(const std::vector<Particle> &particles, bool fromInput) const
 {
   // rank 0. A particle through a wall, or two overlapping, would give a wrong flow silently.
   const char *axis = "xyz";
@@ -289,15 +289,22 @@ std::string FixFdmCouple::checkConfiguration(const std::vector<Particle> &partic
         if (2 * p.radius > domain->prd[d])
           return who + " is larger than the periodic box in " + axis[d] + " (extent " + number(domain->prd[d]) +
                  "): it would overlap its own image";
-      } else if (p.x[d] - p.radius < lo || p.x[d] + p.radius > hi) {
-        const bool low = p.x[d] - p.radius < lo;
+      } else {
+        // A configuration the input gave must be clear of the walls; a continuing or resumed run may
+        // have a sphere pressed into one by its contact spring, as deep as both codes accept at any step.
+        const bool low = p.x[d] - p.radius - lo < hi - p.x[d] - p.radius;
         const double gap = low ? p.x[d] - p.radius - lo : hi - p.x[d] - p.radius;
-        return who + " crosses the wall " + axis[d] + " = " + number(low ? lo : hi) + " (non-periodic boundary; box " +
-               number(lo) + " .. " + number(hi) + "): gap " + number(gap);
+        const double allowed = fromInput ? 0.0 : cpl::contactOverlapTolerance * p.radius;
+        if (gap < -allowed)
+          return who + " crosses the wall " + axis[d] + " = " + number(low ? lo : hi) + " (non-periodic boundary; box " +
+                 number(lo) + " .. " + number(hi) + "): gap " + number(gap) +
+                 (fromInput ? std::string()
+                            : " (" + number(-gap / p.radius) + " radii, more than the " +
+                                  number(cpl::contactOverlapTolerance) + " radii accepted for a contact pressed into a wall)");
       }
     }
   }
-  return checkOverlaps ? findOverlap(particles) : std::string();
+  return fromInput ? findOverlap(particles) : std::string();
 }
 
 std::string FixFdmCouple::findOverlap(const std::vector<Particle> &p) const
@@ -407,10 +414,10 @@ void FixFdmCouple::setup(int)
   }
   std::vector<Particle> particles;
   gather(particles);
-  // Overlaps are an input error in the configuration the input script gave (first run, or positions
-  // set between runs of fixed particles); later runs continue from where contacts (h_r > 0, finite
-  // kn) may legitimately have pressed particles a little into each other.
-  // (a resumed session continues a run: its particles may be pressed into contact like any later run's)
+  // Overlaps and wall crossings are input errors in the configuration the input script gave (first
+  // run, or positions set between runs of fixed particles); later runs, and a resumed session,
+  // continue from where contacts (h_r > 0, finite kn) may legitimately have pressed particles a little
+  // into each other or into a wall.
   allAgree(comm->me == 0 ? checkConfiguration(particles, (firstSetup && !resumed_) || !move_) : std::string());
   // A planned position update continues the previous run only from where that run left the
   // particles: if the input has moved them since (set, displace_atoms, read_restart ...), the next
@@ -875,11 +882,11 @@ void FixFdmCouple::scatter()
 void FixFdmCouple::checkOverlaps()
 {
   // Every rank (collective). Two spheres overlapping by more than the fluid accepts of a sphere
-  // pressed into a wall (maxOverlap of the smaller radius, fdmFoam's 0.05) are beyond what the
+  // pressed into a wall (cpl::contactOverlapTolerance of the smaller radius) are beyond what the
   // contact springs allow for any load they were chosen for: the run is no longer a suspension of
   // rigid spheres (measured: 0.08-0.21 a1 in dense scenes at large steps, docs/benchmarks.md
   // "Stability map"), so it stops rather than record it.
-  const double maxOverlap = 0.05;
+  const double maxOverlap = cpl::contactOverlapTolerance;
   if (!pair_ || !session_.hasFluid()) return;
   const PairFdmSubgrid::Overlap &mine = pair_->deepestOverlap();
   struct {
@@ -1043,8 +1050,7 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
                 "%ld contacts began to slide within their step; position update %s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
-                solver_ == fdm::ParticleVelocitySystem::cholmod ? "CHOLMOD"
-                : solver_ == fdm::ParticleVelocitySystem::ldlt  ? "LDLT" : "CG",
+                fdm::ParticleVelocitySystem::solverName(solver_),
                 t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations,
                 pairBlocks_, wallBlocks_, contacts_, t.contactSlides,
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),

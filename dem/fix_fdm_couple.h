@@ -78,7 +78,7 @@ class FixFdmCouple : public Fix {
   };
 
   void gather(std::vector<Particle> &particles);
-  std::string checkConfiguration(const std::vector<Particle> &particles, bool checkOverlaps) const;
+  std::string checkConfiguration(const std::vector<Particle> &particles, bool fromInput) const;
   std::string findOverlap(const std::vector<Particle> &particles) const;
   fdm::coupler::Step makeStep(const std::vector<Particle> &particles) const;
   void assembleSystem(const std::vector<Particle> &particles);

@@ -275,6 +275,16 @@ void ParticleVelocitySystem::setVolumes(const std::vector<RigidVolume> &volumes)
   m.ready = true;
 }
 
+const char *ParticleVelocitySystem::solverName(Solver solver)
+{
+  switch (solver) {
+    case cholmod: return "CHOLMOD";
+    case ldlt: return "LDLT";
+    case cg: return "CG";
+  }
+  return "?";
+}
+
 void ParticleVelocitySystem::factorise(const std::string &when)
 {
   Matrices &m = *m_;
@@ -284,7 +294,7 @@ void ParticleVelocitySystem::factorise(const std::string &when)
     factorisations_++;
     if (!factorised)
       throw Error(Error::notSolved, -1, std::string("the particle velocity system (Eq. 31) could not be factorised (") +
-                                            (settings_.solver == cholmod ? "Cholesky, CHOLMOD" : "LDLT") + ")" + when);
+                                            solverName(settings_.solver) + ")" + when);
   } else {
     m.cg.setTolerance(settings_.tolerance);
     m.cg.setMaxIterations(std::max(1000, 6 * n_));

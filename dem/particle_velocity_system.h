@@ -96,6 +96,9 @@ class ParticleVelocitySystem {
   explicit ParticleVelocitySystem(const Settings &settings);
   ~ParticleVelocitySystem();
 
+  // The solver as messages and the run-end timing name it: "CHOLMOD", "LDLT" or "CG".
+  static const char *solverName(Solver solver);
+
   // The implicit contact springs of a step (Eqs. C2, C3 of docs/contact.md): their records (layouts
   // above) and U_n with its weight gamma (1/3 with ab2, 0 with euler) in the known part.
   struct Springs {

@@ -6,12 +6,13 @@ answer to a sphere pressed a little into a wall (accepted, warned once) or escap
 small coupled runs; about 30 s."""
 import os
 import re
+import subprocess
 
 import pytest
 
-from fdmsubgrid import case
+from fdmsubgrid import case, output
 
-from test_bad_input import make_case, run_fdm, logs
+from test_bad_input import FDMRUN, make_case, run_fdm, logs
 
 
 
@@ -78,10 +79,11 @@ def test_stuck_and_sliding_with_implicit_springs(tmp_path, env, ct, res):
 WALL_BOX = case.Box((0, 0, 0), (4, 4, 4), 0.25, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
 
 
-def _wall_case(tmp_path, kn, steps):
+def _wall_case(tmp_path, kn, steps, checkpoint=0):
     weight = 0.5 * 2000 * 4.0 / 3.0 * 3.141592653589793 * 0.125 * 0.01
     root = make_case(tmp_path, spheres=[(2.0, 0.502, 2.0, 0.5)], box=WALL_BOX,
-                     fix_options="gravity 0 -0.01 0", runs=("run %d" % steps,), dt=0.1,
+                     fix_options="gravity 0 -0.01 0" + (" checkpoint %d" % checkpoint if checkpoint else ""),
+                     runs=("run %d upto" % steps,), dt=0.1,
                      pair_style="fdm/subgrid lubrication no contact %g 0 0.5 0.0025 wall ylo 0 0 0 wall yhi 0 0 0" % kn)
     # the write_dem_input spheres have density 1000: make them 2000
     data = os.path.join(root, "dem", "spheres.data")
@@ -102,6 +104,24 @@ def test_fluid_accepts_a_sphere_pressed_into_a_wall(tmp_path, env):
     assert 0 < float(warnings[0][1]) <= 0.05
     dem = open(os.path.join(root, "log.dem"), errors="replace").read()
     assert "stable with the implicit springs" in dem
+
+
+def test_a_run_with_a_sphere_pressed_into_a_wall_resumes(tmp_path, env):
+    # the same sphere, checkpointed while pressed 0.01 a into the wall: both codes accept the
+    # resumed configuration as they accepted it at every step (a configuration the input gives must
+    # be clear of the walls: test_particle_crossing_a_wall), and the run extends to step 16
+    root, weight = _wall_case(tmp_path, 698.0, 12, checkpoint=4)
+    status, out, wall = run_fdm(root, env, timeout=120)
+    assert status == 0, out + logs(root)[-3000:]
+    proc = subprocess.run([FDMRUN, "--quiet", "--resume", "--until", "16", root], stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, errors="replace", text=True, env=env, timeout=120)
+    assert proc.returncode == 0, proc.stdout + logs(root)[-3000:]
+    dem = open(os.path.join(root, "log.dem"), errors="replace").read()
+    assert "resuming from checkpoint/dem.12" in dem, dem[-3000:]
+    steps = output.steps(os.path.join(root, "fluid"))["step"].astype(int)
+    assert list(steps) == list(range(1, 17)), steps
+    y = output.particles(os.path.join(root, "fluid"))["y"]
+    assert 0.5 - 0.05 * 0.5 < y[-1] < 0.5, y    # still pressed in, less than the accepted 0.05 radii
 
 
 def test_fluid_stops_a_sphere_escaping_through_a_wall(tmp_path, env):

@@ -27,6 +27,12 @@ namespace coupler {
 //    of the isotropic Ju (Eq. 31's rigid-body block, Galilean invariant).
 const uint16_t protocolVersion = 4;
 
+// How deep (in radii: of the sphere for a wall, of the smaller sphere for a pair) a contact pressed
+// in by its load may go and still be accepted by both codes, at any step and when a run resumes
+// (fdmFoam warns once of a wall overlap); deeper is an escape through a wall, or springs too soft
+// for their loads, and stops the run (docs/contact.md).
+constexpr double contactOverlapTolerance = 0.05;
+
 enum class MessageType : uint16_t {
     Hello      = 1,  // handshake, once per connection, each side sends one
     Step       = 2,  // DEM -> fluid: particle positions/radii/velocities, once per time step

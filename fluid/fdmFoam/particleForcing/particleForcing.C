@@ -34,7 +34,7 @@ Foam::string Foam::particleForcing::checkInsideDomain
 ) const
 {
     // Periodic directions: the centre must be in the box (the DEM wraps it).
-    // Walls: the sphere must be inside them, up to wallOverlapTolerance radii:
+    // Walls: the sphere must be inside them, up to fdm::coupler::contactOverlapTolerance radii:
     // a contact spring pressed into a wall (pair_style fdm/subgrid contact,
     // docs/contact.md) overlaps it by a small fraction of the roughness h_r;
     // the indicator function just loses the thin cap beyond the wall (the
@@ -62,7 +62,7 @@ Foam::string Foam::particleForcing::checkInsideDomain
             {
                 continue;
             }
-            const scalar allowed = periodic ? 0 : wallOverlapTolerance*p.radius;
+            const scalar allowed = periodic ? 0 : fdm::coupler::contactOverlapTolerance*p.radius;
             const scalar face = below > above ? bb.min()[d] : bb.max()[d];
             if (std::isfinite(p.x[d]) && overlap <= allowed)
             {
@@ -75,7 +75,7 @@ Foam::string Foam::particleForcing::checkInsideDomain
                         << axis[d] << " = " << face << " by " << overlap
                         << " (" << overlap/p.radius << " radii): accepted as a "
                         << "contact pressed into the wall (up to "
-                        << wallOverlapTolerance << " radii; the sphere's cap "
+                        << fdm::coupler::contactOverlapTolerance << " radii; the sphere's cap "
                         << "beyond the wall has no forcing). Reported once."
                         << endl;
                 }
@@ -95,7 +95,7 @@ Foam::string Foam::particleForcing::checkInsideDomain
             {
                 os  << " (walls): it crosses the wall " << axis[d] << " = "
                     << face << " by " << overlap << " (" << overlap/p.radius
-                    << " radii, more than the " << wallOverlapTolerance
+                    << " radii, more than the " << fdm::coupler::contactOverlapTolerance
                     << " radii accepted for a contact pressed into a wall): "
                     << "it escapes through the wall";
             }
