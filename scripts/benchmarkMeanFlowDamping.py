@@ -50,9 +50,11 @@ RUNS = [
 
 
 def run_scene(workdir: str, label: str, acceleration: str, damping: float, tol_lambda: float, n_max: int,
-              phi: float, seed: int, friction: bool, tol_solve: float | None = None) -> dict:
+              phi: float, seed: int, friction: bool, tol_solve: float | None = None,
+              rel_tol: tuple[float, float, float] | None = None) -> dict:
     """Two steps of the scene; the second step's solves, convergence and particle velocities.
-    tol_solve: the linear solvers' tolerance (tol_u = tol_p; None: the case's, 1e-5 and 1e-3)."""
+    tol_solve: the linear solvers' tolerance (tol_u = tol_p, every solve to it: relTol 0; None: the
+    case's, 1e-5 and 1e-3); rel_tol: the linear solves' relTol, (U, p, pFinal) (None: the case's)."""
     run_dir = os.path.join(workdir, "seed%d" % seed, label.replace(", ", "_").replace(" ", ""))
     shutil.rmtree(run_dir, ignore_errors=True)
     size, a_over_delta, dt = (10.0, 12.0, 8.0), 3.0, 0.04
@@ -65,6 +67,9 @@ def run_scene(workdir: str, label: str, acceleration: str, damping: float, tol_l
     fluid = dict(first_step=(TIGHT, 3000), mean_flow_damping=damping)
     if tol_solve is not None:
         fluid.update(tol_u=tol_solve, tol_p=tol_solve)
+        rel_tol = (0.0, 0.0, 0.0)
+    if rel_tol is not None:
+        fluid.update(zip(("u_rel_tol", "p_rel_tol", "p_final_rel_tol"), rel_tol))
     scene = couette.write_case(run_dir, pack, springs, a_over_delta, dt, 2 * dt, 1, tol_lambda, acceleration,
                                n_max, fluid_options=fluid)
     try:

@@ -378,16 +378,45 @@ def test_time_step_beyond_the_measured_limit_is_warned(couette):
 
 def test_table8_extends_a_run_whose_averaging_window_is_short():
     """table8.py's rule: a finished run averaged over fewer than --min-average strain units after its
-    transient is continued by the shortfall (in whole steps), never beyond --max-strain."""
+    transient is continued by the shortfall, at least a tenth of --min-average (in whole steps), never
+    beyond --max-strain."""
     import argparse
     table8 = load_case_module("couette", "table8")
-    args = argparse.Namespace(min_average=20.0, max_strain=60.0, dt=0.04)
+    args = argparse.Namespace(min_average=20.0, max_strain=60.0, dt=None)
+    # the rows' time steps: 0.04 below phi_bulk 0.45, 0.02 from it on, unless --dt says one
+    assert (table8.row_dt(0.27, args), table8.row_dt(0.37, args), table8.row_dt(0.47, args)) == (0.04, 0.04, 0.02)
+    assert table8.row_dt(0.47, argparse.Namespace(dt=0.01)) == 0.01
     # 25 strain units (625 steps), transient to strain 12.1: 12.9 averaged, 7.1 short = 177.5 -> 178 steps
-    assert table8.extension(dict(steps_done=625, strain_averaged=12.9), args) == 625 + 178
-    assert table8.extension(dict(steps_done=625, strain_averaged=20.0), args) is None
-    assert table8.extension(dict(steps_done=625, strain_averaged=21.3), args) is None
+    assert table8.extension(dict(steps_done=625, strain_averaged=12.9), args, 0.04) == 625 + 178
+    assert table8.extension(dict(steps_done=625, strain_averaged=20.0), args, 0.04) is None
+    assert table8.extension(dict(steps_done=625, strain_averaged=21.3), args, 0.04) is None
+    # short by less than a tenth of --min-average: extended by 2 strain units (50 steps), not 0.7
+    assert table8.extension(dict(steps_done=880, strain_averaged=19.3), args, 0.04) == 880 + 50
     # capped at --max-strain, and not extended once there
-    assert table8.extension(dict(steps_done=1450, strain_averaged=2.0), args) == 1500
-    assert table8.extension(dict(steps_done=1500, strain_averaged=2.0), args) is None
+    assert table8.extension(dict(steps_done=1450, strain_averaged=2.0), args, 0.04) == 1500
+    assert table8.extension(dict(steps_done=1500, strain_averaged=2.0), args, 0.04) is None
     # a run too short to be analysed yet counts as averaged over nothing
-    assert table8.extension(dict(steps_done=25), args) == 25 + 500
+    assert table8.extension(dict(steps_done=25), args, 0.04) == 25 + 500
+
+
+def test_table8_fits_only_finished_rows_with_a_full_window(tmp_path):
+    """table8.py's Maron-Pierce fit takes the finished rows whose averaging window holds --min-average
+    strain units; a partial run or a short window is plotted and listed as not fitted."""
+    import argparse
+    table8 = load_case_module("couette", "table8")
+    args = argparse.Namespace(a_over_delta=3.0, dt=None, tol_lambda=0.01, strain=25.0, seed=1,
+                              out=str(tmp_path / "table8.json"))
+    alpha, phi_m = 0.8, 0.6
+
+    def row(phi_bulk, phi_core, status="finished", short=False):
+        eta = alpha * (1 - phi_core / phi_m) ** -2
+        return dict(phi_bulk_table8=phi_bulk, phi_core=phi_core, eta_s=eta, eta_s_err=0.02 * eta,
+                    status=status, window_short=short)
+
+    rows = [row(0.27, 0.31), row(0.32, 0.366), row(0.37, 0.41), row(0.47, 0.50, status="partial", short=True)]
+    # the partial row far off the curve: fitted, it would move phi_m
+    rows[3]["eta_s"] *= 0.5
+    fit = table8.summarise(rows, args)["fit"]
+    assert fit["rows"] == [0.27, 0.32, 0.37] and fit["not_fitted"] == [0.47]
+    assert abs(fit["alpha"] - alpha) < 1e-6 and abs(fit["phi_m"] - phi_m) < 1e-6
+    assert "fit" not in table8.summarise(rows[:2] + rows[3:], args)

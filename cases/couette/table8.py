@@ -2,7 +2,8 @@
 """The paper's Table 8 and Fig. 21 (section 6.1) from one command: each phi_bulk's scene written,
 run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq. 55).
 
-  table8.py                                 phi_bulk 0.27, 0.37, 0.47 (25 strain units at dt 0.02)
+  table8.py                                 phi_bulk 0.27, 0.37, 0.47 (25 strain units, dt 0.04 below
+                                            phi_bulk 0.45 and 0.02 from it on, tolLambda 1e-2)
   table8.py --phis 0.27 0.32 0.37 0.42 0.47 0.52 0.54   all seven rows
   table8.py --analyse-only                  the runs as they stand (partial runs reported with the
                                             strain they reached), nothing run
@@ -23,7 +24,8 @@ the session ending) loses at most one checkpoint interval.
 Writes --out (default docs/table8.json): per phi_bulk the paper's row, this project's phi_core,
 gamma_core/gamma_0, eta_s, N1_hat, N2_hat, Sigma_c_hat with error bars, the stress balance, the strain
 reached and the cost; the Maron-Pierce fit with its uncertainty against the paper's alpha = 0.803,
-phi_m = 0.59 (with 3 or more analysed runs); and the figure beside it (Fig. 21 with error bars).
+phi_m = 0.59 (over 3 or more finished rows whose window is full: partial and short rows are plotted
+and listed, not fitted); and the figure beside it (Fig. 21 with error bars).
 """
 import argparse
 import glob
@@ -43,7 +45,18 @@ from fdmsubgrid import checkpoint, output, rheology  # noqa: E402
 from fdmsubgrid.shear import steps_planned  # noqa: E402
 
 PAPER_FIT = dict(zip(("alpha", "phi_m"), rheology.PAPER_MARON_PIERCE))   # paper section 6.1, Eq. (55)
+# The time step of a row unless --dt says one: 0.04/gamma_dot_0 below phi_bulk 0.45, 0.02 from it on,
+# where accuracy sets 0.02 (eta_s at 0.05 is a third lower: docs/benchmarks.md, "Stability map"); the
+# rows of docs/validation.md ran so.
+DENSE_PHI, DT_DENSE, DT_DILUTE = 0.45, 0.02, 0.04
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
+
+
+def row_dt(phi: float, args: argparse.Namespace) -> float:
+    """The time step of the row phi_bulk: --dt if given, else DT_DILUTE or DT_DENSE."""
+    if args.dt is not None:
+        return args.dt
+    return DT_DENSE if phi >= DENSE_PHI - 1e-9 else DT_DILUTE
 
 
 def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int, model: str) -> Optional[str]:
@@ -97,15 +110,22 @@ def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None)
         subprocess.run(cmd, check=True, stdout=f, stderr=subprocess.STDOUT)
 
 
-def extension(row: Dict, args: argparse.Namespace) -> Optional[int]:
+def extension(row: Dict, args: argparse.Namespace, dt: float) -> Optional[int]:
     """The step a finished run must be continued to so that its averaging window (after the
     transient) holds --min-average strain units, at most --max-strain; None if it holds them, or
-    if it has reached --max-strain."""
-    short = args.min_average - row.get("strain_averaged", 0.0)
-    last = int(round(args.max_strain / args.dt))
+    if it has reached --max-strain. A run is extended by its shortfall and by at least a tenth of
+    --min-average: MSER's end of the transient moves a little later as a run grows (its batches
+    grow with it), so extending by the shortfall alone came up short again by a fraction of a unit
+    (the 0.32 row: 19.3 units averaged at strain 35.2, then again at 35.9), each time paying a
+    resume. The chase is bounded: MSER never puts the transient's end past half the run, so a run of
+    2 --min-average holds the window."""
+    averaged = row.get("strain_averaged", 0.0)
+    short = args.min_average - averaged
+    last = int(round(args.max_strain / dt))
     if short <= 1e-9 or row["steps_done"] >= last:
         return None
-    return min(row["steps_done"] + int(math.ceil(short / args.dt - 1e-9)), last)
+    more = max(short, 0.1 * args.min_average)
+    return min(row["steps_done"] + int(math.ceil(more / dt - 1e-9)), last)
 
 
 def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
@@ -113,17 +133,18 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
     averaging window is short of --min-average; returns the analysis of the run as it ends (analyse_row),
     or None if none was made (--min-average 0). A run that another process is running is waited for,
     never started a second time."""
-    run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
+    dt = row_dt(phi, args)
+    run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model)
     if run_dir is not None and running_elsewhere(run_dir):
         print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
         while running_elsewhere(run_dir):
             time.sleep(60)
     if run_dir is None:
-        subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(args.dt),
+        subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(dt),
                         "--strain", str(args.strain), "--a-over-delta", str(args.a_over_delta),
                         "--seed", str(args.seed), "--n-max", str(args.n_max), "--tol-lambda", str(args.tol_lambda),
                         "--model", args.model, "--workdir", args.workdir], check=True)
-        run_dir = find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed, args.model)
+        run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model)
     if steps_done(run_dir) < steps_planned(run_dir):
         print("table8: phi_bulk %g:" % phi, end=" ", flush=True)
         # to the input's last step: an extension killed before its first checkpoint resumes from one
@@ -132,11 +153,11 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
     row = None
     while args.min_average > 0:
         row = analyse_row(phi, run_dir, args)
-        until = extension(row, args)
+        until = extension(row, args, dt)
         if until is None:
             break
         print("table8: phi_bulk %g: averaged over %.1f strain units after the transient, short of --min-average "
-              "%g: extended to strain %g" % (phi, row.get("strain_averaged", 0.0), args.min_average, until * args.dt),
+              "%g: extended to strain %g" % (phi, row.get("strain_averaged", 0.0), args.min_average, until * dt),
               flush=True)
         _fdmrun(run_dir, args, until=until)
     return row
@@ -145,11 +166,12 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
 def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) -> Dict:
     """couette.py --analyse of the run as it stands, with the paper's row."""
     row: Dict = dict(phi_bulk_table8=phi, run_dir=run_dir)
+    dt = row_dt(phi, args)
     if run_dir is None:
         return row | dict(status="not started")
     done, planned = steps_done(run_dir), steps_planned(run_dir)
-    row.update(steps_done=done, steps_planned=planned, strain_reached=done * args.dt)
-    if done * args.dt < MIN_STRAIN_TO_REPORT:
+    row.update(steps_done=done, steps_planned=planned, strain_reached=done * dt)
+    if done * dt < MIN_STRAIN_TO_REPORT:
         return row | dict(status="started")
     out = run_dir + ".results.json"
     subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--analyse", run_dir, "--out", out], check=True,
@@ -169,22 +191,29 @@ def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) ->
 
 
 def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
-    """The Maron-Pierce fit (3 or more analysed rows) and Fig. 21."""
+    """The Maron-Pierce fit (over 3 or more finished rows whose window holds --min-average strain
+    units: a partial or short row is plotted and listed, not fitted) and Fig. 21."""
     done = [r for r in rows if "eta_s" in r]
-    summary: Dict = dict(rows=rows, paper_fit=PAPER_FIT, a_over_delta=args.a_over_delta, dt=args.dt,
-                         strain=args.strain, seed=args.seed)
+    fitted = [r for r in done if r["status"] == "finished" and not r.get("window_short")]
+    dts = sorted({row_dt(r["phi_bulk_table8"], args) for r in rows})
+    summary: Dict = dict(rows=rows, paper_fit=PAPER_FIT, a_over_delta=args.a_over_delta,
+                         dt={"%g" % r["phi_bulk_table8"]: row_dt(r["phi_bulk_table8"], args) for r in rows},
+                         tol_lambda=args.tol_lambda, strain=args.strain, seed=args.seed)
     fit = None
-    if len(done) >= 3:
-        fit = rheology.fit_maron_pierce([r["phi_core"] for r in done], [r["eta_s"] for r in done],
-                                        [r["eta_s_err"] for r in done])
+    if len(fitted) >= 3:
+        fit = rheology.fit_maron_pierce([r["phi_core"] for r in fitted], [r["eta_s"] for r in fitted],
+                                        [r["eta_s_err"] for r in fitted])
         summary["fit"] = dict(alpha=fit.alpha, alpha_error=fit.alpha_error, phi_m=fit.phi_m,
-                              phi_m_error=fit.phi_m_error, chi2=fit.chi2, dof=fit.dof)
+                              phi_m_error=fit.phi_m_error, chi2=fit.chi2, dof=fit.dof,
+                              rows=[r["phi_bulk_table8"] for r in fitted],
+                              not_fitted=[r["phi_bulk_table8"] for r in done if r not in fitted])
     if done:
         figure = os.path.splitext(args.out)[0] + ".png"
         rheology.plot_viscosity(figure, [r["phi_core"] for r in done], [r["eta_s"] for r in done],
                                 [r["eta_s_err"] for r in done], fit=fit,
                                 phi_core_error=[r.get("phi_core_err") or 0.0 for r in done],
-                                label="this project (a1/Δ = %g, Δt = %g)" % (args.a_over_delta, args.dt),
+                                label="this project (a1/Δ = %g, Δt = %s)" % (args.a_over_delta,
+                                                                             ", ".join("%g" % d for d in dts)),
                                 title="Fig. 21: η_s(φ_core)", reference=rheology.PAPER_MARON_PIERCE)
         summary["figure"] = os.path.basename(figure)
     return summary
@@ -207,15 +236,22 @@ def print_table(summary: Dict) -> None:
             r["strain_units"], averaged, r["core_seconds_per_strain_unit"]))
     if "fit" in summary:
         f = summary["fit"]
-        print("Maron-Pierce fit: alpha = %.3f ± %.3f, phi_m = %.3f ± %.3f (chi2 %.2f for %d dof); paper 0.803, 0.59"
-              % (f["alpha"], f["alpha_error"], f["phi_m"], f["phi_m_error"], f["chi2"], f["dof"]))
+        print("Maron-Pierce fit over phi_bulk %s: alpha = %.3f ± %.3f, phi_m = %.3f ± %.3f (chi2 %.2f for %d dof); "
+              "paper 0.803, 0.59%s" % (", ".join("%g" % x for x in f["rows"]), f["alpha"], f["alpha_error"], f["phi_m"],
+                                       f["phi_m_error"], f["chi2"], f["dof"],
+                                       "; not fitted (partial or short): " + ", ".join("%g" % x for x in f["not_fitted"])
+                                       if f["not_fitted"] else ""))
+    else:
+        print("Maron-Pierce fit: needs 3 finished rows with a full window, has %d"
+              % sum(1 for r in summary["rows"] if r.get("status") == "finished" and not r.get("window_short")))
 
 
 def main(argv: Optional[List[str]] = None) -> Dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--phis", type=float, nargs="+", default=[0.27, 0.37, 0.47], help="Table 8 rows (phi_bulk)")
     p.add_argument("--strain", type=float, default=25.0, help="strain units per run (transient + averaging)")
-    p.add_argument("--dt", type=float, default=0.02, help="time step in units of 1/gamma_dot_0")
+    p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 of every row "
+                   "(default: %g below phi_bulk %g, %g from it on)" % (DT_DILUTE, DENSE_PHI, DT_DENSE))
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",
@@ -224,9 +260,9 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--np-fluid", type=int, default=1, help="MPI ranks of fdmFoam per run")
     p.add_argument("--n-max", type=int, default=50, help="fdmFoam's innerIterations nMax for scenes written now "
                    "(the dense rows stop at 50 in most steps: docs/benchmarks.md, 'Stability map')")
-    p.add_argument("--tol-lambda", type=float, default=1e-3, help="fdmFoam's innerIterations tolLambda for scenes "
-                   "written now (1e-2 keeps eta_s within its error bar at 2.4 times fewer fluid solves: "
-                   "docs/benchmarks.md, 'Sheared suspension: run time against error')")
+    p.add_argument("--tol-lambda", type=float, default=1e-2, help="fdmFoam's innerIterations tolLambda for scenes "
+                   "written now (1e-2, the rows of docs/validation.md, keeps eta_s within its error bar of 1e-3's "
+                   "at 2.4 times fewer fluid solves: docs/benchmarks.md, 'Sheared suspension: run time against error')")
     p.add_argument("--min-average", type=float, default=20.0,
                    help="strain units a row is averaged over after its transient: a finished run short of it is "
                         "extended from its last checkpoint (0: never extended)")
@@ -250,8 +286,8 @@ def main(argv: Optional[List[str]] = None) -> Dict:
         row = run_row(phi, args)
         if row is not None:
             analysed[phi] = row
-    rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, args.dt, args.seed,
-                                                            args.model), args)
+    rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args),
+                                                            args.seed, args.model), args)
             for phi in args.phis]
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
