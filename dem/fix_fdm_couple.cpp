@@ -652,6 +652,8 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   run_.contactSlides += system_->slidingSwitches();
   run_.factorisations += system_->factorisations() - factorisationsCounted_;
   factorisationsCounted_ = system_->factorisations();
+  run_.downdates += system_->downdates() - downdatesCounted_;
+  downdatesCounted_ = system_->downdates();
   // the implicit part of the contact forces (Eq. C2) and of their stresslet (Eq. 52)
   std::vector<double> springStress(size_t(6) * natoms_, 0.0);
   springs_ = system_->springForces(stresslets_ ? &springStress : nullptr,
@@ -1045,13 +1047,13 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
   std::snprintf(line, sizeof line,
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
-                "%s iterations mean %.1f max %ld, %ld factorisations; last step %ld sub-grid pair blocks, %ld wall "
+                "%s iterations mean %.1f max %ld, %ld factorisations, %ld low-rank downdates; last step %ld sub-grid pair blocks, %ld wall "
                 "blocks, %ld contacts; "
                 "%ld contacts began to slide within their step; position update %s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
                 fdm::ParticleVelocitySystem::solverName(solver_),
-                t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations,
+                t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations, t.downdates,
                 pairBlocks_, wallBlocks_, contacts_, t.contactSlides,
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");

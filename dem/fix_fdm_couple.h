@@ -72,9 +72,10 @@ class FixFdmCouple : public Fix {
     double gapBoundWorst;          // largest relative bound violation the fallback left
     long contactSlides;            // contacts that began to slide within their step (Coulomb's law at its end)
     long factorisations;           // of Eq. (31) by the direct solvers: per step, and when contacts begin to slide
+    long downdates;                // contacts that began to slide handled without a factorisation (Woodbury)
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
                gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0),
-               contactSlides(0), factorisations(0) {}
+               contactSlides(0), factorisations(0), downdates(0) {}
   };
 
   void gather(std::vector<Particle> &particles);
@@ -119,6 +120,7 @@ class FixFdmCouple : public Fix {
   bool stresslets_;          // per-particle stresslets asked for (fluid, sub-grid, contact)
   fdm::ParticleVelocitySystem::Solver solver_;  // of Eq. (31): cholmod (default), ldlt or cg
   long factorisationsCounted_ = 0;              // the system's factorisations already in run_
+  long downdatesCounted_ = 0;                   // and its downdates
   double tolerance_;         // relative residual of the conjugate-gradient solve
   class PairFdmSubgrid *pair_;  // the sub-grid / contact pair style, if that is the pair style
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
+#include <Eigen/Eigenvalues>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -51,16 +52,40 @@ struct ParticleVelocitySystem::Matrices {
   bool analysed = false;                // the direct solver's symbolic analysis of this step's pattern
   bool ready = false;                   // factorised (or preconditioned) for this step's rigid-body blocks
 
+  // The tangential springs of the contacts that began to slide since the last factorisation left
+  // the matrix: matrix = A - V V^T with A the factorised one, each such spring block V_c V_c^T of
+  // rank 2 (columns of V scattered to the particles' rows). Solved by the Woodbury identity,
+  // (A - V V^T)^-1 = A^-1 + A^-1 V C^-1 V^T A^-1 with the capacitance C = I - V^T A^-1 V: one
+  // back-substitution per new column of V instead of a factorisation (docs/benchmarks.md,
+  // "The particle solve of a dense suspension").
+  Eigen::MatrixXd downdate;             // V (6N x r)
+  Eigen::MatrixXd solvedDowndate;       // A^-1 V
+  Eigen::LLT<Eigen::MatrixXd> capacitance;
+  std::vector<Eigen::VectorXd> leaving; // columns of V of the spring blocks that left the matrix in this round
+
   // x = (the factorised matrix)^-1 b
-  Eigen::VectorXd directSolve(Solver solver, const Eigen::VectorXd &b) const
+  Eigen::VectorXd factorisedSolve(Solver solver, const Eigen::VectorXd &b) const
   {
     return solver == ParticleVelocitySystem::cholmod ? Eigen::VectorXd(cholmod.solve(b)) : Eigen::VectorXd(ldlt.solve(b));
+  }
+  Eigen::MatrixXd factorisedSolve(Solver solver, const Eigen::MatrixXd &b) const
+  {
+    return solver == ParticleVelocitySystem::cholmod ? Eigen::MatrixXd(cholmod.solve(b)) : Eigen::MatrixXd(ldlt.solve(b));
+  }
+  // x = matrix^-1 b: the factorisation, and the downdate of the contacts that slide since (Woodbury).
+  // A stiff spring leaving the matrix (kt c1 dt much larger than the drag) costs the identity a few
+  // digits by cancellation: about 1e-12 relative at kt c1 dt/zeta = 1000.
+  Eigen::VectorXd directSolve(Solver solver, const Eigen::VectorXd &b) const
+  {
+    Eigen::VectorXd x = factorisedSolve(solver, b);
+    if (downdate.cols() > 0) x += solvedDowndate * capacitance.solve(downdate.transpose() * x);
+    return x;
   }
 };
 
 ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
   settings_(settings), n_(0), springGamma_(0), slidingSwitches_(0), pairRecord_(subgrid::pairRecord), wallRecord_(subgrid::wallRecord), pairBlocks_(0),
-  wallBlocks_(0), iterations_(0), factorisations_(0), m_(new Matrices)
+  wallBlocks_(0), iterations_(0), factorisations_(0), downdates_(0), m_(new Matrices)
 {
   if (!(settings_.alphaLambda > 0) || !(settings_.rhoFluid > 0) || !(settings_.tolerance > 0))
     throw Error(Error::notSolved, -1, "Eq. (31) needs a positive alpha_lambda (" + number(settings_.alphaLambda) +
@@ -288,6 +313,8 @@ const char *ParticleVelocitySystem::solverName(Solver solver)
 void ParticleVelocitySystem::factorise(const std::string &when)
 {
   Matrices &m = *m_;
+  m.downdate.resize(6 * n_, 0);
+  m.solvedDowndate.resize(6 * n_, 0);
   if (settings_.solver != cg) {
     const bool factorised = settings_.solver == cholmod ? factoriseDirect(m.cholmod, m.matrix, m.analysed)
                                                         : factoriseDirect(m.ldlt, m.matrix, m.analysed);
@@ -381,6 +408,7 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   // exceeds what the contact holds at either end, and a contact that opens within the step loses it.
   Matrices &m = *m_;
   bool matrixChanged = false, rhsChanged = false;
+  m.leaving.clear();
   auto setSlideForce = [&](size_t record, const double target[3], const double *ft, const int *base, int size,
                            const double *tail, bool wall) {
     double change[3], f[12];
@@ -399,7 +427,20 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     rhsChanged = true;
   };
   auto removeBlock = [&](const int *base, int size, const double *R) {
-    // R_t leaves the matrix (its entries exist: R_c had them), and gamma R_t U_n the known part
+    // R_t leaves the matrix (its entries exist: R_c had them), and gamma R_t U_n the known part;
+    // R_t = sum_k lambda_k v_k v_k^T (rank 2: the tangential plane) gives the columns sqrt(lambda_k) v_k of V
+    if (settings_.solver != cg) {
+      const Eigen::MatrixXd block = Eigen::Map<const Eigen::MatrixXd>(R, size, size);
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(block);
+      const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+      for (int k = 0; k < size; k++) {
+        const double lambda = eigen.eigenvalues()(k);
+        if (!(lambda > 1e-12 * largest)) continue;
+        Eigen::VectorXd column = Eigen::VectorXd::Zero(6 * n_);
+        for (int i = 0; i < size; i++) column(base[i / 6] + i % 6) = std::sqrt(lambda) * eigen.eigenvectors()(i, k);
+        m.leaving.push_back(column);
+      }
+    }
     for (int i = 0; i < size; i++) {
       const int row = base[i / 6] + i % 6;
       for (int j = 0; j < size; j++) {
@@ -455,8 +496,37 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     const int base[1] = {6 * tagIndex(rec[0])};
     coulomb(record, rec + springs::wallFriction, base, 6, true);
   }
-  if (matrixChanged) factorise(" after contacts started to slide");
+  if (matrixChanged) downdateOrFactorise();
   return matrixChanged || rhsChanged;
+}
+
+void ParticleVelocitySystem::downdateOrFactorise()
+{
+  // Beyond maxDowndateColumns the column solves cost about as much as a factorisation of the
+  // phi 0.47 Table 8 system (5742 unknowns, 2.1e6 non-zeros in its factor: 1.2e9 flops against
+  // about 1e7 per column), and the capacitance grows; CG has no factorisation to downdate.
+  const int maxDowndateColumns = 96;
+  Matrices &m = *m_;
+  const std::vector<Eigen::VectorXd> &leaving = m.leaving;
+  const long r0 = long(m.downdate.cols()), r = r0 + long(leaving.size());
+  if (settings_.solver == cg || r > maxDowndateColumns) {
+    factorise(" after contacts started to slide");
+    return;
+  }
+  Eigen::MatrixXd added(6 * n_, long(leaving.size()));
+  for (size_t k = 0; k < leaving.size(); k++) added.col(long(k)) = leaving[k];
+  const Eigen::MatrixXd solvedAdded = m.factorisedSolve(settings_.solver, added);
+  m.downdate.conservativeResize(Eigen::NoChange, r);
+  m.downdate.rightCols(r - r0) = added;
+  m.solvedDowndate.conservativeResize(Eigen::NoChange, r);
+  m.solvedDowndate.rightCols(r - r0) = solvedAdded;
+  Eigen::MatrixXd capacitance = -m.downdate.transpose() * m.solvedDowndate;
+  capacitance.diagonal().array() += 1.0;
+  m.capacitance.compute(capacitance);
+  downdates_++;
+  // A - V V^T stays positive definite while the particles keep their drag; if the capacitance says
+  // otherwise (round-off near a singular system), the matrix is factorised as it stands
+  if (m.capacitance.info() != Eigen::Success) factorise(" after contacts started to slide");
 }
 
 double ParticleVelocitySystem::diagonal(int k) const { return m_->rigidBlock[size_t(36) * (k / 6) + 7 * (k % 6)]; }

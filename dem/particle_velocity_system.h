@@ -144,6 +144,9 @@ class ParticleVelocitySystem {
   std::vector<int> closePairs() const;
   long lastIterations() const { return iterations_; }   // CG's, of the last solve (the most of its Coulomb rounds; 1 for LDLT)
   long factorisations() const { return factorisations_; }
+  // Contacts that began to slide handled by a low-rank downdate of the step's factorisation instead
+  // of a new one (Woodbury; CHOLMOD and LDLT): the number of such downdates since construction.
+  long downdates() const { return downdates_; }
 
   // After the last solve: F^SG, T^SG = -(R^SG u - wall term) (Eqs. 21, D.6), 6 per particle.
   std::vector<double> subgridForces() const;
@@ -175,6 +178,9 @@ class ParticleVelocitySystem {
   // leaves the matrix, the capped force along the trial direction replaces F_t in F^tot); true if
   // any did (the matrix is then factorised again).
   bool slideOverloadedContacts();
+  // The tangential spring blocks that left the matrix (columns of V, R_t = V V^T): a low-rank
+  // downdate of the factorisation (Woodbury), or a new factorisation once the downdate grows large.
+  void downdateOrFactorise();
   double springVelocity(int k) const;  // u - gamma U_n, the unknowns' part of the contact displacement
 
   struct Matrices;                     // Eigen's, in the .cpp
@@ -192,7 +198,7 @@ class ParticleVelocitySystem {
   long pairBlocks_, wallBlocks_;
   std::vector<RigidVolume> volumes_;   // of this step, for the messages
   std::vector<double> u_;              // the last solution: warm start of the next solve
-  long iterations_, factorisations_;
+  long iterations_, factorisations_, downdates_;
   std::unique_ptr<Matrices> m_;
 };
 
