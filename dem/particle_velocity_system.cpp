@@ -523,10 +523,12 @@ void ParticleVelocitySystem::downdateOrFactorise()
   Eigen::MatrixXd capacitance = -m.downdate.transpose() * m.solvedDowndate;
   capacitance.diagonal().array() += 1.0;
   m.capacitance.compute(capacitance);
-  downdates_++;
   // A - V V^T stays positive definite while the particles keep their drag; if the capacitance says
   // otherwise (round-off near a singular system), the matrix is factorised as it stands
-  if (m.capacitance.info() != Eigen::Success) factorise(" after contacts started to slide");
+  if (m.capacitance.info() != Eigen::Success)
+    factorise(" after contacts started to slide");
+  else
+    downdates_++;
 }
 
 double ParticleVelocitySystem::diagonal(int k) const { return m_->rigidBlock[size_t(36) * (k / 6) + 7 * (k % 6)]; }
