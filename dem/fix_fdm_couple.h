@@ -71,7 +71,7 @@ class FixFdmCouple : public Fix {
     int gapSweepsMax;
     double gapBoundWorst;          // largest relative bound violation the fallback left
     long contactSlides;            // contacts that began to slide within their step (Coulomb's law at its end)
-    long factorisations;           // of Eq. (31) by the direct solvers: per step, and when contacts begin to slide
+    long factorisations;           // of Eq. (31) by the direct solvers: per step, and when the downdates grow too large
     long downdates;                // contacts that began to slide handled without a factorisation (Woodbury)
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
                gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0),

@@ -176,7 +176,7 @@ class ParticleVelocitySystem {
   // Coulomb's law at the end of the step (docs/contact.md 2c): sticking contacts whose implicit
   // tangential force at u exceeds mu_s F_n slide from now on in this step (their tangential spring
   // leaves the matrix, the capped force along the trial direction replaces F_t in F^tot); true if
-  // any did (the matrix is then factorised again).
+  // any did (their blocks then leave by downdateOrFactorise).
   bool slideOverloadedContacts();
   // The tangential spring blocks that left the matrix (columns of V, R_t = V V^T): a low-rank
   // downdate of the factorisation (Woodbury), or a new factorisation once the downdate grows large.

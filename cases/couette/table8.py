@@ -190,11 +190,16 @@ def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) ->
     return row
 
 
+def fitted_rows(rows: List[Dict]) -> List[Dict]:
+    """The rows the Maron-Pierce fit takes: finished runs whose window holds --min-average units."""
+    return [r for r in rows if "eta_s" in r and r["status"] == "finished" and not r.get("window_short")]
+
+
 def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
     """The Maron-Pierce fit (over 3 or more finished rows whose window holds --min-average strain
     units: a partial or short row is plotted and listed, not fitted) and Fig. 21."""
     done = [r for r in rows if "eta_s" in r]
-    fitted = [r for r in done if r["status"] == "finished" and not r.get("window_short")]
+    fitted = fitted_rows(rows)
     dts = sorted({row_dt(r["phi_bulk_table8"], args) for r in rows})
     summary: Dict = dict(rows=rows, paper_fit=PAPER_FIT, a_over_delta=args.a_over_delta,
                          dt={"%g" % r["phi_bulk_table8"]: row_dt(r["phi_bulk_table8"], args) for r in rows},
@@ -242,8 +247,7 @@ def print_table(summary: Dict) -> None:
                                        "; not fitted (partial or short): " + ", ".join("%g" % x for x in f["not_fitted"])
                                        if f["not_fitted"] else ""))
     else:
-        print("Maron-Pierce fit: needs 3 finished rows with a full window, has %d"
-              % sum(1 for r in summary["rows"] if r.get("status") == "finished" and not r.get("window_short")))
+        print("Maron-Pierce fit: needs 3 finished rows with a full window, has %d" % len(fitted_rows(summary["rows"])))
 
 
 def main(argv: Optional[List[str]] = None) -> Dict:

@@ -294,11 +294,11 @@ namespace {
 // their contact sticking at the start of the step with a stiff tangential spring (kt c1 dt / zeta =
 // 1000), no explicit tangential force yet; Stokes drag zeta, rotational drag zetaR. Returns the
 // system after one solve.
-struct PulledPair {
-  struct Parameters {
-    double zeta = 2, zetaR = 3, cap = 4, normal = 8, ktc1dt = 2000, lever = 1.0025;  // kn c1 dt 0: F_n constant
-  };
-  double zeta = 2, zetaR = 3, cap = 4, normal = 8, ktc1dt = 2000, lever = 1.0025;  // Parameters'
+struct PullParameters {
+  double zeta = 2, zetaR = 3, cap = 4, normal = 8, ktc1dt = 2000, lever = 1.0025;  // kn c1 dt 0: F_n constant
+};
+
+struct PulledPair : PullParameters {
   ParticleVelocitySystem system;
   std::vector<double> u;
   PulledPair(double F, bool ab2, double ftStart = 0) : system(settings())
@@ -445,7 +445,7 @@ namespace {
 std::vector<std::vector<double> > pulledPairs(ParticleVelocitySystem &system, int K,
                                               const std::vector<std::vector<double> > &pulls)
 {
-  const PulledPair::Parameters q;
+  const PullParameters q;
   std::vector<ParticleVelocitySystem::Particle> particles(2 * K);
   for (auto &p : particles) p.radius = p.mass = p.density = 1;
   ParticleVelocitySystem::Springs s;
@@ -480,7 +480,7 @@ TEST(ContactSprings, SlidingContactsDowndateTheFactorisation)
   // (Woodbury): the velocities of a new factorisation (CG here, the matrix as it stands), every
   // sliding pair drifting at (F - cap)/zeta; a later inner iteration adds its own downdate; beyond
   // 96 columns (48 contacts) the matrix is factorised again instead.
-  const PulledPair::Parameters q;
+  const PullParameters q;
   const int K = 20;
   std::vector<double> first(K), second(K);
   // a pair pulled by F <= 6.5 rolls without sliding (its spring holds less than the cap of 4), one
