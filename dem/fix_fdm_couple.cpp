@@ -135,6 +135,12 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       if (!(tolerance_ > 0 && tolerance_ < 1))
         error->all(FLERR, "fix fdm/couple: tolerance (relative residual of Eq. 31) must be in (0, 1)");
       i++;
+    } else if (key == "coulomb_tolerance") {
+      coulombTolerance_ = force->numeric(FLERR, value(1));
+      if (!(coulombTolerance_ > 0 && coulombTolerance_ < 1))
+        error->all(FLERR, ("fix fdm/couple: coulomb_tolerance (of the sliding contacts' forces) must be in (0, 1), got " +
+                           std::string(value(1))).c_str());
+      i++;
     } else {
       error->all(FLERR, ("fix fdm/couple: unknown keyword " + key + " (see docs/dem.md)").c_str());
     }
@@ -562,6 +568,7 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
       fdm::ParticleVelocitySystem::Settings settings;
       settings.solver = solver_;
       settings.tolerance = tolerance_;
+      settings.coulombTolerance = coulombTolerance_;
       settings.alphaLambda = session_.alphaLambda();
       settings.rhoFluid = session_.rhoFluid();
       for (int d = 0; d < 3; d++) settings.gravity[d] = gravity_[d];
@@ -621,6 +628,7 @@ void FixFdmCouple::solveVelocities(const cpl::Integrals &integrals)
     fail(systemProblem(e, integrals.step, integrals.iteration));
   }
   const long iterations = system_->lastIterations();
+  run_.coulombRoundsMax = std::max(run_.coulombRoundsMax, system_->lastRounds());
   run_.solves++;
   run_.solverIterations += iterations;
   run_.solverIterationsMax = std::max(run_.solverIterationsMax, iterations);
@@ -654,6 +662,8 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   factorisationsCounted_ = system_->factorisations();
   run_.downdates += system_->downdates() - downdatesCounted_;
   downdatesCounted_ = system_->downdates();
+  run_.backSubstitutions += system_->backSubstitutions() - backSubstitutionsCounted_;
+  backSubstitutionsCounted_ = system_->backSubstitutions();
   // the implicit part of the contact forces (Eq. C2) and of their stresslet (Eq. 52)
   std::vector<double> springStress(size_t(6) * natoms_, 0.0);
   springs_ = system_->springForces(stresslets_ ? &springStress : nullptr,
@@ -1047,13 +1057,13 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
   std::snprintf(line, sizeof line,
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
-                "%s iterations mean %.1f max %ld, %ld factorisations, %ld low-rank downdates; last step %ld sub-grid pair blocks, %ld wall "
+                "%s iterations mean %.1f max %ld, %ld factorisations, %ld low-rank downdates, %ld back-substitutions (Coulomb rounds, at most %ld in a solve); last step %ld sub-grid pair blocks, %ld wall "
                 "blocks, %ld contacts; "
                 "%ld contacts began to slide within their step; position update %s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
                 fdm::ParticleVelocitySystem::solverName(solver_),
-                t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations, t.downdates,
+                t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations, t.downdates, t.backSubstitutions, t.coulombRoundsMax,
                 pairBlocks_, wallBlocks_, contacts_, t.contactSlides,
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");

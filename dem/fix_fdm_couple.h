@@ -73,9 +73,11 @@ class FixFdmCouple : public Fix {
     long contactSlides;            // contacts that began to slide within their step (Coulomb's law at its end)
     long factorisations;           // of Eq. (31) by the direct solvers: per step, and when the downdates grow too large
     long downdates;                // contacts that began to slide handled without a factorisation (Woodbury)
+    long backSubstitutions;        // of Eq. (31): one per Coulomb round of each solve
+    long coulombRoundsMax;         // the most rounds of one solve (100 stops the rounds where they stand)
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
                gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0),
-               contactSlides(0), factorisations(0), downdates(0) {}
+               contactSlides(0), factorisations(0), downdates(0), backSubstitutions(0), coulombRoundsMax(0) {}
   };
 
   void gather(std::vector<Particle> &particles);
@@ -121,7 +123,9 @@ class FixFdmCouple : public Fix {
   fdm::ParticleVelocitySystem::Solver solver_;  // of Eq. (31): cholmod (default), ldlt or cg
   long factorisationsCounted_ = 0;              // the system's factorisations already in run_
   long downdatesCounted_ = 0;                   // and its downdates
+  long backSubstitutionsCounted_ = 0;           // and its back-substitutions
   double tolerance_;         // relative residual of the conjugate-gradient solve
+  double coulombTolerance_ = fdm::ParticleVelocitySystem::Settings().coulombTolerance;  // of the Coulomb rounds
   class PairFdmSubgrid *pair_;  // the sub-grid / contact pair style, if that is the pair style
 
   int atomsAtInit_;                // atom count when init() checked the tags 1..N

@@ -2,6 +2,7 @@
 #include "contact_springs.h"
 #include "message_text.h"
 #include "particle_velocity_system.h"
+#include "andersonMixing.H"
 
 #include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
@@ -12,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 namespace fdm {
@@ -85,8 +87,12 @@ struct ParticleVelocitySystem::Matrices {
 
 ParticleVelocitySystem::ParticleVelocitySystem(const Settings &settings) :
   settings_(settings), n_(0), springGamma_(0), slidingSwitches_(0), pairRecord_(subgrid::pairRecord), wallRecord_(subgrid::wallRecord), pairBlocks_(0),
-  wallBlocks_(0), iterations_(0), factorisations_(0), downdates_(0), m_(new Matrices)
+  wallBlocks_(0), iterations_(0), factorisations_(0), downdates_(0), m_(new Matrices),
+  coulombMixing_(new AndersonMixing(coulombMixingDepth))
 {
+  if (!(settings_.coulombTolerance > 0 && settings_.coulombTolerance < 1))
+    throw Error(Error::notSolved, -1, "Eq. (31): the tolerance of Coulomb's law must be in (0, 1), got " +
+                                      number(settings_.coulombTolerance));
   if (!(settings_.alphaLambda > 0) || !(settings_.rhoFluid > 0) || !(settings_.tolerance > 0))
     throw Error(Error::notSolved, -1, "Eq. (31) needs a positive alpha_lambda (" + number(settings_.alphaLambda) +
                                       " s), fluid density (" + number(settings_.rhoFluid) + " kg/m3) and CG tolerance (" +
@@ -183,6 +189,7 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   springSlides_.assign(springRecords, 0);
   slideForce_.assign(3 * springRecords, 0.0);
   slideDirection_.assign(3 * springRecords, 0.0);
+  slideCap_.assign(springRecords, 0.0);
   slidingSwitches_ = 0;
   for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord) {
     const double *rec = &springPairs_[b];
@@ -382,12 +389,17 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
       u_[k] = u(k);
     }
   };
-  // Coulomb's law at the end of the step: solve, let the overloaded sticking contacts slide, solve
-  // again; a round only moves contacts from sticking to sliding or lowers their cap (docs/contact.md 2c)
+  // Coulomb's law at the end of the step: solve, let the overloaded sticking contacts slide and set
+  // the sliding ones' caps at the solution, solve again, until the caps settle (docs/contact.md 2c)
   iterations_ = 0;
-  const int maxCoulombRounds = 100;  // each round a back-substitution (a factorisation if contacts began to slide)
+  coulombMixing_->reset();  // a new right-hand side: a new map of the caps
+  lastCoulombResidual_ = HUGE_VAL;
+  rounds_ = 0;
+  const int maxCoulombRounds = 100;  // each round a back-substitution (a downdate if contacts began to slide)
   for (int round = 0;; round++) {
     solveLinear(rhs + m.springRhs + m.frictionRhs);
+    backSubstitutions_++;
+    rounds_++;
     if (round == maxCoulombRounds || !slideOverloadedContacts()) break;
   }
   return u_;
@@ -406,16 +418,20 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   // cap along the direction of the overloaded force. The cap is mu_s times the smaller of the normal
   // force at the start and at the end of the step (the implicit normal spring): friction never
   // exceeds what the contact holds at either end, and a contact that opens within the step loses it.
+  // The end's normal force depends on the velocities, which depend on the caps: the rounds are a
+  // fixed-point iteration x -> G(x) on the caps, Anderson-mixed while no contact begins to slide.
   Matrices &m = *m_;
   bool matrixChanged = false, rhsChanged = false;
   m.leaving.clear();
+  const size_t records = springSlides_.size();
+  std::vector<double> caps(records, 0.0), capBounds(records, 0.0);  // G(x) of the sliding contacts; mu_s F_n(start)
   auto setSlideForce = [&](size_t record, const double target[3], const double *ft, const int *base, int size,
                            const double *tail, bool wall) {
     double change[3], f[12];
     bool differs = false;
     for (int a = 0; a < 3; a++) {
       change[a] = target[a] - ft[a] - slideForce_[3 * record + a];
-      differs = differs || std::fabs(change[a]) > 1e-9 * (std::fabs(target[a]) + std::fabs(ft[a])) + 1e-300;
+      differs = differs || change[a] != 0;
     }
     if (!differs) return;
     for (int a = 0; a < 3; a++) slideForce_[3 * record + a] += change[a];
@@ -481,21 +497,56 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
       removeBlock(base, size, Rt);
       matrixChanged = true;
     }
-    double target[3];
-    for (int a = 0; a < 3; a++) target[a] = cap * slideDirection_[3 * record + a];
-    setSlideForce(record, target, ft, base, size, tail, wall);
+    caps[record] = cap;
+    capBounds[record] = mu * normalStart;
   };
-  size_t record = 0;
-  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
-    const double *rec = &springPairs_[b];
-    const int base[2] = {6 * tagIndex(rec[0]), 6 * tagIndex(rec[1])};
-    coulomb(record, rec + springs::pairFriction, base, 12, false);
+  // every spring record: fn(record, friction tail, the particles' first unknowns, 12 or 6, wall)
+  auto forEachSpring = [&](const std::function<void(size_t, const double *, const int *, int, bool)> &fn) {
+    size_t record = 0;
+    for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
+      const double *rec = &springPairs_[b];
+      const int base[2] = {6 * tagIndex(rec[0]), 6 * tagIndex(rec[1])};
+      fn(record, rec + springs::pairFriction, base, 12, false);
+    }
+    for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord, record++) {
+      const double *rec = &springWalls_[b];
+      const int base[1] = {6 * tagIndex(rec[0])};
+      fn(record, rec + springs::wallFriction, base, 6, true);
+    }
+  };
+  forEachSpring(coulomb);
+  // converged when no sliding contact's force at G(x) differs from its force at x (the caps of the
+  // last solve) by more than coulombTolerance of its size (and of its F_t at the start)
+  bool converged = !matrixChanged;
+  forEachSpring([&](size_t r, const double *tail, const int *, int, bool) {
+    if (!springSlides_[r] || !converged) return;
+    const double *ft = tail + 9;
+    for (int a = 0; a < 3; a++) {
+      const double next = caps[r] * slideDirection_[3 * r + a], now = slideCap_[r] * slideDirection_[3 * r + a];
+      if (std::fabs(next - now) > settings_.coulombTolerance * (std::fabs(next) + std::fabs(ft[a])) + 1e-300) converged = false;
+    }
+  });
+  if (converged) return false;
+  // the next caps: G(x), or its Anderson mixture with the last rounds' (kept within [0, mu_s F_n(start)]).
+  // The history restarts when a contact began to slide (its spring left the matrix: a new map) and
+  // when the caps moved more than in the round before (the clamps of G made the mixture overshoot)
+  double residual = 0;
+  for (size_t r = 0; r < records; r++) residual = std::max(residual, std::fabs(caps[r] - slideCap_[r]));
+  const bool restart = matrixChanged || !settings_.coulombAcceleration || !(residual < lastCoulombResidual_);
+  lastCoulombResidual_ = matrixChanged ? HUGE_VAL : residual;
+  if (restart) {
+    coulombMixing_->reset();
+    if (!matrixChanged && settings_.coulombAcceleration) coulombMixing_->mix(slideCap_.data(), caps.data(), records);
+  } else if (coulombMixing_->mix(slideCap_.data(), caps.data(), records)) {
+    for (size_t r = 0; r < records; r++) caps[r] = springSlides_[r] ? std::min(std::max(caps[r], 0.0), capBounds[r]) : 0.0;
   }
-  for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord, record++) {
-    const double *rec = &springWalls_[b];
-    const int base[1] = {6 * tagIndex(rec[0])};
-    coulomb(record, rec + springs::wallFriction, base, 6, true);
-  }
+  forEachSpring([&](size_t r, const double *tail, const int *base, int size, bool wall) {
+    if (!springSlides_[r]) return;
+    double target[3];
+    for (int a = 0; a < 3; a++) target[a] = caps[r] * slideDirection_[3 * r + a];
+    slideCap_[r] = caps[r];
+    setSlideForce(r, target, tail + 9, base, size, tail, wall);
+  });
   if (matrixChanged) downdateOrFactorise();
   return matrixChanged || rhsChanged;
 }

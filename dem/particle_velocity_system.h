@@ -71,6 +71,11 @@ class ParticleVelocitySystem {
     double rhoFluid = 0;               // [kg/m3]
     double gravity[3] = {0, 0, 0};     // [m/s2]
     bool stresslets = false;           // the block records carry their stress rows (subgrid::*StressRecord)
+    // Coulomb's law at the end of the step (docs/contact.md 2c) is solved by rounds, one
+    // back-substitution each, until no sliding contact's force changes by more than this fraction of
+    // its size (plus its F_t at the start); Anderson-mixed rounds unless coulombAcceleration is off
+    double coulombTolerance = 1e-6;
+    bool coulombAcceleration = true;
   };
 
   // What Eq. (32) needs of a particle besides the fluid; index = tag - 1.
@@ -147,6 +152,10 @@ class ParticleVelocitySystem {
   // Contacts that began to slide handled by a low-rank downdate of the step's factorisation instead
   // of a new one (Woodbury; CHOLMOD and LDLT): the number of such downdates since construction.
   long downdates() const { return downdates_; }
+  // Back-substitutions (or CG solves) since construction: one per Coulomb round of each solve().
+  long backSubstitutions() const { return backSubstitutions_; }
+  // The Coulomb rounds of the last solve (at most 100: it then stops where the rounds stand).
+  long lastRounds() const { return rounds_; }
 
   // After the last solve: F^SG, T^SG = -(R^SG u - wall term) (Eqs. 21, D.6), 6 per particle.
   std::vector<double> subgridForces() const;
@@ -193,13 +202,17 @@ class ParticleVelocitySystem {
   std::vector<char> springSlides_;     // per spring record (pairs, then walls): slides since this step's start
   std::vector<double> slideForce_;     // per spring record: capped force - F_t (3) of a contact that slides
   std::vector<double> slideDirection_; // per spring record: the direction of its sliding force (3)
+  std::vector<double> slideCap_;       // per spring record: the cap of a contact that slides, as in the last solve
   long slidingSwitches_;
   int pairRecord_, wallRecord_;
   long pairBlocks_, wallBlocks_;
   std::vector<RigidVolume> volumes_;   // of this step, for the messages
   std::vector<double> u_;              // the last solution: warm start of the next solve
-  long iterations_, factorisations_, downdates_;
+  long iterations_, factorisations_, downdates_, backSubstitutions_ = 0, rounds_ = 0;
+  double lastCoulombResidual_ = 0;     // the largest change of a cap in the last round of this solve
   std::unique_ptr<Matrices> m_;
+  static const int coulombMixingDepth = 10;              // differences kept: a solve takes 5-20 rounds
+  std::unique_ptr<class AndersonMixing> coulombMixing_;  // of the caps over the Coulomb rounds of one solve
 };
 
 }  // namespace fdm

@@ -96,6 +96,11 @@ def test_dense_packing_in_shear(tmp_path, env, solver, tol):
         assert r["iterations"].max() < 0.95 * CG_CAP, (np.median(r["iterations"]), r["iterations"].max())
     else:
         assert r["iterations"].max() == 1
+    # the run-end line is read whole: one solve per step without the fluid, each at least one
+    # back-substitution (one per Coulomb round), no solve stopped at the 100-round cap
+    t = r["timing"]
+    assert t is not None and t["solves"] == scene.steps, t
+    assert t["back_substitutions"] >= t["solves"] and t["coulomb_rounds_max"] < 100, t
 
 
 @pytest.mark.full

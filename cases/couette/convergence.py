@@ -3,7 +3,7 @@
 steps and two mesh sizes, the rheology of each with its error bar and its cost.
 
 Every run is couette.py with the same packing (same box, phi_bulk and seed: the packing does not
-depend on dt or a1/Delta) and its own springs from the docs/contact.md recipe (k_t depends on dt).
+depend on dt or a1/Delta) and the springs of the docs/contact.md recipe (k_t = k_n, whatever dt).
 A run whose results file exists is not run again, so the study can be stopped and continued.
 
   convergence.py                      dt in {0.04, 0.02, 0.01} at a1/Delta = 3, dt 0.02 at 4, and

@@ -413,6 +413,14 @@ TEST(FdmDEMErrors, UnknownKeyword)
     expectFailure("keyword", scene, nullptr, "fix fdm/couple: unknown keyword gravitation", false);
 }
 
+TEST(FdmDEMErrors, CoulombToleranceOutOfRange)
+{
+    Scene scene;
+    scene.fixOptions = "coulomb_tolerance 2";
+    expectFailure("coulomb-tolerance", scene, nullptr,
+                  "fix fdm/couple: coulomb_tolerance (of the sliding contacts' forces) must be in (0, 1), got 2", false);
+}
+
 TEST(FdmDEMErrors, FixOutputBadInput)
 {
     // fix fdm/output (fix_fdm_output.h): the keywords, checked when the fix is defined

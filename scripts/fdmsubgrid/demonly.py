@@ -128,7 +128,9 @@ def fdmdem() -> str:
 
 TIMING = re.compile(r"fdm/couple timing of this run \((\d+) runs?, (\d+) steps, ([0-9.eE+-]+) s\): particle solve "
                     r"([0-9.eE+-]+) s .*?gather/scatter ([0-9.eE+-]+) s.*?Eq\. 31: (\d+) solves, (\w+) iterations "
-                    r"mean ([0-9.eE+-]+|nan) max (\d+); last step (\d+) sub-grid pair blocks, (\d+) wall blocks, "
+                    r"mean ([0-9.eE+-]+|nan) max (\d+)(?:, (\d+) factorisations, (\d+) low-rank downdates)?"
+                    r"(?:, (\d+) back-substitutions \(Coulomb rounds, at most (\d+) in a solve\))?; "
+                    r"last step (\d+) sub-grid pair blocks, (\d+) wall blocks, "
                     r"(\d+) contacts(?:; (\d+) contacts began to slide within their step)?")
 
 
@@ -138,10 +140,12 @@ def parse_timing(text):
     if not found:
         return None
     g = found[-1]
+    optional = lambda v: int(v) if v else None  # noqa: E731 (fields older binaries did not write)
     return dict(steps=int(g[1]), wall=float(g[2]), particle_solve=float(g[3]), gather_scatter=float(g[4]),
                 solves=int(g[5]), solver=g[6], iterations_mean=float(g[7]), iterations_max=int(g[8]),
-                pair_blocks=int(g[9]), wall_blocks=int(g[10]), contacts=int(g[11]),
-                contact_slides=int(g[12]) if g[12] else None)
+                factorisations=optional(g[9]), downdates=optional(g[10]), back_substitutions=optional(g[11]),
+                coulomb_rounds_max=optional(g[12]), pair_blocks=int(g[13]), wall_blocks=int(g[14]),
+                contacts=int(g[15]), contact_slides=optional(g[16]))
 
 
 def parse_thermo(text):
