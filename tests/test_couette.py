@@ -368,11 +368,14 @@ def test_time_step_beyond_the_measured_limit_is_warned(couette):
     assert couette.time_step_warning(0.47, 0.02) is None
     assert couette.time_step_warning(0.27, 0.1) is None
     assert couette.time_step_warning(0.3032, 0.04) is None     # the run time against error scene
+    assert couette.time_step_warning(0.3687, 0.04) is None     # the Table 8 row of phi_bulk 0.37
+    message = couette.time_step_warning(0.3751, 0.08)          # the time-step study's scene at 0.37
+    assert "phi_bulk 0.37" in message and "0.04" in message, message
     message = couette.time_step_warning(0.47, 0.05)
     assert "dt = 0.05" in message and "phi_bulk 0.47" in message and "0.02" in message and "viscosity" in message
     # between two measured rows the denser row's limit applies; beyond the densest, said so
     assert "0.08" in couette.time_step_warning(0.29, 0.09)
-    assert "0.02" in couette.time_step_warning(0.37, 0.04)
+    assert "0.02" in couette.time_step_warning(0.42, 0.04)
     assert "denser than any measured" in couette.time_step_warning(0.54, 0.15)
 
 
