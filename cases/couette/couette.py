@@ -64,8 +64,8 @@ TABLE8 = {
 # rule is k_t = k_n (Coulomb's law at the end of the step, docs/contact.md 2c) 0.47 was measured
 # again: dt 0.05 gives eta_s 28.7 +- 4.0 against 43.0 +- 6.4 at 0.02, and dt 0.1 stopped at step 6
 # with two spheres overlapping (docs/benchmarks.md, "Coulomb's law at the end of the step"). 0.37 from
-# the time-step study with k_t = k_n (12 strain units of 10 x 16 x 8 a1, 2026-11-27): eta_s at dt 0.04,
-# 0.02, 0.01 within two error bars, at 0.08 25 % lower with less contact stress (docs/benchmarks.md,
+# the time-step study with k_t = k_n (12 strain units of 10 x 16 x 8 a1, two seeds, 2026-11-27): eta_s at
+# dt 0.04 within one error bar of dt 0.01, at 0.08 22 % lower with less contact stress (docs/benchmarks.md,
 # "The time step at phi 0.37").
 MEASURED_DT_LIMITS = {0.27: 0.1, 0.30: 0.08, 0.37: 0.04, 0.47: 0.02}
 
