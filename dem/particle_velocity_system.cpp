@@ -425,6 +425,7 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   m.leaving.clear();
   const size_t records = springSlides_.size();
   std::vector<double> caps(records, 0.0), capBounds(records, 0.0);  // G(x) of the sliding contacts; mu_s F_n(start)
+  bool converged = true;
   auto setSlideForce = [&](size_t record, const double target[3], const double *ft, const int *base, int size,
                            const double *tail, bool wall) {
     double change[3], f[12];
@@ -499,6 +500,12 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     }
     caps[record] = cap;
     capBounds[record] = mu * normalStart;
+    // converged while no sliding contact's force at G(x) differs from its force at x (the cap of the
+    // last solve) by more than coulombTolerance of its size (and of its F_t at the start)
+    for (int a = 0; a < 3; a++) {
+      const double next = cap * slideDirection_[3 * record + a], now = slideCap_[record] * slideDirection_[3 * record + a];
+      if (std::fabs(next - now) > settings_.coulombTolerance * (std::fabs(next) + std::fabs(ft[a])) + 1e-300) converged = false;
+    }
   };
   // every spring record: fn(record, friction tail, the particles' first unknowns, 12 or 6, wall)
   auto forEachSpring = [&](const std::function<void(size_t, const double *, const int *, int, bool)> &fn) {
@@ -515,18 +522,7 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     }
   };
   forEachSpring(coulomb);
-  // converged when no sliding contact's force at G(x) differs from its force at x (the caps of the
-  // last solve) by more than coulombTolerance of its size (and of its F_t at the start)
-  bool converged = !matrixChanged;
-  forEachSpring([&](size_t r, const double *tail, const int *, int, bool) {
-    if (!springSlides_[r] || !converged) return;
-    const double *ft = tail + 9;
-    for (int a = 0; a < 3; a++) {
-      const double next = caps[r] * slideDirection_[3 * r + a], now = slideCap_[r] * slideDirection_[3 * r + a];
-      if (std::fabs(next - now) > settings_.coulombTolerance * (std::fabs(next) + std::fabs(ft[a])) + 1e-300) converged = false;
-    }
-  });
-  if (converged) return false;
+  if (converged && !matrixChanged) return false;
   // the next caps: G(x), or its Anderson mixture with the last rounds' (kept within [0, mu_s F_n(start)]).
   // The history restarts when a contact began to slide (its spring left the matrix: a new map) and
   // when the caps moved more than in the round before (the clamps of G made the mixture overshoot)

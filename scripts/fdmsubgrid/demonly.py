@@ -140,7 +140,10 @@ def parse_timing(text):
     if not found:
         return None
     g = found[-1]
-    optional = lambda v: int(v) if v else None  # noqa: E731 (fields older binaries did not write)
+
+    def optional(v: str) -> int | None:  # a field older binaries did not write
+        return int(v) if v else None
+
     return dict(steps=int(g[1]), wall=float(g[2]), particle_solve=float(g[3]), gather_scatter=float(g[4]),
                 solves=int(g[5]), solver=g[6], iterations_mean=float(g[7]), iterations_max=int(g[8]),
                 factorisations=optional(g[9]), downdates=optional(g[10]), back_substitutions=optional(g[11]),
