@@ -135,6 +135,11 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       if (!(tolerance_ > 0 && tolerance_ < 1))
         error->all(FLERR, "fix fdm/couple: tolerance (relative residual of Eq. 31) must be in (0, 1)");
       i++;
+    } else if (key == "contact_chord") {
+      const std::string v = value(1);
+      if (v != "yes" && v != "no") error->all(FLERR, "fix fdm/couple: contact_chord must be yes or no");
+      contactChord_ = (v == "yes");
+      i++;
     } else if (key == "coulomb_tolerance") {
       coulombTolerance_ = force->numeric(FLERR, value(1));
       if (!(coulombTolerance_ > 0 && coulombTolerance_ < 1))
@@ -535,6 +540,12 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
       springs.gamma = 1.0 / 3.0;
       springs.previous = currentVelocity_;
     }
+    // Eq. (C5): the straight step's chord of a sliding or rolling pair, in its normal spring, from
+    // U_n (kept in the checkpoints: a resumed run takes the same chord terms)
+    if (contactChord_ && haveVelocities_ && currentVelocity_.size() == size_t(6) * natoms_) {
+      springs.dt = update->dt;
+      springs.previous = currentVelocity_;
+    }
   }
   if (!wallFile_.empty()) {
     // the wall of each block, gathered in the same rank order as the blocks; the contact loads summed
@@ -658,6 +669,7 @@ void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
   // when asked, the particle stresslets: S^h = S^FDM + S^SG, s^h = s^FDM + s^SG (Eq. 13), S^c (Eq. 52).
   subgrid_ = system_->subgridForces();
   run_.contactSlides += system_->slidingSwitches();
+  run_.chordForceMax = std::max(run_.chordForceMax, system_->largestChordForce());
   run_.factorisations += system_->factorisations() - factorisationsCounted_;
   factorisationsCounted_ = system_->factorisations();
   run_.downdates += system_->downdates() - downdatesCounted_;
@@ -1053,18 +1065,24 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
                   t.gapSweepsMax, t.gapLimited, t.gapFallbacks, t.gapBoundWorst);
     gapStats = g;
   }
-  char line[1400];
+  std::string chordStats;
+  if (contactChord_ && pair_ && pair_->implicitContact()) {
+    char c[120];
+    std::snprintf(c, sizeof c, ", pair springs' chord terms up to %.3g N", t.chordForceMax);
+    chordStats = c;
+  }
+  char line[1500];
   std::snprintf(line, sizeof line,
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
                 "%s iterations mean %.1f max %ld, %ld factorisations, %ld low-rank downdates, %ld back-substitutions (Coulomb rounds, at most %ld in a solve); last step %ld sub-grid pair blocks, %ld wall "
                 "blocks, %ld contacts; "
-                "%ld contacts began to slide within their step; position update %s%s%s\n",
+                "%ld contacts began to slide within their step%s; position update %s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
                 fdm::ParticleVelocitySystem::solverName(solver_),
                 t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations, t.downdates, t.backSubstitutions, t.coulombRoundsMax,
-                pairBlocks_, wallBlocks_, contacts_, t.contactSlides,
+                pairBlocks_, wallBlocks_, contacts_, t.contactSlides, chordStats.c_str(),
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");
   if (screen) fputs(line, screen);

@@ -75,9 +75,11 @@ class FixFdmCouple : public Fix {
     long downdates;                // contacts that began to slide handled without a factorisation (Woodbury)
     long backSubstitutions;        // of Eq. (31): one per Coulomb round of each solve
     long coulombRoundsMax;         // the most rounds of one solve (100 stops the rounds where they stand)
+    double chordForceMax;          // the largest chord term of a pair spring (Eq. C5 of docs/contact.md) [N]
     Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
                gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0),
-               contactSlides(0), factorisations(0), downdates(0), backSubstitutions(0), coulombRoundsMax(0) {}
+               contactSlides(0), factorisations(0), downdates(0), backSubstitutions(0), coulombRoundsMax(0),
+               chordForceMax(0) {}
   };
 
   void gather(std::vector<Particle> &particles);
@@ -126,6 +128,7 @@ class FixFdmCouple : public Fix {
   long backSubstitutionsCounted_ = 0;           // and its back-substitutions
   double tolerance_;         // relative residual of the conjugate-gradient solve
   double coulombTolerance_ = fdm::ParticleVelocitySystem::Settings().coulombTolerance;  // of the Coulomb rounds
+  bool contactChord_ = true;          // the chord term of the pair springs (Eq. C5 of docs/contact.md)
   class PairFdmSubgrid *pair_;  // the sub-grid / contact pair style, if that is the pair style
 
   int atomsAtInit_;                // atom count when init() checked the tags 1..N

@@ -45,6 +45,7 @@ struct ParticleVelocitySystem::Matrices {
   Eigen::VectorXd springRhs;            // known part of the implicit springs: gamma R_c U_n + dt B^T K U_w (Eq. C2)
   Eigen::VectorXd frictionRhs;          // what the contacts that slide within the step change in F^tot:
                                         // B^T (capped force - F_t), less a wall spring's tangential wall term
+  Eigen::VectorXd chordRhs;             // the pair springs' chord term (Eq. C5), from U_n, once per step
   std::vector<double> rigidBlock;       // per particle, 36: (rho_f/rho_p) J/alpha_lambda of this step
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                            Eigen::DiagonalPreconditioner<double> > cg;  // Jacobi
@@ -132,12 +133,13 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   springWalls_.swap(springs.walls);
   springPrevious_.swap(springs.previous);
   springGamma_ = springs.gamma;
+  springDt_ = springs.dt;
   if (springPairs_.size() % springs::pairRecord != 0 || springWalls_.size() % springs::wallRecord != 0)
     throw Error(Error::badBlock, -1, "pair fdm/subgrid sent " + std::to_string(springPairs_.size()) + " pair and " +
                                      std::to_string(springWalls_.size()) + " wall contact-spring values, not whole "
                                      "records of " + std::to_string(springs::pairRecord) + " and " +
                                      std::to_string(springs::wallRecord));
-  if (springGamma_ != 0 && springPrevious_.size() != size_t(6) * N)
+  if ((springGamma_ != 0 || springDt_ > 0) && springPrevious_.size() != size_t(6) * N)
     throw Error(Error::badBlock, -1, "the implicit contact springs need U_n of " + std::to_string(N) +
                                      " particles, got " + std::to_string(springPrevious_.size()) + " values");
   if (pairs_.size() % pairRecord_ != 0 || walls_.size() % wallRecord_ != 0)
@@ -185,6 +187,9 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   // the implicit contact springs (Eqs. C2, C3): R_c into the matrix, gamma R_c U_n + wall term into F^tot
   m.springRhs = Eigen::VectorXd::Zero(6 * N);
   m.frictionRhs = Eigen::VectorXd::Zero(6 * N);
+  m.chordRhs = Eigen::VectorXd::Zero(6 * N);
+  chordForce_.assign(springPairs_.size() / springs::pairRecord, 0.0);
+  largestChordForce_ = 0;
   const size_t springRecords = springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord;
   springSlides_.assign(springRecords, 0);
   slideForce_.assign(3 * springRecords, 0.0);
@@ -240,6 +245,7 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   m.rigidBlock.assign(size_t(36) * N, 0.0);
   m.analysed = false;
   m.ready = false;
+  setChordForces();  // Eq. (C5), from U_n (the last solution) for the whole step
 }
 
 void ParticleVelocitySystem::setVolumes(const std::vector<double> &Vu, const std::vector<double> &Ju)
@@ -397,12 +403,52 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
   rounds_ = 0;
   const int maxCoulombRounds = 100;  // each round a back-substitution (a downdate if contacts began to slide)
   for (int round = 0;; round++) {
-    solveLinear(rhs + m.springRhs + m.frictionRhs);
+    solveLinear(rhs + m.springRhs + m.frictionRhs + m.chordRhs);
     backSubstitutions_++;
     rounds_++;
     if (round == maxCoulombRounds || !slideOverloadedContacts()) break;
   }
   return u_;
+}
+
+void ParticleVelocitySystem::setChordForces()
+{
+  // Eq. (C5) of docs/contact.md. The next position update moves the centres of a pair in contact by
+  // dt rho_c, rho_c = c1 (U_i - U_j)_{n+1} + c0 (U_i - U_j)_n, and the straight step opens the gap by
+  // its normal part and, to second order, by the chord dt^2 |rho_c,t|^2/(2r) of the tangential part
+  // (r = l_i + l_j). The implicit normal spring (C2) sees the normal part only; at
+  // a large dt the chord is as large as the few per cent of h_r by which a stiff spring holds its
+  // gap below h_r (docs/benchmarks.md, "Where the contacts go at dt 0.08"), and the explicit force of
+  // the next step lost k_n times it: contacts broke. The force the spring will lose, k_n times the
+  // chord, enters F^tot (pulling the pair together along n), estimated from U_n (rho_c = (U_i - U_j)_n,
+  // the rate of a steady slide) and kept for the step. Not from the step's own solution:
+  // the chord depends on the tangential velocities, which the normal forces move, with a gain of
+  // k_n dt^2 |rho_t|/(r zeta) >> 1 at a large dt (iterating it diverged).
+  Matrices &m = *m_;
+  m.chordRhs.setZero();
+  largestChordForce_ = 0;
+  if (!(springDt_ > 0)) return;
+  const double c1 = 1.0 / (1.0 - springGamma_);
+  size_t record = 0;
+  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
+    const double *rec = &springPairs_[b], *tail = rec + springs::pairFriction;
+    const int base[2] = {6 * tagIndex(rec[0]), 6 * tagIndex(rec[1])};
+    const double *n = tail, r = tail[3] + tail[4], knc1dt = tail[8];
+    double rho[3], normal = 0, tangential2 = 0;
+    for (int a = 0; a < 3; a++) {
+      rho[a] = springPrevious_[size_t(base[0] + a)] - springPrevious_[size_t(base[1] + a)];  // U_n
+      normal += n[a] * rho[a];
+    }
+    for (int a = 0; a < 3; a++) tangential2 += (rho[a] - normal * n[a]) * (rho[a] - normal * n[a]);
+    // k_n dt^2 |rho_t|^2/(2r) with k_n = knc1dt/(c1 dt)
+    const double force = r > 0 ? knc1dt * springDt_ * tangential2 / (2 * c1 * r) : 0.0;
+    chordForce_[record] = force;
+    largestChordForce_ = std::max(largestChordForce_, force);
+    for (int a = 0; a < 3; a++) {  // on i along -n (towards j), on j along +n
+      m.chordRhs(base[0] + a) -= force * n[a];
+      m.chordRhs(base[1] + a) += force * n[a];
+    }
+  }
 }
 
 double ParticleVelocitySystem::springVelocity(int k) const
@@ -476,7 +522,9 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     double w[12], end[3];
     for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
     const double rel[3] = {w[0] - (wall ? 0.0 : w[6]), w[1] - (wall ? 0.0 : w[7]), w[2] - (wall ? 0.0 : w[8])};
-    const double normalEnd = std::max(0.0, normalStart - knc1dt * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]));
+    const double chord = wall ? 0.0 : chordForce_[record];  // Eq. (C5): pairs only
+    const double normalEnd =
+        std::max(0.0, normalStart - knc1dt * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]) - chord);
     const double cap = mu * std::min(normalStart, normalEnd);
     if (!springSlides_[record]) {  // sticking: does its implicit force stay under the cap?
       if (wall)
@@ -610,7 +658,7 @@ std::vector<double> ParticleVelocitySystem::subgridForces() const
   Eigen::VectorXd forces = m.wallRhs - m.matrix * u + Eigen::Map<const Eigen::VectorXd>(rigid.data(), 6 * n_);
   // less the implicit springs' part of the matrix (contact forces, not sub-grid ones)
   const std::vector<double> springs = springForces();
-  for (int k = 0; k < 6 * n_; k++) forces(k) -= springs[size_t(k)] - m.springRhs(k) - m.frictionRhs(k);
+  for (int k = 0; k < 6 * n_; k++) forces(k) -= springs[size_t(k)] - m.springRhs(k) - m.frictionRhs(k) - m.chordRhs(k);
   return std::vector<double>(forces.data(), forces.data() + forces.size());
 }
 
@@ -644,6 +692,7 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     for (int k = 0; k < 12; k++) w[k] = springVelocity(6 * p[k / 6] + k % 6);
     for (int i = 0; i < 12; i++) {
       f[i] = slid[i];
+      if (i % 6 < 3) f[i] += (i < 6 ? -1.0 : 1.0) * chordForce_[record] * tail[i % 6];  // Eq. (C5)
       for (int j = 0; j < 12; j++) f[i] -= (R[12 * i + j] - (slides ? Rt[12 * i + j] : 0.0)) * w[j];
       out[size_t(6) * p[i / 6] + i % 6] += f[i];
     }

@@ -108,8 +108,12 @@ class ParticleVelocitySystem {
   // above) and U_n with its weight gamma (1/3 with ab2, 0 with euler) in the known part.
   struct Springs {
     std::vector<double> pairs, walls;
-    std::vector<double> previous;      // 6N: U_n by tag (may be empty if gamma = 0)
+    std::vector<double> previous;      // 6N: U_n by tag (may be empty if gamma = 0 and dt = 0)
     double gamma = 0;
+    // the time step, for the chord term of the pair springs (Eq. C5 of docs/contact.md: the straight
+    // step opens a sliding or rolling pair by dt^2 |rho_t|^2/(2r), estimated from U_n = previous);
+    // 0 leaves it out
+    double dt = 0;
   };
 
   // Once per time step: the particles and R^SG from the gathered block records (layouts above),
@@ -175,6 +179,8 @@ class ParticleVelocitySystem {
   // Contacts that stuck at the start of the step and slide within it (Coulomb's law at the end of
   // the step, docs/contact.md 2c), counted since the last assemble().
   long slidingSwitches() const { return slidingSwitches_; }
+  // The chord terms of this step (Eq. C5): the largest k_n dt^2 |rho_t|^2/(2r) of a pair spring [N]
+  double largestChordForce() const { return largestChordForce_; }
   long springBlocks() const { return long(springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord); }
 
  private:
@@ -190,6 +196,9 @@ class ParticleVelocitySystem {
   // The tangential spring blocks that left the matrix (columns of V, R_t = V V^T): a low-rank
   // downdate of the factorisation (Woodbury), or a new factorisation once the downdate grows large.
   void downdateOrFactorise();
+  // The chord term of each pair spring (Eq. C5 of docs/contact.md) from U_n (Springs::previous), into
+  // F^tot, once per step (assemble).
+  void setChordForces();
   double springVelocity(int k) const;  // u - gamma U_n, the unknowns' part of the contact displacement
 
   struct Matrices;                     // Eigen's, in the .cpp
@@ -199,6 +208,9 @@ class ParticleVelocitySystem {
   std::vector<double> pairs_, walls_;  // the block records of this step
   std::vector<double> springPairs_, springWalls_, springPrevious_;  // implicit contact springs of this step
   double springGamma_;
+  double springDt_ = 0;                // the step's dt for the chord term (0: none)
+  std::vector<double> chordForce_;     // per pair spring record: k_n times its chord (Eq. C5), set by assemble()
+  double largestChordForce_ = 0;
   std::vector<char> springSlides_;     // per spring record (pairs, then walls): slides since this step's start
   std::vector<double> slideForce_;     // per spring record: capped force - F_t (3) of a contact that slides
   std::vector<double> slideDirection_; // per spring record: the direction of its sliding force (3)

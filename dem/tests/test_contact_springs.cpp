@@ -2,7 +2,8 @@
 // of their place in Eq. (31) (particle_velocity_system.h): symmetric positive semi-definite,
 // frame-invariant, no force for a rigid motion of the pair, the block times u equal to the spring
 // force of the contact points' relative velocity as the contact law has it, and the overdamped
-// spring stepped through Eq. (31) decaying by the factor of Eq. (C4) at any dt.
+// spring stepped through Eq. (31) decaying by the factor of Eq. (C4) at any dt; the chord term of
+// Eq. (C5) keeping a sliding pair's straight step where its spring assumed it.
 #include "contact_springs.h"
 #include "particle_velocity_system.h"
 
@@ -587,5 +588,90 @@ TEST(ContactSprings, CoulombRoundsAreAcceleratedToTheSameAnswer)
     EXPECT_LT(accelerated.backSubstitutions(), plain.backSubstitutions()) << seed;
     EXPECT_LE(loose.backSubstitutions(), accelerated.backSubstitutions()) << seed;
     EXPECT_EQ(loose.lastRounds(), loose.backSubstitutions()) << seed;  // one solve
+  }
+}
+
+namespace {
+
+// Two unit spheres in contact along x (sphere 2 at +x, gap h < h_r), pressed together by P and
+// sliding past each other: F on sphere 2 along y (frictionless contact: kt = 0, the normal spring
+// implicit), Stokes drag zeta. The step of fix fdm/couple with the given integrator weights, taken
+// `steps` times from the same positions (a steady slide: U_n is the last step's solution, from which
+// the chord term (C5) is estimated): the spring's explicit force at the start in the loads, Eq. (31)
+// with the spring blocks. Keeps the last velocities and, in `gapAfter`, the gap the straight step
+// x + dt (c1 U_{n+1} + c0 U_n) gives.
+struct SlidingPair {
+  double kn = 1e4, hr = 5e-3, h = 4e-3, P = 5, F = 10, zeta = 10, dt = 0.1;
+  std::vector<double> u, previous;
+  double springEnd = 0;   // the normal force on sphere 2 at the end of the step the solve applied
+  double gapAfter = 0;
+  SlidingPair(bool chord, bool ab2, int steps)
+  {
+    ParticleVelocitySystem::Settings settings;
+    settings.alphaLambda = 1;
+    settings.rhoFluid = 1;
+    ParticleVelocitySystem system(settings);
+    const double c1 = ab2 ? 1.5 : 1.0, gamma = ab2 ? 1.0 / 3.0 : 0.0;
+    const double lever = 1 + h / 2, start = kn * (hr - h);
+    std::vector<ParticleVelocitySystem::Particle> particles(2);
+    for (int p = 0; p < 2; p++) {
+      particles[p].radius = 1;
+      particles[p].mass = particles[p].density = 1;
+    }
+    particles[0].x[0] = 0;
+    particles[1].x[0] = 2 + h;
+    particles[0].force[0] = P - start;   // the spring pushes 1 to -x, 2 to +x
+    particles[1].force[0] = -P + start;
+    particles[1].force[1] = F;
+    const double n[3] = {-1, 0, 0};      // from 2 to 1
+    double R[144];
+    contact::pairSpringBlock(n, lever, lever, kn, 0, c1 * dt, R);
+    u.assign(12, 0.0);
+    for (int step = 0; step < steps; step++) {
+      previous = u;
+      ParticleVelocitySystem::Springs s;
+      s.pairs = {1, 2};
+      s.pairs.insert(s.pairs.end(), R, R + 144);
+      s.pairs.insert(s.pairs.end(), {2 + h, 0, 0, 0.5});
+      s.pairs.insert(s.pairs.end(), {n[0], n[1], n[2], lever, lever, 0, 0, start, kn * c1 * dt, 0, 0, 0});
+      s.gamma = gamma;
+      s.previous = previous;
+      s.dt = chord ? dt : 0.0;
+      system.assemble(particles, {}, {}, s);
+      system.setVolumes({zeta, zeta}, {zeta, zeta});
+      u = system.solve(std::vector<double>(12, 0.0));
+    }
+    // the straight step of the next position update
+    double x[2][3] = {{0, 0, 0}, {2 + h, 0, 0}};
+    for (int p = 0; p < 2; p++)
+      for (int a = 0; a < 3; a++) x[p][a] += dt * (c1 * u[6 * p + a] - c1 * gamma * previous[6 * p + a]);
+    gapAfter = std::sqrt(std::pow(x[1][0] - x[0][0], 2) + std::pow(x[1][1] - x[0][1], 2) +
+                         std::pow(x[1][2] - x[0][2], 2)) - 2;
+    // the force on sphere 2 along +x at the end of the step, as the solve applied it
+    springEnd = start + system.springForces()[6];
+  }
+};
+
+}  // namespace
+
+TEST(ContactSprings, ChordTermKeepsTheStraightStepWhereTheSpringAssumedIt)
+{
+  // Eq. (C5): a pair sliding by dt |rho_t| of about 0.1 a per step opens by the chord
+  // dt^2 |rho_t|^2/(2r) of 2.5e-3 a in a straight step, half of h_r. Without the chord term the explicit
+  // force of the next step, k_n (h_r - h_{n+1}), falls short of the force the implicit spring
+  // applied by k_n times the chord (here more than the spring's whole force: the contact breaks);
+  // with it the two agree to the chord's own second order, and the gap stays in contact
+  for (bool ab2 : {false, true}) {
+    const SlidingPair without(false, ab2, 4), with(true, ab2, 4);
+    const double chord = std::hypot(2.004, with.dt * (with.u[7] - with.u[1])) - 2.004;  // a steady slide
+    ASSERT_GT(chord, 1e-3) << "ab2 " << ab2;
+    const double nextWithout = without.kn * (without.hr - without.gapAfter);
+    const double nextWith = with.kn * (with.hr - with.gapAfter);
+    EXPECT_GT(std::fabs(nextWithout - without.springEnd), 0.9 * without.kn * chord) << "ab2 " << ab2;
+    EXPECT_GT(without.gapAfter, without.hr) << "ab2 " << ab2 << ": the contact breaks without the chord term";
+    EXPECT_LT(std::fabs(nextWith - with.springEnd), 0.02 * with.kn * chord) << "ab2 " << ab2;
+    EXPECT_LT(with.gapAfter, with.hr) << "ab2 " << ab2 << ": the contact holds with it";
+    // the pressing load is carried at the end of the step: the spring force balances P
+    EXPECT_NEAR(with.springEnd, with.P, 0.02 * with.P) << "ab2 " << ab2;
   }
 }

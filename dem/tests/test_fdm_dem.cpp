@@ -421,6 +421,13 @@ TEST(FdmDEMErrors, CoulombToleranceOutOfRange)
                   "fix fdm/couple: coulomb_tolerance (of the sliding contacts' forces) must be in (0, 1), got 2", false);
 }
 
+TEST(FdmDEMErrors, ContactChordNotYesOrNo)
+{
+    Scene scene;
+    scene.fixOptions = "contact_chord maybe";
+    expectFailure("contact-chord", scene, nullptr, "fix fdm/couple: contact_chord must be yes or no", false);
+}
+
 TEST(FdmDEMErrors, FixOutputBadInput)
 {
     // fix fdm/output (fix_fdm_output.h): the keywords, checked when the fix is defined
