@@ -536,16 +536,12 @@ void FixFdmCouple::assembleSystem(const std::vector<Particle> &particles)
     springs.pairs = fdm::gatherToRoot(springPairs, world);
     springs.walls = fdm::gatherToRoot(springWalls, world);
     if (!wallFile_.empty()) springWallBlockWall_ = fdm::gatherToRoot(springWallIndex, world);
-    if (multistep) {
-      springs.gamma = 1.0 / 3.0;
-      springs.previous = currentVelocity_;
-    }
     // Eq. (C5): the straight step's chord of a sliding or rolling pair, in its normal spring, from
     // U_n (kept in the checkpoints: a resumed run takes the same chord terms)
-    if (contactChord_ && haveVelocities_ && currentVelocity_.size() == size_t(6) * natoms_) {
-      springs.dt = update->dt;
-      springs.previous = currentVelocity_;
-    }
+    const bool chord = contactChord_ && haveVelocities_ && currentVelocity_.size() == size_t(6) * natoms_;
+    if (multistep) springs.gamma = 1.0 / 3.0;
+    if (chord) springs.dt = update->dt;
+    if (multistep || chord) springs.previous = currentVelocity_;
   }
   if (!wallFile_.empty()) {
     // the wall of each block, gathered in the same rank order as the blocks; the contact loads summed

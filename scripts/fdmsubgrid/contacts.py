@@ -24,8 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import cKDTree
 
+from . import packing
 from .output import ParticleRecords, read_particle_records
 
 
@@ -38,39 +38,25 @@ def _period(records: ParticleRecords) -> NDArray:
 
 
 def _minimum_image(d: NDArray, period: NDArray) -> NDArray:
-    """Separations d (..., 3) brought to their nearest periodic image."""
-    d = np.array(d, dtype=float)
-    for k in range(3):
-        if period[k] > 0:
-            d[..., k] -= period[k] * np.round(d[..., k] / period[k])
-    return d
+    """Separations d (..., 3) brought to their nearest periodic image (period 0: not periodic)."""
+    return packing._minimum_image(np.asarray(d, dtype=float), np.where(period > 0, period, 1.0), period > 0)
 
 
 def close_pairs(x: NDArray, radii: NDArray, period: NDArray, max_gap: float) -> tuple[NDArray, NDArray]:
     """Index pairs (m, 2) with i < j whose surface gap is below max_gap, and their gaps (m,).
 
-    x: (N, 3) positions, radii (N,), period: box lengths of the periodic directions (0: none)."""
+    x: (N, 3) positions, radii (N,), period: box lengths of the periodic directions (0: none).
+    The neighbours are those of packing.neighbour_pairs (scipy's periodic KD-tree)."""
     x = np.asarray(x, dtype=float)
     radii = np.asarray(radii, dtype=float)
     if len(x) < 2:
         return np.zeros((0, 2), dtype=int), np.zeros(0)
-    # scipy's periodic KD-tree wants coordinates in [0, L) and a box size per direction
-    shifted = x - x.min(axis=0)
-    box = np.where(period > 0, period, 0.0)
-    for k in range(3):
-        if period[k] > 0:
-            shifted[:, k] = np.mod(x[:, k], period[k])
-        else:
-            box[k] = shifted[:, k].max() + 2 * radii.max() + max_gap + 1.0   # no wrap
-    tree = cKDTree(shifted, boxsize=box)
-    pairs = tree.query_pairs(2 * radii.max() + max_gap, output_type="ndarray")
-    if len(pairs) == 0:
-        return np.zeros((0, 2), dtype=int), np.zeros(0)
-    pairs = np.sort(pairs, axis=1)
-    d = _minimum_image(x[pairs[:, 1]] - x[pairs[:, 0]], period)
-    gaps = np.linalg.norm(d, axis=1) - radii[pairs[:, 0]] - radii[pairs[:, 1]]
+    walls = tuple(k for k in range(3) if not period[k] > 0)
+    i, j, distance = packing.neighbour_pairs(x, np.where(period > 0, period, 1.0),
+                                             2 * radii.max() + max_gap, walls)
+    gaps = distance - radii[i] - radii[j]
     keep = gaps < max_gap
-    return pairs[keep], gaps[keep]
+    return np.stack([i, j], axis=1)[keep], gaps[keep]
 
 
 def contact_set(x: NDArray, radii: NDArray, period: NDArray, roughness: float) -> set:
