@@ -13,7 +13,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <sstream>
 
 namespace fdm {
@@ -411,6 +410,22 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
   return u_;
 }
 
+template <class Visit>
+void ParticleVelocitySystem::forEachSpring(Visit &&visit) const
+{
+  size_t record = 0;
+  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
+    const double *rec = &springPairs_[b];
+    const int base[2] = {6 * tagIndex(rec[0]), 6 * tagIndex(rec[1])};
+    visit(record, rec + springs::pairFriction, base, 12, false);
+  }
+  for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord, record++) {
+    const double *rec = &springWalls_[b];
+    const int base[1] = {6 * tagIndex(rec[0])};
+    visit(record, rec + springs::wallFriction, base, 6, true);
+  }
+}
+
 void ParticleVelocitySystem::setChordForces()
 {
   // Eq. (C5) of docs/contact.md. The next position update moves the centres of a pair in contact by
@@ -429,10 +444,8 @@ void ParticleVelocitySystem::setChordForces()
   largestChordForce_ = 0;
   if (!(springDt_ > 0)) return;
   const double c1 = 1.0 / (1.0 - springGamma_);
-  size_t record = 0;
-  for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
-    const double *rec = &springPairs_[b], *tail = rec + springs::pairFriction;
-    const int base[2] = {6 * tagIndex(rec[0]), 6 * tagIndex(rec[1])};
+  forEachSpring([&](size_t record, const double *tail, const int *base, int, bool wall) {
+    if (wall) return;  // a wall is flat: no chord
     const double *n = tail, r = tail[3] + tail[4], knc1dt = tail[8];
     double rho[3], normal = 0, tangential2 = 0;
     for (int a = 0; a < 3; a++) {
@@ -448,7 +461,7 @@ void ParticleVelocitySystem::setChordForces()
       m.chordRhs(base[0] + a) -= force * n[a];
       m.chordRhs(base[1] + a) += force * n[a];
     }
-  }
+  });
 }
 
 double ParticleVelocitySystem::springVelocity(int k) const
@@ -553,20 +566,6 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     for (int a = 0; a < 3; a++) {
       const double next = cap * slideDirection_[3 * record + a], now = slideCap_[record] * slideDirection_[3 * record + a];
       if (std::fabs(next - now) > settings_.coulombTolerance * (std::fabs(next) + std::fabs(ft[a])) + 1e-300) converged = false;
-    }
-  };
-  // every spring record: fn(record, friction tail, the particles' first unknowns, 12 or 6, wall)
-  auto forEachSpring = [&](const std::function<void(size_t, const double *, const int *, int, bool)> &fn) {
-    size_t record = 0;
-    for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord, record++) {
-      const double *rec = &springPairs_[b];
-      const int base[2] = {6 * tagIndex(rec[0]), 6 * tagIndex(rec[1])};
-      fn(record, rec + springs::pairFriction, base, 12, false);
-    }
-    for (size_t b = 0; b < springWalls_.size(); b += springs::wallRecord, record++) {
-      const double *rec = &springWalls_[b];
-      const int base[1] = {6 * tagIndex(rec[0])};
-      fn(record, rec + springs::wallFriction, base, 6, true);
     }
   };
   forEachSpring(coulomb);

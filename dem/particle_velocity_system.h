@@ -199,6 +199,11 @@ class ParticleVelocitySystem {
   // The chord term of each pair spring (Eq. C5 of docs/contact.md) from U_n (Springs::previous), into
   // F^tot, once per step (assemble).
   void setChordForces();
+  // Every implicit contact spring of this step, pairs then walls: visit(record, friction tail, the
+  // first unknowns 6 i of its particles, 12 or 6 unknowns, wall). `record` indexes the per-spring
+  // state (springSlides_, slideForce_, ...); chordForce_ has the pairs' records only.
+  template <class Visit>
+  void forEachSpring(Visit &&visit) const;
   double springVelocity(int k) const;  // u - gamma U_n, the unknowns' part of the contact displacement
 
   struct Matrices;                     // Eigen's, in the .cpp
