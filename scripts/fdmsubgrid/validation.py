@@ -197,14 +197,14 @@ def channel_shear_rows(r: dict) -> List[Row]:
 
 def poiseuille_sphere_rows(r: dict) -> List[Row]:
     """U_x/U_c against Staben et al. (2003) where it applies, else against Faxen's laws with the leading wall
-    reflections (meaningful at h >~ 1.5 a: none beside the wall), Omega_z a/U_c and S* likewise."""
+    reflections where those are a reference (the centre 2 radii or more from both walls: the case's
+    wall_estimate_applies; nearer, the row has no reference), Omega_z a/U_c and S* likewise."""
     rows = []
     for row in r["rows"]:
         config = "a %g, 2a/H %g, d/a %s, a/Δ %.3g, box %s a, %d positions" % (
             row["radius"], row["two_a_over_H"], "%.4g (centre)" % row["d_over_a"] if row["centre_plane"] else
             "%g" % row["d_over_a"], row["a_over_delta"], "×".join("%g" % v for v in row["box"]), row["n_positions"])
-        near_wall = row["d_over_a"] < 1.5
-        faxen = {} if near_wall else row["faxen_wall"]
+        faxen = row["faxen_wall"] if row.get("faxen_wall_applies") else {}
         if row.get("staben_Ux_norm") is not None:
             rows.append(Row("U_x/U_c (Staben)", config, row["Ux_norm"], row["staben_Ux_norm"],
                             "%g (Staben et al. 2003; Fig. 12: very good agreement)" % row["staben_Ux_norm"],
@@ -272,7 +272,7 @@ for _c in [
          "the unbounded limits Ω_z = −γ̇/2, S* = 1 (wide channels); no tabulated values", channel_shear_rows),
     Case("poiseuilleSphere", "5.2.3 a free sphere in plane Poiseuille flow",
          "Staben et al. (2003) on the centre plane at 2a/H 0.6; elsewhere Faxén's laws with the leading wall "
-         "reflections (none within 1.5 a of a wall)", poiseuille_sphere_rows),
+         "reflections (the centre 2 radii or more from both walls; none nearer)", poiseuille_sphere_rows),
     Case("pairPoiseuille", "5.4 two free spheres in a confined plane Poiseuille flow (H = 4a)",
          "no tabulated values (Bhattacharya et al. 2006 are plots): the sign change of U_y, lubrication near "
          "contact, the isolated spheres far apart", pair_poiseuille_rows),
