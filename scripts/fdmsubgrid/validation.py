@@ -100,15 +100,21 @@ def squeeze_rows(label: str, gaps: Sequence[float], gap_name: str, theory: Seque
     return rows
 
 
+def squeeze_box(r: dict) -> str:
+    """The mesh and box of a squeeze case's results: 'a1/Δ 4, L 8 a1' (', → ∞ with 12' if extrapolated)."""
+    text = "a1/Δ %g, L %g a1" % (r["a_over_delta"], r["L_over_a"])
+    return text + (" (→ ∞ with L %g)" % r["box_extrapolated_with"] if r.get("box_extrapolated_with") else "")
+
+
 def pair_squeeze_rows(r: dict) -> List[Row]:
     rows = []
     for c in r["cases"]:
-        rows += squeeze_rows("a2/a1 %g, " % c["lambda"], c["xi"], "ξ", c["theory"], c)
+        rows += squeeze_rows("a2/a1 %g, %s, " % (c["lambda"], squeeze_box(r)), c["xi"], "ξ", c["theory"], c)
     return rows
 
 
 def wall_squeeze_rows(r: dict) -> List[Row]:
-    return squeeze_rows("", r["eps"], "ε", r["theory"], r)
+    return squeeze_rows(squeeze_box(r) + ", ", r["eps"], "ε", r["theory"], r)
 
 
 # The paper's contact case (section 5.3, Fig. 14): the spheres touch for -1.39 <~ r_x/a1 <~ 0
@@ -254,7 +260,9 @@ for _c in [
     Case("periodicArray", "5.1 periodic array of spheres: the drag K against Hasimoto (Table 4)",
          "Hasimoto's series (Eq. 41)", periodic_array_rows),
     Case("pairSqueeze", "3 / Appendix C: squeeze flow of a pair, with and without the sub-grid correction",
-         "two-sphere theory (Jeffrey & Onishi 1984, full range)", pair_squeeze_rows),
+         "two-sphere theory (Jeffrey & Onishi 1984, full range); the box effect extrapolated away (L = 8 and "
+         "12 a1: the theory is for an unbounded fluid)", pair_squeeze_rows,
+         default_args=["--box-extrapolate", "12"]),
     Case("wallSqueeze", "Appendix D: squeeze flow toward a wall, with and without the sub-grid correction",
          "Brenner (1961)", wall_squeeze_rows),
     Case("pairShear", "5.3 a sphere pair in simple shear without contact (reversibility)",
