@@ -12,7 +12,7 @@ import pytest
 TESTS = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(TESTS)
 MODULES = ("calibration", "case", "checkpoint", "contacts", "decomposition", "demonly", "environment", "output", "packing",
-           "pairstresslet", "pairtangential", "periodicarray", "poiseuille", "profiles", "rheology", "sbm", "shear", "squeeze",
+           "pairshearstresslet", "pairstresslet", "pairtangential", "periodicarray", "poiseuille", "profiles", "rheology", "sbm", "shear", "squeeze",
            "suspension", "theory", "timeseries", "validation", "wallcalibration")
 
 

@@ -6,7 +6,8 @@ rheology, timeseries), and the analysis of a sheared-suspension run folder (shea
 command) and of its contacts (contacts); squeeze flows and the calibration of the solver's own
 resistance, the squeeze and the tangential wall functions (squeeze, calibration, wallcalibration),
 and the measurement of the tangential pair modes (pairtangential); the probe of the pair's squeeze
-stresslet (pairstresslet); the validation report (validation).
+stresslet (pairstresslet) and of its shear-mode stresslets (pairshearstresslet); the validation report
+(validation).
 ./Allwmake installs the package (editable) so that a notebook can `import fdmsubgrid`;
 the programs it runs are found through the environment (environment.program). docs/profiles.md.
 

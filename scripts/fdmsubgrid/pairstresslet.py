@@ -6,8 +6,9 @@ What is run: the squeeze scene of calibration.py (squeeze.run_pair: spheres of r
 a periodic cube, pushed together by +-F), held at each gap for one coupled step with `stresslets yes`, at the
 calibration's 4 positions in the cell and 2 box sizes; the sub-grid lubrication off (the solver alone), or on
 with `--model` (the coupled solver, stresslet = fluid + sub-grid parts). Each sphere's stresslet S (fix
-fdm/output's S_fluid + S_subgrid, the force the fluid exerts; Kim-Karrila's S is its opposite) has the
-traceless part S_xx - tr S/3 = (2/3) (g_11 U1 + g_12 U2) for motion along the line of centres x. One loading
+fdm/output's S_fluid + S_subgrid: Kim-Karrila's S, of the particle on the fluid, S = -G.U in a quiescent
+fluid; the sign checked in tests/test_pair_shear_stresslet.py) has the traceless part
+S_xx - tr S/3 = -(2/3) (g_11 U1 + g_12 U2) for motion along the line of centres x. One loading
 cannot split g_11 from g_12: the response to a rigid translation of the pair, g_11 + g_12, is taken as the
 theory's X^G_11 + X^G_12 (the far field, which the solver resolves, and which the frame-invariant sub-grid
 matrix leaves alone), so
@@ -65,7 +66,7 @@ def run_squeeze(workdir: str, ratio: float, a_over_delta: float, L_over_a: float
 
 
 def kim_karrila_xx(S: np.ndarray) -> np.ndarray:
-    """(3/2) of the traceless xx part of S_fluid with Kim-Karrila's sign: X^G U for motion along x."""
+    """-(3/2) of the traceless xx part of a recorded S (Kim-Karrila's, S = -G.U): X^G U for motion along x."""
     S = np.asarray(S, dtype=float)
     return -1.5 * (S[..., 0] - (S[..., 0] + S[..., 3] + S[..., 5]) / 3)
 

@@ -79,15 +79,18 @@ def _load_lines(r: float) -> List[str]:
 
 def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_delta: float, L_over_a: float,
                     offset: Sequence[float], tol_lambda: float = 1e-5, np_fluid: int = 1, keep: bool = False,
-                    model: str | None = None) -> dict:
+                    model: str | None = None, stresslets: bool = False) -> dict:
     """The loaded pair at the gaps `xis` (largest first, each one coupled step warm-started from the
     previous) in a periodic cube of side L_over_a a1; returns dict(U1, W1, U2, W2: per gap [x, y, z],
     wall_seconds, inner_iterations, converged). The torques' moment arm r/2 changes with the gap: the
     fixes are redefined before each step. Kept as <run folder>.json: a later call with the same scene and
     gaps reads it (a killed measurement resumes). `model` None: the solver alone (lubrication off, the
-    measurement); 'calibrated' or 'cutoff': the coupled solver with that sub-grid model (the validation)."""
+    measurement); 'calibrated' or 'cutoff': the coupled solver with that sub-grid model (the validation).
+    With `stresslets` (fix fdm/couple ... stresslets yes, the records of fix fdm/output read) also S1, S2:
+    per gap each sphere's stresslet S_fluid + S_subgrid (xx xy xz yy yz zz as recorded: Kim-Karrila's S,
+    of the particle on the fluid; pairshearstresslet.py)."""
     run_dir = os.path.join(workdir, "lambda%g_ad%g_L%g_off%g_%g_%g" % (ratio, a_over_delta, L_over_a, *offset)
-                           + ("" if model is None else "_" + model))
+                           + ("" if model is None else "_" + model) + ("_stresslets" if stresslets else ""))
     kept = squeeze.kept_result(run_dir, xis, tol_lambda)
     if kept is not None:
         return kept
@@ -106,8 +109,11 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
                      for i, c in enumerate(pair_centres(ratio, xi, centre))]
         runs += _load_lines(separation(ratio, xi))
         runs.append("run             1")
+    if stresslets:
+        runs = ["fix             output all fdm/output records 1 particles.records"] + runs
     p1, p2 = pair_centres(ratio, xis[0], centre)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
+                         fix_options="move no stresslets yes" if stresslets else "move no",
                          pair_style="fdm/subgrid " + ("lubrication no" if model is None else "model " + model),
                          before_run="group           one id 1\ngroup           two id 2", runs=runs,
                          name="in.pairTangential")
@@ -119,6 +125,11 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
         out["W" + k] = np.column_stack([parts[c][sel] for c in ("Wx", "Wy", "Wz")]).tolist()
     out.update(wall_seconds=wall, inner_iterations=[int(n) for n in steps["innerIterations"]],
                converged=bool(steps["converged"].all()), gaps=[float(x) for x in xis], tol_lambda=tol_lambda)
+    if stresslets:
+        n = len(xis)
+        records, _ = case.read_held_steps(run_dir, n, "pairtangential.run_loaded_pair")
+        total = np.asarray(records["S_fluid"][-n:], dtype=float) + np.asarray(records["S_subgrid"][-n:], dtype=float)
+        out.update(S1=total[:, 0].tolist(), S2=total[:, 1].tolist())
     squeeze.keep_result(run_dir, out)
     return out
 

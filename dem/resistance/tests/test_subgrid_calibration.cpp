@@ -370,6 +370,44 @@ TEST(CalibratedSubgridModel, PairTangentialBlockIsTheTabulatedInternalCorrection
         EXPECT_EQ(model5.pair(a, a, 0.05).f[f], cutoff5.pair(a, a, 0.05).f[f]) << subgridBaseName(SubgridBaseFunction(f));
 }
 
+// The stresslet rows on the rolling mode (W1 - W2 along n, q1 = 0) stay the cut-off model's when the table
+// calibrates the tangential forces: through C.2 the calibrated Y21A, Y21B alone would move them (Y21H takes
+// the change back: CalibratedSubgridModel::pair). Equal spheres, where each sphere's is fixed by symmetry.
+TEST(CalibratedSubgridModel, RollingModeStressletStaysTheCutoffModels)
+{
+    const double K[4] = {2.5, -0.8, 1.3, 0.2};
+    const SubgridCalibration cal =
+        SubgridCalibration::read(writeTable("pair_rolling_synthetic.dat", tableWithPairTangential(K)));
+    const double a = 0.5, delta = a / 3;
+    const CalibratedSubgridModel model(cal, delta, 0.65, 0.75);
+    const CutoffSubgridModel cutoff(delta, 0.65);
+    for (double xi : {1e-3, 0.02, 0.1}) {
+        const double r = a * (2 + xi);
+        const Eigen::Vector3d d = Eigen::Vector3d(0.3, -0.5, 0.8).normalized(), e = d.unitOrthogonal(), n = d.cross(e);
+        const double x1[3] = {0.1, 0.2, -0.3}, x2[3] = {x1[0] + r * d[0], x1[1] + r * d[1], x1[2] + r * d[2]};
+        PairBlock calibrated, cut;
+        ASSERT_TRUE(subgridPairBlock(model, x1, x2, a, a, 1.0, calibrated));
+        ASSERT_TRUE(subgridPairBlock(cutoff, x1, x2, a, a, 1.0, cut));
+        // the table acts: the force blocks differ (by more than rounding; the squeeze dominates their norm)
+        EXPECT_GT((pairMatrix(calibrated) - pairMatrix(cut)).norm(), 1e-4 * pairMatrix(cut).norm()) << xi;
+        Vector12 rolling = Vector12::Zero();
+        rolling.segment<3>(3) = n;
+        rolling.segment<3>(9) = -n;
+        double scale = 0, largestDifference = 0;
+        for (int row = 0; row < 14; ++row) {
+            double sCalibrated = 0, sCutoff = 0;
+            for (int j = 0; j < 12; ++j) {
+                sCalibrated += calibrated.stress[row][j] * rolling(j);
+                sCutoff += cut.stress[row][j] * rolling(j);
+            }
+            scale = std::max(scale, std::fabs(sCutoff));
+            largestDifference = std::max(largestDifference, std::fabs(sCalibrated - sCutoff));
+        }
+        EXPECT_GT(scale, 0) << xi;
+        EXPECT_LT(largestDifference, 1e-12 * scale) << xi;
+    }
+}
+
 // The shipped table's pair blocks: every size the suspension runs need is covered, and the dissipation
 // rule holds: the full-range theory's block plus the sub-grid block is positive semi-definite (the
 // correction takes away at most what the solver resolves), at the tabulated sizes and in between.

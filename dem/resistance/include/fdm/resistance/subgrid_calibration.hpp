@@ -126,10 +126,12 @@ void pairBaseFromInternal(const double K[4], double r, PairSubgridBase& base);
 // The cut-off model with the functions the table calibrates replaced: the squeeze functions (pair X21A,
 // wall X^A; required) and, where the table has them, the tangential wall functions Y^A, Y^B, Y^C, X^C and
 // the pair's Y21A, Y21B, Y11C, X21C (from K on the internal modes: pairBaseFromInternal). The base stresslet
-// functions (X11G, Y11G, Y21H, X12P, X21P) stay the cut-off model's; through C.2 and the average over the
+// functions (X11G, Y11G, X12P, X21P) stay the cut-off model's; through C.2 and the average over the
 // labellings the squeeze stresslet the pair style applies still follows the calibrated X21A (for equal
 // spheres X^G_11 = -r X21A/2: within 5 % of the theory, measured; docs/resistance.md, "The pair's squeeze
-// stresslet"). A wall's X^G is the cut-off model's.
+// stresslet"), and so does the sliding mode's. Y21H is the cut-off model's plus what keeps the rolling
+// mode's stresslet the cut-off model's when Y21A, Y21B are calibrated (docs/resistance.md, "The pair's
+// shear-mode stresslets"). A wall's X^G is the cut-off model's.
 // Dissipation rule for a wall (docs/resistance.md): the correction may take away at most half of what
 // the solver itself resolves, R^SG + R^FDM/2 >= 0 with R^FDM = R^th - R^SG, i.e. R^th + R^SG positive
 // semi-definite for the tangential block [[Y^A, -Y^B], [-Y^B, Y^C]] (dimensional) and X^C. Y^A, Y^C,
