@@ -352,9 +352,9 @@ PairSubgridBase CalibratedSubgridModel::pair(double a1, double a2, double xi) co
         // c2 = Y21H + (r/2) Y11G + (r^2/4) Y21A. Their sum, (r/2)(Y21B - (r/2) Y21A), is the force dipole
         // of the rolling mode's force pair and follows the calibrated forces; their difference
         // c1 - c2 = -2 Y21H - r Y11G - (3/4) r^2 Y21A + (r/2) Y21B is the split, which the calibrated
-        // Y21A, Y21B alone moved (for equal spheres +50-70 % against the theory at a1/Delta 3, where the
-        // cut-off model's is within 4 %: docs/resistance.md, "The pair's shear-mode stresslets"). Y21H
-        // keeps the cut-off model's difference.
+        // Y21A, Y21B alone moved (for equal spheres 25-72 % too large at a1/Delta 3 and xi <= 0.15, where
+        // the cut-off model's is within 10 %: docs/resistance.md, "The pair's shear-mode stresslets").
+        // Y21H keeps the cut-off model's difference.
         b.f[BaseY21H] += -0.375 * r * r * (b.f[BaseY21A] - cutoffYA) + 0.25 * r * (b.f[BaseY21B] - cutoffYB);
     }
     return b;
