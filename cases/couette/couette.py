@@ -68,8 +68,8 @@ TABLE8 = {
 # dt 0.04 within one error bar of dt 0.01, at 0.08 22 % lower with less contact stress (docs/benchmarks.md,
 # "The time step at phi 0.37"). 0.42 from the same study with the chord term (Eq. C5; 16 strain units,
 # 2026-11-27): dt 0.04 gives eta_s 10.9 +- 0.7 and 11.9 +- 0.9 (seeds 1, 2) against 18.2 +- 2.4 and
-# 14.1 +- 0.9 at dt 0.02 and 15.2 +- 0.8 at 0.01 (seed 1): 0.02 (docs/benchmarks.md, "The time step at
-# phi 0.42").
+# 14.1 +- 0.9 at dt 0.02 and 15.2 +- 0.8, 15.2 +- 1.2 at 0.01: 0.02 (docs/benchmarks.md, "The time step
+# at phi 0.42").
 MEASURED_DT_LIMITS = {0.27: 0.1, 0.30: 0.08, 0.37: 0.04, 0.42: 0.02, 0.47: 0.02}
 
 

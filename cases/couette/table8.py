@@ -47,7 +47,7 @@ from fdmsubgrid.shear import steps_planned  # noqa: E402
 PAPER_FIT = dict(zip(("alpha", "phi_m"), rheology.PAPER_MARON_PIERCE))   # paper section 6.1, Eq. (55)
 # The time step of a row unless --dt says one: 0.04/gamma_dot_0 below phi_bulk 0.40, 0.02 from it on,
 # where accuracy sets 0.02 (at phi_bulk 0.47 eta_s at 0.05 is a third lower: docs/benchmarks.md, "Stability
-# map"; at 0.42 dt 0.04 is 16-28 % lower than 0.02 and 0.01: "The time step at phi 0.42"); the rows 0.27-0.47 of
+# map"; at 0.42 dt 0.04 is 26 % lower than 0.01, 0.02 agrees: "The time step at phi 0.42"); the rows 0.27-0.47 of
 # docs/validation.md ran so (the boundary was 0.45 before 2026-11-27, no row lay between).
 DENSE_PHI, DT_DENSE, DT_DILUTE = 0.40, 0.02, 0.04
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
