@@ -101,7 +101,8 @@ def squeeze_rows(label: str, gaps: Sequence[float], gap_name: str, theory: Seque
 
 
 def squeeze_box(r: dict) -> str:
-    """The mesh and box of a squeeze case's results: 'a1/Δ 4, L 8 a1' (', → ∞ with 12' if extrapolated)."""
+    """The mesh and box of a squeeze case's results: 'a1/Δ 4, L 8 a1', and ' (→ ∞ with L 12)' if the box effect
+    was extrapolated away with a second box."""
     text = "a1/Δ %g, L %g a1" % (r["a_over_delta"], r["L_over_a"])
     return text + (" (→ ∞ with L %g)" % r["box_extrapolated_with"] if r.get("box_extrapolated_with") else "")
 
