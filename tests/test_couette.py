@@ -380,6 +380,21 @@ def test_time_step_beyond_the_measured_limit_is_warned(couette):
     assert "denser than any measured" in couette.time_step_warning(0.54, 0.15)
 
 
+def test_table8_names_a_run_that_stopped(tmp_path, env):
+    """A run that fdmRun stops (here a folder without a case) ends table8.py with a message naming the run
+    and its log, not a traceback; the log holds fdmRun's own reason."""
+    import argparse
+    table8 = load_case_module("couette", "table8")
+    run_dir = tmp_path / "table8_phi0.47_broken"
+    run_dir.mkdir()
+    with pytest.raises(SystemExit) as stopped:
+        table8._fdmrun(str(run_dir), argparse.Namespace(np_fluid=1))
+    message = str(stopped.value)
+    assert "exit code" in message and str(run_dir) in message and str(run_dir) + ".log" in message
+    assert "resumes the run from its last checkpoint" in message
+    assert "fluid/system not found" in (tmp_path / "table8_phi0.47_broken.log").read_text()
+
+
 def test_table8_extends_a_run_whose_averaging_window_is_short():
     """table8.py's rule: a finished run averaged over fewer than --min-average strain units after its
     transient is continued by the shortfall, at least a tenth of --min-average (in whole steps), never

@@ -108,7 +108,11 @@ def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None)
     log = run_dir + ".log"
     print("table8: %s (log %s)" % (" ".join(cmd), log), flush=True)
     with open(log, "a") as f:
-        subprocess.run(cmd, check=True, stdout=f, stderr=subprocess.STDOUT)
+        done = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
+    if done.returncode != 0:
+        # fdmRun has said why at the end of the log; the checkpoints are kept
+        raise SystemExit("table8: fdmRun stopped with exit code %d on %s: the end of %s says why; the same "
+                         "table8.py command resumes the run from its last checkpoint" % (done.returncode, run_dir, log))
 
 
 def extension(row: Dict, args: argparse.Namespace, dt: float) -> Optional[int]:
