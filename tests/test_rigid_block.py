@@ -27,7 +27,7 @@ def uniform_flow_step(root, offset, a_over_delta=3.0, L=8.0):
         [U0 * np.ones(len(c)), np.zeros(len(c)), np.zeros(len(c))]))
     centre = tuple(0.5 * L + o * delta for o in offset)
     case.write_dem_input(os.path.join(root, "dem"), box, [centre + (1.0,)], dt=0.01, fix_options="move no",
-                         runs=["fix             output all fdm/output records 1 particles.records", "run 1"],
+                         runs=[case.RECORD_EVERY_STEP, "run 1"],
                          name="in.uniform")
     case.run(root)
     records = output.read_particle_records(os.path.join(root, "dem", "particles.records"))

@@ -131,7 +131,7 @@ def torque_step(root, torque, a_over_delta=3.0, L=8.0):
     centre = (0.5 * L + 0.17 / a_over_delta, 0.5 * L + 0.31 / a_over_delta, 0.5 * L + 0.05 / a_over_delta)
     case.write_dem_input(os.path.join(root, "dem"), box, [centre + (1.0,)], fix_options="move no",
                          before_run="fix             turn all fdm/torque %r %r %r" % tuple(torque),
-                         runs=["fix             output all fdm/output records 1 particles.records", "run 1"],
+                         runs=[case.RECORD_EVERY_STEP, "run 1"],
                          name="in.torque")
     case.run(root)
     records = output.read_particle_records(os.path.join(root, "dem", "particles.records"))

@@ -160,7 +160,7 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
     def centre(o: tuple[float, float]) -> tuple[float, float, float]:
         return (x0 + o[0] * delta, H / 2, z0 + o[1] * delta)
 
-    runs = ["fix             output all fdm/output records 1 particles.records"]
+    runs = [case.RECORD_EVERY_STEP]
     runs += case.held_step_runs([[centre(o)] for o in offsets])
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [centre(offsets[0]) + (a,)], dt=0.01,
                          fix_options="move no stresslets yes", runs=runs,

@@ -251,7 +251,7 @@ def run_configurations(run_dir: str, scene: Scene, configurations: Sequence[np.n
     case.write_dem_input(os.path.join(run_dir, "dem"), scene.box, spheres, dt=1.0, fix_options="move no",
                          pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid,
                                                             options.model, options.cutoff, options.wall_cutoff),
-                         before_run="fix             output all fdm/output records 1 particles.records",
+                         before_run=case.RECORD_EVERY_STEP,
                          runs=runs, name="in.pairPoiseuille")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
     m = len(configurations)

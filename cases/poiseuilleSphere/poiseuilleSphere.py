@@ -357,7 +357,7 @@ def run_channel(workdir: str, scene: Scene, d_list: Sequence[float], offsets: Se
                          fix_options="move no stresslets yes",
                          pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), options.subgrid,
                                                             options.model, options.cutoff, options.wall_cutoff),
-                         before_run="fix             output all fdm/output records 1 particles.records",
+                         before_run=case.RECORD_EVERY_STEP,
                          runs=runs, name="in.poiseuilleSphere")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
     n = len(configurations)

@@ -66,7 +66,7 @@ def run(workdir: str, size=(12.0, 20.0, 12.0), a_over_delta: float = 3.0, offset
     centre = tuple(0.5 * s + o * delta for s, o in zip((L, H, Lz), offset))
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [centre + (A,)], dt=0.01,
                          fix_options="move no stresslets yes",
-                         runs=["fix             output all fdm/output records 1 particles.records", "run 1"],
+                         runs=[case.RECORD_EVERY_STEP, "run 1"],
                          name="in.shearedSphere")
     wall = case.run(run_dir, np_fluid=np_fluid)
     rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"))

@@ -144,8 +144,7 @@ def _pair_functions(xi: float) -> dict:
     eta, a = 1), from the project's resistance library."""
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
     from fdmsubgrid import theory
-    return theory.resistance("pair", "--a1", 1, "--a2", 1, "--xi", "%.17g" % xi, "--theory",
-                             "--full")["dimensional_over_eta"]
+    return theory.pair_full_range(1.0, 1.0, xi)
 
 
 def two_sphere_mobility(x1, x2) -> np.ndarray:

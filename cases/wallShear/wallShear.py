@@ -182,7 +182,7 @@ def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool,
                          # the walls as in the fluid case: y = 0 at rest, y = L_y at gamma_dot L_y along x
                          pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (SHEAR_RATE * size[1], 0, 0))),
                                                             subgrid, options.model, options.cutoff, options.wall_cutoff),
-                         before_run="fix             output all fdm/output records 1 particles.records",
+                         before_run=case.RECORD_EVERY_STEP,
                          runs=runs, name="in.wallShear")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
     rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"), mmap=False)

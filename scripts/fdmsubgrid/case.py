@@ -317,8 +317,13 @@ def held_step_runs(configurations) -> list:
     return runs
 
 
+# The LIGGGHTS line that records every particle at every step in dem/particles.records (fix fdm/output),
+# the file read_held_steps and the one-step validation cases read.
+RECORD_EVERY_STEP = "fix             output all fdm/output records 1 particles.records"
+
+
 def read_held_steps(run_dir: str, n: int, who: str):
-    """The particle records (dem/particles.records, `fix fdm/output records 1`) and fdmFoam's step records of
+    """The particle records (dem/particles.records, RECORD_EVERY_STEP) and fdmFoam's step records of
     a run of n held configurations (held_step_runs), checked to hold at least n steps; the last n blocks are
     the n steps (a block at step 0, if written, holds no solution). Returns (records, steps); a run that
     recorded fewer is a RuntimeError naming `who` and the folder."""

@@ -32,7 +32,6 @@ rows (Y^G_11 and Y^H_21 of C.2, with the calibrated Y^A, Y^B, Y^C) make the coup
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 import os
 import time
@@ -49,19 +48,10 @@ OFFSETS = [(0.1, 0.2, 0.3), (0.23, 0.57, 0.71)]
 COMPONENTS = (1, 2)    # xy, xz of (xx xy xz yy yz zz)
 
 
-@functools.lru_cache(maxsize=None)
-def theory_functions(ratio: float, xi: float) -> Dict[str, float]:
-    """The library's full-range X^G, Y^G, Y^H (ab = 11, 12, 21, 22; dimensional, eta = a1 = 1, d from sphere 1
-    to sphere 2 for every ab: `fdmResistance pair --theory --full`)."""
-    f = theory.resistance("pair", "--a1", 1, "--a2", ratio, "--xi", "%.17g" % xi, "--theory",
-                          "--full")["dimensional_over_eta"]
-    return {k: f[k] for k in f if k[:2] in ("XG", "YG", "YH")}
-
-
 def theory_stresslet(ratio: float, xi: float, velocities: Dict[str, np.ndarray]) -> np.ndarray:
     """(2, 3, 3): the theory's stresslets S of spheres 1 and 2 (Kim-Karrila's: of the particle on the fluid;
     module docstring) in a quiescent fluid for the velocities U1, W1, U2, W2 (3 each), d = e_x."""
-    f = theory_functions(ratio, xi)
+    f = theory.pair_full_range(1.0, ratio, xi)  # X^G, Y^G, Y^H of every ab: d from sphere 1 to 2
     d, eye = np.array([1.0, 0.0, 0.0]), np.eye(3)
     out = np.zeros((2, 3, 3))
     for a in range(2):

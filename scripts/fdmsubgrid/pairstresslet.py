@@ -74,7 +74,7 @@ def kim_karrila_xx(S: np.ndarray) -> np.ndarray:
 @functools.lru_cache(maxsize=None)
 def theory_xg(a1: float, a2: float, xi: float) -> tuple:
     """The library's X^G_11, X^G_12, X^G_21, X^G_22 (dimensional, eta = 1; full-range forms)."""
-    d = theory.resistance("pair", "--a1", a1, "--a2", a2, "--xi", xi, "--theory", "--full")["dimensional_over_eta"]
+    d = theory.pair_full_range(a1, a2, xi)
     return d["XG11"], d["XG12"], d["XG21"], d["XG22"]
 
 

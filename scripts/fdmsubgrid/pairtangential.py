@@ -110,7 +110,7 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
         runs += _load_lines(separation(ratio, xi))
         runs.append("run             1")
     if stresslets:
-        runs = ["fix             output all fdm/output records 1 particles.records"] + runs
+        runs = [case.RECORD_EVERY_STEP] + runs
     p1, p2 = pair_centres(ratio, xis[0], centre)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
                          fix_options="move no stresslets yes" if stresslets else "move no",
@@ -161,8 +161,7 @@ def theory_matrix(ratio: float, xi: float) -> np.ndarray:
     """The 12 x 12 two-sphere resistance (eta = 1, a1 = 1, d = e_x; F = -R U, order U1 W1 U2 W2) from the
     full-range functions of `fdmResistance pair --theory --full` (Jeffrey & Onishi; same convention as
     `fdmResistance matrix`, checked to 1e-13 with the near-field forms)."""
-    f = theory.resistance("pair", "--a1", 1, "--a2", ratio, "--xi", "%.17g" % xi, "--theory",
-                          "--full")["dimensional_over_eta"]
+    f = theory.pair_full_range(1.0, ratio, xi)
     d = np.array([1.0, 0.0, 0.0])
     dd, eye, ed = np.outer(d, d), np.eye(3), _levi_civita_dot(d)
     R = np.zeros((12, 12))

@@ -122,7 +122,7 @@ def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_
                           n_particles=2)
     runs = case.held_step_runs([pair_centres(ratio, xi, centre) for xi in xis])
     if stresslets:
-        runs = ["fix             output all fdm/output records 1 particles.records"] + runs
+        runs = [case.RECORD_EVERY_STEP] + runs
     p1, p2 = pair_centres(ratio, xis[0], centre)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0,
                          fix_options="move no stresslets yes" if stresslets else "move no",

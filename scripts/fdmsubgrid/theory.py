@@ -31,6 +31,13 @@ def wall_squeeze_velocity(a, eps):
     return resistance("squeeze", "--a", a, "--eps", eps, "--wall")["closing_velocity_normalised"]
 
 
+@functools.lru_cache(maxsize=4096)
+def pair_full_range(a1: float, a2: float, xi: float) -> dict:
+    """Every full-range two-sphere function (X^A ... Z^M, ab = 11, 12, 21, 22; dimensional / eta, d from
+    sphere 1 to sphere 2) at the reduced gap xi: `fdmResistance pair --theory --full` (docs/resistance.md)."""
+    return resistance("pair", "--a1", a1, "--a2", a2, "--xi", "%.17g" % xi, "--theory", "--full")["dimensional_over_eta"]
+
+
 def relative_errors(values, reference):
     """(value - reference) / reference, element by element."""
     return [(v - r) / r for v, r in zip(values, reference)]
