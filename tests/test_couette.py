@@ -440,3 +440,32 @@ def test_table8_fits_only_finished_rows_with_a_full_window(tmp_path):
     assert fit["rows"] == [0.27, 0.32, 0.37] and fit["not_fitted"] == [0.47]
     assert abs(fit["alpha"] - alpha) < 1e-6 and abs(fit["phi_m"] - phi_m) < 1e-6
     assert "fit" not in table8.summarise(rows[:2] + rows[3:], args)
+
+
+def test_table8_runs_rows_at_once_and_names_a_stopped_one(tmp_path, monkeypatch):
+    """--jobs 2: two rows run at the same time and the third waits for one of them; a row whose run
+    fdmRun stops (run_row's SystemExit) lets the others finish, the summary is written, and table8.py
+    then ends naming it. The rows' runs are replaced by a pause here: this is the scheduling alone."""
+    import json
+    import time
+    table8 = load_case_module("couette", "table8")
+    spans = {}
+
+    def run_row(phi, args):
+        begin = time.monotonic()
+        time.sleep(0.5)
+        spans[phi] = (begin, time.monotonic())
+        if phi == 0.32:
+            raise SystemExit("table8: fdmRun stopped with exit code 1 on the row 0.32")
+        return None
+
+    monkeypatch.setattr(table8, "run_row", run_row)
+    out = tmp_path / "table8.json"
+    with pytest.raises(SystemExit, match="row 0.32"):
+        table8.main(["--phis", "0.27", "0.32", "0.37", "--jobs", "2", "--workdir", str(tmp_path), "--out", str(out)])
+    assert set(spans) == {0.27, 0.32, 0.37}
+    (a0, a1), (b0, b1), (c0, _) = spans[0.27], spans[0.32], spans[0.37]
+    assert b0 < a1 and a0 < b1                  # the first two at once
+    assert c0 >= min(a1, b1) - 0.05             # the third when a worker was free
+    assert [r["status"] for r in json.loads(out.read_text())["rows"]] == ["not started"] * 3
+    assert table8.default_jobs(1) >= table8.default_jobs(2) >= 1
