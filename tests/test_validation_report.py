@@ -58,6 +58,11 @@ def test_report_only_reads_the_same_rows(sheared_report, env):
         read = json.load(f)
     assert read["cases"][0]["status"] == "read"
     assert read["cases"][0]["rows"] == summary["cases"][0]["rows"]
+    # the command that made the results, and its wall time, come back from the case's run record
+    assert read["cases"][0]["command"] == summary["cases"][0]["command"]
+    assert read["cases"][0]["wall_seconds"] == pytest.approx(summary["cases"][0]["wall_seconds"])
+    assert "at commit" in read["cases"][0]["provenance"]
+    assert "Command: `%s`; read (run on " % summary["cases"][0]["command"] in again.read_text()
 
 
 def test_unreadable_and_missing_results_are_reported(tmp_path, env):

@@ -335,6 +335,7 @@ class CaseResult:
     log: Optional[str] = None
     message: str = ""
     figures: List[str] = field(default_factory=list)
+    provenance: str = ""                # read: when, at which commit and where the results were made
 
 
 def case_command(case: Case, full: bool, folder: str) -> List[str]:
@@ -362,21 +363,43 @@ def collect(key: str, case: Case, folder: str, status: str, command: str, wall: 
     return CaseResult(key, case, status, command, wall, rows, log, figures=figures)
 
 
+RUN_RECORD = "validation_run.json"   # in a case's folder: the command that made its results, when and where
+
+
 def run_case(key: str, case: Case, full: bool, folder: str) -> CaseResult:
-    """Run one case as a user would (its own script) into folder, its output in folder/log, then read it."""
+    """Run one case as a user would (its own script) into folder, its output in folder/log, then read it.
+    The command, the commit, the date and the wall time go into folder/RUN_RECORD, which a later
+    --report-only shows (read_case)."""
     if os.path.isdir(folder):
         shutil.rmtree(folder)   # never report a previous run's numbers or figures as this one's
     os.makedirs(folder)
     command = case_command(case, full, folder)
     shown = " ".join(os.path.relpath(c, PROJECT) if c.startswith(PROJECT) else c for c in command[1:])
     log = os.path.join(folder, "log")
+    started = time.strftime("%Y-%m-%d %H:%M")
     t0 = time.time()
     with open(log, "w") as f:
         done = subprocess.run(command, stdout=f, stderr=subprocess.STDOUT, cwd=PROJECT)
     wall = time.time() - t0
+    with open(os.path.join(folder, RUN_RECORD), "w") as f:
+        json.dump(dict(command=shown, commit=git_commit(), date=started, wall_seconds=wall,
+                       exit_code=done.returncode), f, indent=1)
     if done.returncode != 0:
         return CaseResult(key, case, "failed", shown, wall, [], log, "exit code %d (log %s)" % (done.returncode, log))
     return collect(key, case, folder, "ran", shown, wall, log)
+
+
+def read_case(key: str, case: Case, folder: str) -> CaseResult:
+    """A case's results as an earlier run left them in folder (--report-only): its command, commit and wall
+    time from folder/RUN_RECORD where run_case wrote one, else the results file's path."""
+    record_path = os.path.join(folder, RUN_RECORD)
+    if not os.path.exists(record_path):
+        return collect(key, case, folder, "read", "(read: %s)" % os.path.join(folder, "results.json"), None, None)
+    with open(record_path) as f:
+        record = json.load(f)
+    read = collect(key, case, folder, "read", record["command"], record.get("wall_seconds"), None)
+    read.provenance = "run on %s at commit %s, read from %s" % (record["date"], record["commit"], folder)
+    return read
 
 
 def number(v: Optional[float]) -> str:
@@ -406,9 +429,9 @@ def markdown(results: List[CaseResult], table8: Optional[dict], info: dict, figu
     lines.append("")
     for r in results:
         lines += ["## %s (`cases/%s`)" % (r.case.section, r.case.name), "",
-                  "Command: `%s`; %s; wall time %s. Reference: %s." % (
-                      r.command, r.status, "%.0f s" % r.wall_seconds if r.wall_seconds else "—",
-                      r.case.reference_source), ""]
+                  "Command: `%s`; %s%s; wall time %s. Reference: %s." % (
+                      r.command, r.status, " (%s)" % r.provenance if r.provenance else "",
+                      "%.0f s" % r.wall_seconds if r.wall_seconds else "—", r.case.reference_source), ""]
         if r.message:
             lines += ["**%s**: %s" % (r.status, r.message), ""]
         lines += table(r.rows)
@@ -477,8 +500,7 @@ def run_report(keys: Optional[Sequence[str]] = None, full: bool = False, report_
         case = CASES[key]
         if report_only:
             folder = os.path.join(workdir, key)
-            results.append(collect(key, case, folder, "read", "(read: %s)" % os.path.join(folder, "results.json"),
-                                   None, None))
+            results.append(read_case(key, case, folder))
         else:
             elapsed = time.time() - t0
             print("[%d/%d] %s (%.0f s so far)" % (i + 1, len(keys), key, elapsed), flush=True)
@@ -493,7 +515,7 @@ def run_report(keys: Optional[Sequence[str]] = None, full: bool = False, report_
     with open(out, "w") as f:
         f.write(text)
     summary = dict(info, cases=[dict(key=r.key, section=r.case.section, status=r.status, command=r.command,
-                                     wall_seconds=r.wall_seconds, message=r.message,
+                                     provenance=r.provenance, wall_seconds=r.wall_seconds, message=r.message,
                                      rows=[asdict(row) for row in r.rows]) for r in results])
     if table8_summary is not None:
         summary["table8_rows"] = [asdict(row) for row in table8_rows(table8_summary)]
