@@ -140,6 +140,12 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
       if (v != "yes" && v != "no") error->all(FLERR, "fix fdm/couple: contact_chord must be yes or no");
       contactChord_ = (v == "yes");
       i++;
+    } else if (key == "background_shear") {
+      backgroundShear_ = force->numeric(FLERR, value(1));
+      if (!std::isfinite(backgroundShear_))
+        error->all(FLERR, ("fix fdm/couple: background_shear needs a finite shear rate [1/s], got " +
+                           std::string(value(1))).c_str());
+      i++;
     } else if (key == "coulomb_tolerance") {
       coulombTolerance_ = force->numeric(FLERR, value(1));
       if (!(coulombTolerance_ > 0 && coulombTolerance_ < 1))
@@ -155,8 +161,12 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   if (options.transport == "none" && (!(request.viscosity > 0) || !(request.meshSize > 0) || !(request.fluidDensity > 0)))
     error->all(FLERR, "fix fdm/couple transport none (DEM only, no fluid) needs viscosity eta [Pa s] and mesh Delta [m] "
                       "(the sub-grid model's mesh size), both positive; fluid_density (default 1000 kg/m3) too");
-  if (options.transport == "none" && stresslets_)
-    error->all(FLERR, "fix fdm/couple: stresslets need the fluid solver (not with transport none)");
+  if (options.transport != "none" && backgroundShear_ != 0)
+    error->all(FLERR, "fix fdm/couple: background_shear goes with transport none (with the fluid solver the "
+                      "walls drive the flow)");
+  if (options.transport == "none" && stresslets_ && backgroundShear_ == 0)
+    error->all(FLERR, "fix fdm/couple: stresslets need the fluid solver, or, with transport none, a "
+                      "background_shear (the isolated sphere's stresslet in it)");
   if (options.transport == "socket" && (options.port <= 0 || options.port > 65535) && options.portFile.empty())
     error->all(FLERR, "fix fdm/couple: give the fluid solver's port (port P) or its port file (portfile F)");
   if (options.transport == "file" && options.directory.empty())
@@ -659,6 +669,27 @@ cpl::Volumes FixFdmCouple::noFluidVolumes(const std::vector<Particle> &particles
   return m;
 }
 
+void FixFdmCouple::backgroundFlow(const std::vector<Particle> &particles, cpl::Integrals &integrals)
+{
+  // transport none with background_shear G: each isolated sphere's drag is taken relative to the simple
+  // shear u = G (y - y_centre) e_x, whose vorticity turns it at Omega = -G/2 e_z, so the fluid's part of
+  // Eq. (31) is 6 pi eta a u(x_p) and 8 pi eta a^3 Omega; with stresslets, the sphere's own stresslet
+  // in it, (20/3) pi eta a^3 E with E_xy = G/2 (Kim & Karrila's S, docs/dem.md). Frame-invariant
+  // sub-grid lubrication and the springs act on the velocities as with the fluid: the particle side of
+  // a sheared suspension without the fluid solver (docs/benchmarks.md, "Without the fluid").
+  const double pi = 3.14159265358979323846, eta = session_.viscosity(), G = backgroundShear_;
+  const double yCentre = 0.5 * (domain->boxlo[1] + domain->boxhi[1]);
+  for (int p = 0; p < natoms_; p++) {
+    const double a = particles[p].radius;
+    integrals.particles[p].F[0] = 6 * pi * eta * a * G * (particles[p].x[1] - yCentre);
+    integrals.particles[p].T[2] = -8 * pi * eta * a * a * a * 0.5 * G;
+    if (stresslets_) {   // order xx xy xz yy yz zz, then the trace
+      std::fill(&fluidStress_[size_t(7) * p], &fluidStress_[size_t(7) * p] + 7, 0.0);
+      fluidStress_[size_t(7) * p + 1] = (10.0 / 3.0) * pi * eta * a * a * a * G;
+    }
+  }
+}
+
 void FixFdmCouple::subgridResults(const std::vector<Particle> &particles)
 {
   // rank 0, after the last inner iteration: the sub-grid force and torque (Eq. 21 and D.6) and,
@@ -724,10 +755,14 @@ void FixFdmCouple::final_integrate()
     atRest.step = update->ntimestep;
     atRest.iteration = 1;
     atRest.particles.assign(natoms_, cpl::ForceTorque());
+    if (backgroundShear_ != 0) backgroundFlow(particles, atRest);
     solveVelocities(atRest);
     const std::vector<double> drag = system_->rigidBlocksTimes(solution_);
-    for (int k = 0; k < 6 * natoms_; k++)  // the far-field (Stokes) force: F = -6 pi eta a U
-      hydro_[k] = -drag[k];
+    for (int p = 0; p < natoms_; p++)  // the far-field (Stokes) force: F = 6 pi eta a (u_background - U)
+      for (int d = 0; d < 3; d++) {
+        hydro_[size_t(6) * p + d] = atRest.particles[p].F[d] - drag[size_t(6) * p + d];
+        hydro_[size_t(6) * p + 3 + d] = atRest.particles[p].T[d] - drag[size_t(6) * p + 3 + d];
+      }
     subgridResults(particles);
     lastIterations_ = 1;
     run_.solve += MPI_Wtime() - t0;

@@ -92,6 +92,7 @@ class FixFdmCouple : public Fix {
   std::string systemProblem(const fdm::ParticleVelocitySystem::Error &e, uint64_t step, uint32_t iteration) const;
   void subgridResults(const std::vector<Particle> &particles);
   fdm::coupler::Volumes noFluidVolumes(const std::vector<Particle> &particles) const;
+  void backgroundFlow(const std::vector<Particle> &particles, fdm::coupler::Integrals &integrals);
   void storeStepDone(const fdm::coupler::StepDone &done);
   void planNextMove(const std::vector<Particle> &particles);
   void scatter();
@@ -140,6 +141,7 @@ class FixFdmCouple : public Fix {
   double lastResidual_;
   long notConverged_;              // steps where the fluid reported converged=0
   Timing run_;                     // this run
+  double backgroundShear_ = 0;     // transport none: the simple shear rate the spheres' drag sees
   double runStart_;
   int nmax_;                       // rows allocated in array_atom
   double **perAtom_;

@@ -421,6 +421,14 @@ TEST(FdmDEMErrors, CoulombToleranceOutOfRange)
                   "fix fdm/couple: coulomb_tolerance (of the sliding contacts' forces) must be in (0, 1), got 2", false);
 }
 
+TEST(FdmDEMErrors, BackgroundShearWithTheFluid)
+{
+    Scene scene;
+    scene.fixOptions = "background_shear 1";
+    expectFailure("background-shear", scene, nullptr, "fix fdm/couple: background_shear goes with transport none",
+                  false);
+}
+
 TEST(FdmDEMErrors, ContactChordNotYesOrNo)
 {
     Scene scene;

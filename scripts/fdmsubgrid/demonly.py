@@ -38,11 +38,13 @@ class Scene:
     walls: {face: (ux, uy, uz)} moving walls declared to the pair style (faces on the packing's
     wall-bounded axes); forces: {group-name: (ids or 'type N', (fx, fy, fz))} applied with fix
     addforce; contact: (kn, kt, mu_s, h_r) or None; fluid: None for transport none (viscosity eta,
-    mesh delta), else the fix's socket options (e.g. 'portfile ../fluid/coupling.port')."""
+    mesh delta), else the fix's socket options (e.g. 'portfile ../fluid/coupling.port'); extra_fix: more
+    fix fdm/couple keywords (e.g. 'background_shear 1 stresslets yes'); records_every: fix fdm/output
+    records every so many steps into particles.records (0: none)."""
 
     def __init__(self, packing, solver="cg", tolerance=None, steps=100, dt=1e-3, eta=1.0, delta=0.2,
                  contact=(1e4, 1e4, 0.5, 5e-3), walls=None, forces=None, move=True, skin=None,
-                 dump_every=0, fluid=None, extra_pair="", density=1000.0):
+                 dump_every=0, fluid=None, extra_pair="", density=1000.0, extra_fix="", records_every=0):
         self.packing = packing
         self.solver, self.tolerance = solver, tolerance
         self.steps, self.dt, self.eta, self.delta = int(steps), float(dt), float(eta), float(delta)
@@ -50,6 +52,7 @@ class Scene:
         self.move, self.dump_every, self.fluid, self.extra_pair = move, int(dump_every), fluid, extra_pair
         self.skin = 0.1 * float(np.min(packing.radii)) if skin is None else skin
         self.density = density
+        self.extra_fix, self.records_every = extra_fix, int(records_every)
 
     def input_text(self, data_file):
         p = self.packing
@@ -91,7 +94,11 @@ class Scene:
             fix += " tolerance %r" % self.tolerance
         if not self.move:
             fix += " move no"
+        if self.extra_fix:
+            fix += " " + self.extra_fix
         lines.append(fix)
+        if self.records_every:
+            lines.append("fix             output all fdm/output records %d particles.records" % self.records_every)
         lines += ["compute         spin all property/atom omegax omegay omegaz",
                   "variable        speed atom sqrt(vx*vx+vy*vy+vz*vz)",
                   "variable        spin atom sqrt(c_spin[1]*c_spin[1]+c_spin[2]*c_spin[2]+c_spin[3]*c_spin[3])",
