@@ -21,7 +21,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -31,7 +30,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import output, timeseries  # noqa: E402
+from fdmsubgrid import case, output, profiles, timeseries  # noqa: E402
 from fdmsubgrid.environment import program, run_environment  # noqa: E402
 
 ETA, SHEAR_RATE = 1.0, 1.0   # the Couette scenes' units (couette.py)
@@ -48,7 +47,7 @@ def dem_input(couette_input: str, dt: float, steps: int, a_over_delta: float, ex
             line = ("fix             couple all fdm/couple transport none viscosity %r mesh %r background_shear %r "
                     "stresslets yes walls walls.dat %s" % (ETA, 1.0 / a_over_delta, SHEAR_RATE, extra_fix)).rstrip()
         elif word == "fix" and "fdm/output" in line:
-            line = "fix             output all fdm/output records %d particles.records" % max(1, round(0.04 / dt))
+            line = case.records_line(max(1, round(0.04 / dt)))
         elif word == "read_data":
             line = "read_data       spheres.data"
         lines.append(line)
@@ -57,17 +56,18 @@ def dem_input(couette_input: str, dt: float, steps: int, a_over_delta: float, ex
     return "\n".join(lines + ["thermo          1000", "run             %d" % steps]) + "\n"
 
 
-def viscosity(records_path: str, box: np.ndarray, from_strain: float) -> dict:
-    """eta_r from the records' bulk particle shear stress, and the core's shear rate (|y - y_c| < L_y/5)."""
+def viscosity(records_path: str, from_strain: float) -> dict:
+    """eta_r from the records' bulk particle shear stress, and the core's shear rate (profiles.core_shear_rate:
+    the core |y - y_mid| < L_y/2 - 5 a1, as for the coupled runs)."""
     r = output.read_particle_records(records_path)
-    volume = float(np.prod(box))
+    channel = profiles.Channel(r.header["box_lo"], r.header["box_hi"])
+    volume = float(np.prod(np.subtract(channel.hi, channel.lo)))
     hydro = (r["S_fluid"][..., 1] + r["S_subgrid"][..., 1]).sum(axis=1) / volume
     contact = r["S_contact"][..., 1].sum(axis=1) / volume
     keep = r.times * SHEAR_RATE >= from_strain
     eta = timeseries.block_average(1 + (hydro[keep] + contact[keep]) / (ETA * SHEAR_RATE))
-    y, ux = r["x"][keep][..., 1], r["U"][keep][..., 0]
-    core = np.abs(y - box[1] / 2) < box[1] / 5
-    rates = [np.polyfit(y[k][core[k]], ux[k][core[k]], 1)[0] for k in range(len(y))]
+    snapshots, _ = output.record_snapshots(r, SHEAR_RATE)
+    rates = [profiles.core_shear_rate(s, channel) for s, k in zip(snapshots, keep) if k]
     return dict(eta_r=float(eta.mean), eta_r_err=float(eta.error), contact=float(contact[keep].mean()),
                 hydrodynamic=float(hydro[keep].mean()), gamma_core=float(np.mean(rates)), samples=int(keep.sum()))
 
@@ -89,9 +89,6 @@ def main(argv=None) -> dict:
             raise SystemExit("timeStepWithoutFluid: %s has no dem/%s: is it a folder couette.py wrote?" % (args.run, name))
     with open(os.path.join(dem, "in.couette")) as f:
         couette_input = f.read()
-    with open(os.path.join(dem, "spheres.data")) as f:
-        bounds = re.findall(r"^\s*(\S+)\s+(\S+)\s+[xyz]lo\s+[xyz]hi", f.read(), flags=re.M)
-    box = np.array([float(hi) - float(lo) for lo, hi in bounds])
     rows = []
     for dt in args.dts:
         folder = os.path.join(args.workdir, "dt%g" % dt)
@@ -109,7 +106,7 @@ def main(argv=None) -> dict:
             raise SystemExit("timeStepWithoutFluid: fdmDEM stopped at dt %g (exit code %d): see %s"
                              % (dt, done.returncode, os.path.join(folder, "log")))
         row = dict(dt=dt, steps=steps, wall_seconds=time.time() - t0, fix=args.fix)
-        row.update(viscosity(os.path.join(folder, "particles.records"), box, args.from_strain))
+        row.update(viscosity(os.path.join(folder, "particles.records"), args.from_strain))
         rows.append(row)
         print("dt %-6g eta_r %.2f +- %.2f (contact %.2f, hydrodynamic %.2f), gamma_core %.3f, %d steps in %.0f s"
               % (dt, row["eta_r"], row["eta_r_err"], row["contact"], row["hydrodynamic"], row["gamma_core"], steps,

@@ -317,9 +317,14 @@ def held_step_runs(configurations) -> list:
     return runs
 
 
-# The LIGGGHTS line that records every particle at every step in dem/particles.records (fix fdm/output),
-# the file read_held_steps and the one-step validation cases read.
-RECORD_EVERY_STEP = "fix             output all fdm/output records 1 particles.records"
+def records_line(every: int) -> str:
+    """The LIGGGHTS line that records every particle every `every` steps in particles.records (fix
+    fdm/output, docs/dem.md)."""
+    return "fix             output all fdm/output records %d particles.records" % every
+
+
+# every step: the file read_held_steps and the one-step validation cases read
+RECORD_EVERY_STEP = records_line(1)
 
 
 def read_held_steps(run_dir: str, n: int, who: str):

@@ -27,6 +27,7 @@ import time
 import numpy as np
 
 from . import packing as packing_module
+from .case import records_line
 from .environment import program, run_environment
 
 THERMO = ("step iterations solveTotal pairBlocks wallBlocks contacts maxSpeed maxSpin").split()
@@ -98,7 +99,7 @@ class Scene:
             fix += " " + self.extra_fix
         lines.append(fix)
         if self.records_every:
-            lines.append("fix             output all fdm/output records %d particles.records" % self.records_every)
+            lines.append(records_line(self.records_every))
         lines += ["compute         spin all property/atom omegax omegay omegaz",
                   "variable        speed atom sqrt(vx*vx+vy*vy+vz*vz)",
                   "variable        spin atom sqrt(c_spin[1]*c_spin[1]+c_spin[2]*c_spin[2]+c_spin[3]*c_spin[3])",
