@@ -14,12 +14,14 @@ from fdmsubgrid import demonly, output, packing
 ETA, DELTA, G = 2.0, 1.0 / 3.0, 1.5
 
 
-def run(tmp_path, positions, radii, steps=1):
+def run(tmp_path, positions, radii, steps=1, logs=None):
     p = packing.Packing(positions, radii, [1 if a == 1.0 else 2 for a in radii], [12.0] * 3)
     scene = demonly.Scene(p, solver="ldlt", steps=steps, dt=1e-3, eta=ETA, delta=DELTA, contact=None,
                           extra_fix="background_shear %r stresslets yes" % G, records_every=1)
     r = demonly.run(scene, str(tmp_path))
     assert r["ok"] and r["completed"], r["log"]
+    if logs is not None:
+        logs.append(r["log"])
     return output.read_particle_records(str(tmp_path / "particles.records"))
 
 
@@ -51,3 +53,16 @@ def test_close_pair_across_the_shear_is_symmetric_and_slowed(tmp_path):
     assert 0 < U[1][0] < 0.99 * free
     assert abs(U[0][1]) < 1e-10 and abs(U[0][2]) < 1e-10
     assert np.any(rec["S_subgrid"][-1] != 0)
+
+
+def test_position_update_counts_are_read_from_the_log(tmp_path):
+    # the run-end line's log-gap counts (demonly.position_update_counts, which table runs and
+    # timeStepWithoutFluid.py report): a close pair sliding in the shear has a log-gap target every step
+    # and, alone, no contradictory targets
+    logs = []
+    run(tmp_path, [[6.0, 6.0 - 1.05, 6.0], [6.0, 6.0 + 1.05, 6.0]], [1.0, 1.0], steps=20, logs=logs)
+    counts = demonly.position_update_counts(logs[0])
+    assert counts == dict(steps=20, fallback_steps=0, limited=0, fallback_fraction=0.0), counts
+    assert demonly.time_step_too_large(counts) is None
+    too_many = dict(counts, fallback_steps=15, fallback_fraction=0.75)
+    assert "15 of 20 steps" in demonly.time_step_too_large(too_many)

@@ -363,20 +363,26 @@ def test_fdmProfiles_command_on_a_run_folder(tiny_run, tmp_path, env):
 
 
 def test_time_step_beyond_the_measured_limit_is_warned(couette):
-    # the measured limits (docs/benchmarks.md): phi 0.47 holds up to dt 0.1 since the fallback, but its
-    # viscosity is right at 0.02 only
-    assert couette.time_step_warning(0.47, 0.02) is None
+    # the measured limits (docs/benchmarks.md, "What limits the time step"): phi 0.47 holds up to dt 0.1,
+    # but its particle stress is that of smaller steps at 0.01 only (30 % low at 0.02)
+    assert couette.time_step_warning(0.47, 0.01) is None
+    message = couette.time_step_warning(0.4691, 0.02)          # the small scene of the study at 0.47
+    assert "dt = 0.02" in message and "phi_bulk 0.47" in message and "0.01" in message and "viscosity" in message
     assert couette.time_step_warning(0.2682, 0.04) is None     # the Table 8 row of phi_bulk 0.27
     assert "phi_bulk 0.32" in couette.time_step_warning(0.3032, 0.04)   # the run time against error scene
     message = couette.time_step_warning(0.3687, 0.04)          # the Table 8 row of phi_bulk 0.37 (ran so)
     assert "phi_bulk 0.37" in message and "0.02" in message, message
-    message = couette.time_step_warning(0.47, 0.05)
-    assert "dt = 0.05" in message and "phi_bulk 0.47" in message and "0.02" in message and "viscosity" in message
-    # between two measured rows the denser row's limit applies; beyond the densest, said so
+    # between two measured rows the denser row's limit applies
     assert "phi_bulk 0.32" in couette.time_step_warning(0.29, 0.03)
     assert "phi_bulk 0.42" in couette.time_step_warning(0.42, 0.04) and "0.02" in couette.time_step_warning(0.42, 0.04)
     assert couette.time_step_warning(0.4160, 0.02) is None     # the time-step study's scene at 0.42
-    assert "denser than any measured" in couette.time_step_warning(0.54, 0.15)
+    # beyond the densest: the limit scaled by 1/eta_MP(phi), rounded down, said so
+    message = couette.time_step_warning(0.54, 0.01)
+    assert "denser than any measured" in message and "0.0024" in message, message
+    limits = [couette.largest_good_dt(phi) for phi in (0.27, 0.32, 0.37, 0.42, 0.47, 0.52, 0.54)]
+    assert limits == sorted(limits, reverse=True) and limits[-2:] == [0.0034, 0.0024]
+    from fdmsubgrid import suspension
+    assert limits[-1] <= 0.01 * suspension.maron_pierce_viscosity(0.47) / suspension.maron_pierce_viscosity(0.54)
 
 
 def test_table8_names_a_run_that_stopped(tmp_path, env):
@@ -401,11 +407,13 @@ def test_table8_extends_a_run_whose_averaging_window_is_short():
     import argparse
     table8 = load_case_module("couette", "table8")
     args = argparse.Namespace(min_average=20.0, max_strain=60.0, dt=None)
-    # the rows' time steps: 0.04 below phi_bulk 0.30, 0.02 from it on, unless --dt says one
-    assert (table8.row_dt(0.27, args), table8.row_dt(0.37, args), table8.row_dt(0.47, args)) == (0.04, 0.02, 0.02)
+    # the rows' time steps: couette.largest_good_dt (0.04 at 0.27, 0.02 from 0.32 to 0.42, 0.01 at 0.47),
+    # unless --dt says one
+    assert (table8.row_dt(0.27, args), table8.row_dt(0.37, args), table8.row_dt(0.47, args)) == (0.04, 0.02, 0.01)
     assert table8.row_dt(0.32, args) == 0.02     # dt 0.04 is 7 % low there without the fluid (docs/benchmarks.md)
     assert table8.row_dt(0.42, args) == 0.02     # dt 0.04 is 26 % low there (docs/benchmarks.md)
-    assert table8.row_dt(0.47, argparse.Namespace(dt=0.01)) == 0.01
+    assert table8.row_dt(0.47, argparse.Namespace(dt=0.02)) == 0.02
+    assert table8.row_dt(0.54, args) == 0.0024   # beyond the densest measured: scaled by 1/eta_MP
     # 25 strain units (625 steps), transient to strain 12.1: 12.9 averaged, 7.1 short = 177.5 -> 178 steps
     assert table8.extension(dict(steps_done=625, strain_averaged=12.9), args, 0.04) == 625 + 178
     assert table8.extension(dict(steps_done=625, strain_averaged=20.0), args, 0.04) is None

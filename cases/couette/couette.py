@@ -23,6 +23,7 @@ Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png her
 """
 
 import argparse
+import math
 import os
 import shutil
 import sys
@@ -54,43 +55,49 @@ TABLE8 = {
 
 
 # The largest time step measured good with the case's springs (phi_bulk -> dt gamma_dot_0, a1/Delta = 3,
-# seed 1): the run holds (no overlap beyond h_r) and its eta_s is that of smaller steps within the error
-# bars. 0.27 from the stability map (2 strain units of the 10 x 12 x 8 a1 scene), 0.30 from the run time
-# against error study (12 strain units of 10 x 16 x 8 a1), 0.47 from the fourth stability map: since
-# the position update's fallback (2026-11-25) the runs hold up to dt 0.1, but over 8 strain units
-# eta_s at dt 0.05 is 16 +- 2 against 36 +- 5 at dt 0.02: accuracy, not stability, sets 0.02 there
-# (largely through the rule's k_t = 0.5 zeta_t/dt: with 0.02's k_t at dt 0.05, 24 +- 4).
-# docs/benchmarks.md, "Stability map". 0.27 and 0.30 were measured with that former rule; since the
-# rule is k_t = k_n (Coulomb's law at the end of the step, docs/contact.md 2c) 0.47 was measured
-# again: dt 0.05 gives eta_s 28.7 +- 4.0 against 43.0 +- 6.4 at 0.02, and dt 0.1 stopped at step 6
-# with two spheres overlapping (docs/benchmarks.md, "Coulomb's law at the end of the step"). 0.37 from
-# the time-step study with k_t = k_n (12 strain units of 10 x 16 x 8 a1, two seeds, 2026-11-27): eta_s at
-# dt 0.04 within one error bar of dt 0.01, at 0.08 22 % lower with less contact stress (docs/benchmarks.md,
-# "The time step at phi 0.37"). 0.42 from the same study with the chord term (Eq. C5; 16 strain units,
-# 2026-11-27): dt 0.04 gives eta_s 10.9 +- 0.7 and 11.9 +- 0.9 (seeds 1, 2) against 18.2 +- 2.4 and
-# 14.1 +- 0.9 at dt 0.02 and 15.2 +- 0.8, 15.2 +- 1.2 at 0.01: 0.02 (docs/benchmarks.md, "The time step
-# at phi 0.42"). Since 2026-11-27 (later) the particle side alone in a background shear (fix fdm/couple
-# background_shear, cases/couette/timeStepWithoutFluid.py on the Table 8 scenes; docs/benchmarks.md,
-# "Without the fluid: the time step") resolves what the coupled runs' error bars could not: with k_t = k_n,
-# dt 0.04 gives eta_r 0.7 % below dt 0.02 at phi_bulk 0.27, 7 % at 0.32 and 15 % at 0.37 (21 % at 0.42,
-# as the coupled runs), dt 0.02 within 3 % of 0.01 and 0.005; the limits of 0.27 and 0.30 measured with the
-# former soft tangential rule (0.1, 0.08) are withdrawn.
-MEASURED_DT_LIMITS = {0.27: 0.04, 0.32: 0.02, 0.37: 0.02, 0.42: 0.02, 0.47: 0.02}
+# seed 1): the run holds (no overlap beyond h_r) and its viscosity is that of smaller steps within the error
+# bars. History (docs/benchmarks.md, "Stability map", "The time step at phi 0.37 / 0.42"): the coupled
+# runs' error bars (3-7 % over 8-16 strain units) could not resolve it; the particle side alone in a
+# background shear (fix fdm/couple background_shear; cases/couette/timeStepWithoutFluid.py, "Without the
+# fluid: the time step") does, in minutes: with k_t = k_n, dt 0.04 gives eta_r 0.7 % below dt 0.02 at
+# phi_bulk 0.27, 7 % at 0.32, 12-15 % at 0.37 and 21 % at 0.42 (as the coupled runs), dt 0.02 within
+# 3 % of 0.01 and 0.005 up to 0.42; at 0.47 dt 0.02 is 30 % below 0.01, which agrees with 0.005
+# (14.8 +- 0.7, 21.1 +- 0.9, 20.9 +- 0.7, 2026-11-27: "What limits the time step"). What sets the limit
+# is the position update: where its gap targets contradict each other in most steps (70-95 %) the
+# particle stress is low; the good steps have 1-15 % such steps. Beyond the densest measured row the
+# limit is carried with the stress scale, dt proportional to 1/eta_MP(phi) (Eq. 55): the loads in the
+# contacts, and the closing rates of loaded gaps, grow with it (0.0034 at 0.52, 0.0024 at 0.54).
+MEASURED_DT_LIMITS = {0.27: 0.04, 0.32: 0.02, 0.37: 0.02, 0.42: 0.02, 0.47: 0.01}
+
+
+def largest_good_dt(phi: float) -> float:
+    """The largest time step [1/gamma_dot_0] measured good at the nearest measured volume fraction at or
+    above phi (within 0.01; a measured row counts for the packings of its nominal phi_bulk); beyond the
+    densest, that row's limit scaled by eta_MP(densest)/eta_MP(phi)."""
+    denser = [p for p in sorted(MEASURED_DT_LIMITS) if p >= phi - 0.01]
+    if denser:
+        return MEASURED_DT_LIMITS[denser[0]]
+    densest = max(MEASURED_DT_LIMITS)
+    scaled = MEASURED_DT_LIMITS[densest] * (suspension.maron_pierce_viscosity(densest)
+                                            / suspension.maron_pierce_viscosity(phi))
+    unit = 10.0 ** (math.floor(math.log10(scaled)) - 1)
+    return round(math.floor(scaled / unit * (1 + 1e-12)) * unit, 12)   # rounded down to two digits
 
 
 def time_step_warning(phi: float, dt: float) -> str | None:
-    """A warning if dt exceeds the largest time step measured good at the nearest measured volume
-    fraction at or above phi (within 0.01), else None."""
-    # a measured row counts for the packings of its nominal phi_bulk (within 0.01 of it)
-    denser = [p for p in sorted(MEASURED_DT_LIMITS) if p >= phi - 0.01]
-    reference = denser[0] if denser else max(MEASURED_DT_LIMITS)
-    limit = MEASURED_DT_LIMITS[reference]
+    """A warning if dt exceeds largest_good_dt(phi), else None."""
+    limit = largest_good_dt(phi)
     if dt <= limit * (1 + 1e-9):
         return None
-    beyond = "" if denser else " (phi_bulk %.3g is denser than any measured: the limit may be smaller)" % phi
-    return ("WARNING: dt = %g/gamma_dot_0 is beyond the largest time step measured good at phi_bulk %g with "
-            "these springs, %g%s (docs/benchmarks.md, 'Stability map'): expect overlapping spheres or a "
-            "viscosity off that of smaller steps; a smaller --dt is safe" % (dt, reference, limit, beyond))
+    denser = [p for p in sorted(MEASURED_DT_LIMITS) if p >= phi - 0.01]
+    if denser:
+        where = "the largest time step measured good at phi_bulk %g with these springs, %g" % (denser[0], limit)
+    else:
+        where = ("%g, the limit at phi_bulk %g scaled by the stress, 1/eta_MP(phi) (phi_bulk %.3g is denser "
+                 "than any measured)" % (limit, max(MEASURED_DT_LIMITS), phi))
+    return ("WARNING: dt = %g/gamma_dot_0 is beyond %s (docs/benchmarks.md, 'What limits the time step'): "
+            "expect a viscosity below that of smaller steps, or overlapping spheres; a smaller --dt is safe"
+            % (dt, where))
 
 
 def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None

@@ -2,8 +2,9 @@
 """The paper's Table 8 and Fig. 21 (section 6.1) from one command: each phi_bulk's scene written,
 run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq. 55).
 
-  table8.py                                 phi_bulk 0.27, 0.37, 0.47 (25 strain units, dt 0.04 below
-                                            phi_bulk 0.30 and 0.02 from it on, tolLambda 1e-2)
+  table8.py                                 phi_bulk 0.27, 0.37, 0.47 (25 strain units, tolLambda 1e-2,
+                                            each row at the largest time step measured good there:
+                                            0.04, 0.02, 0.01)
   table8.py --phis 0.27 0.32 0.37 0.42 0.47 0.52 0.54   all seven rows
   table8.py --analyse-only                  the runs as they stand (partial runs reported with the
                                             strain they reached), nothing run
@@ -48,21 +49,22 @@ sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 from fdmsubgrid import checkpoint, output, rheology  # noqa: E402
 from fdmsubgrid.shear import steps_planned  # noqa: E402
 
+sys.path.insert(0, HERE)
+import couette  # noqa: E402  (the scene's own rules: the time step of a row)
+
 PAPER_FIT = dict(zip(("alpha", "phi_m"), rheology.PAPER_MARON_PIERCE))   # paper section 6.1, Eq. (55)
-# The time step of a row unless --dt says one: 0.04/gamma_dot_0 below phi_bulk 0.30, 0.02 from it on,
-# where accuracy sets 0.02 (at phi_bulk 0.47 eta_s at 0.05 is a third lower: docs/benchmarks.md, "Stability
-# map"; at 0.42 dt 0.04 is 26 % lower than 0.01, 0.02 agrees: "The time step at phi 0.42"; the particle side
-# alone: dt 0.04 is 7 % low at 0.32 and 15 % at 0.37, 0.7 % at 0.27: "Without the fluid: the time step").
-# The boundary was 0.45 until 2026-11-27, then 0.40: the rows 0.32 and 0.37 of docs/validation.md ran at 0.04.
-DENSE_PHI, DT_DENSE, DT_DILUTE = 0.30, 0.02, 0.04
+# The time step of a row unless --dt says one: couette.largest_good_dt(phi_bulk), the largest measured good
+# (0.04 at 0.27, 0.02 from 0.32 to 0.42, 0.01 at 0.47, smaller beyond; couette.py's MEASURED_DT_LIMITS,
+# docs/benchmarks.md "What limits the time step"). Until 2026-11-27 0.04 below phi_bulk 0.30 (0.45, then
+# 0.40 before that) and 0.02 above it: the rows 0.32 and 0.37 of docs/validation.md ran at 0.04, 0.47 at 0.02.
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
 
 
 def row_dt(phi: float, args: argparse.Namespace) -> float:
-    """The time step of the row phi_bulk: --dt if given, else DT_DILUTE or DT_DENSE."""
+    """The time step of the row phi_bulk: --dt if given, else couette.largest_good_dt(phi)."""
     if args.dt is not None:
         return args.dt
-    return DT_DENSE if phi >= DENSE_PHI - 1e-9 else DT_DILUTE
+    return couette.largest_good_dt(phi)
 
 
 def default_jobs(np_fluid: int) -> int:
@@ -271,7 +273,8 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--phis", type=float, nargs="+", default=[0.27, 0.37, 0.47], help="Table 8 rows (phi_bulk)")
     p.add_argument("--strain", type=float, default=25.0, help="strain units per run (transient + averaging)")
     p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 of every row "
-                   "(default: %g below phi_bulk %g, %g from it on)" % (DT_DILUTE, DENSE_PHI, DT_DENSE))
+                   "(default: the largest measured good at its phi_bulk, couette.largest_good_dt: %s)"
+                   % ", ".join("%g at %g" % (couette.largest_good_dt(phi), phi) for phi in sorted(couette.TABLE8)))
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",

@@ -30,7 +30,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output, profiles, timeseries  # noqa: E402
+from fdmsubgrid import case, demonly, output, profiles, timeseries  # noqa: E402
 from fdmsubgrid.environment import program, run_environment  # noqa: E402
 
 ETA, SHEAR_RATE = 1.0, 1.0   # the Couette scenes' units (couette.py)
@@ -107,10 +107,16 @@ def main(argv=None) -> dict:
                              % (dt, done.returncode, os.path.join(folder, "log")))
         row = dict(dt=dt, steps=steps, wall_seconds=time.time() - t0, fix=args.fix)
         row.update(viscosity(os.path.join(folder, "particles.records"), args.from_strain))
+        with open(os.path.join(folder, "log")) as log:
+            counts = demonly.position_update_counts(log.read())
+        # the position update's fallbacks: beyond demonly.FALLBACK_FRACTION_LIMIT the step is too large
+        row["position_update"] = counts
         rows.append(row)
-        print("dt %-6g eta_r %.2f +- %.2f (contact %.2f, hydrodynamic %.2f), gamma_core %.3f, %d steps in %.0f s"
+        print("dt %-6g eta_r %.2f +- %.2f (contact %.2f, hydrodynamic %.2f), gamma_core %.3f, %d steps in %.0f s%s"
               % (dt, row["eta_r"], row["eta_r_err"], row["contact"], row["hydrodynamic"], row["gamma_core"], steps,
-                 row["wall_seconds"]), flush=True)
+                 row["wall_seconds"], "" if counts is None else
+                 "; position update fell back in %.0f %% of the steps" % (100 * counts["fallback_fraction"])),
+              flush=True)
     summary = dict(run=os.path.abspath(args.run), strain=args.strain, from_strain=args.from_strain, rows=rows,
                    command="cases/couette/timeStepWithoutFluid.py " + " ".join(argv if argv is not None else sys.argv[1:]))
     with open(args.out, "w") as f:

@@ -159,6 +159,39 @@ def parse_timing(text):
                 contacts=int(g[15]), contact_slides=optional(g[16]))
 
 
+POSITION_UPDATE = re.compile(r"fdm/couple timing of this run \((\d+) runs?, (\d+) steps, .*?position update "
+                             r"\w+ with log gaps: .*?(\d+) limited, (\d+) steps with contradictory targets")
+# A run whose position update fell back in more than this fraction of its steps ran at a time step too
+# large for its packing: at phi_bulk 0.37-0.47 the steps with 3-15 % fallbacks gave the viscosity of
+# smaller steps, those with 70-95 % were 12-30 % low (docs/benchmarks.md, "What limits the time step").
+FALLBACK_FRACTION_LIMIT = 0.25
+
+
+def position_update_counts(text: str) -> dict | None:
+    """The log-gap position update's counts summed over every 'fdm/couple timing of this run' line of a
+    log (one per session of a resumed run): steps, fallback_steps (steps whose gap targets contradicted
+    each other and moved straight with bounds, docs/dem.md 'Position update'), limited (log targets
+    capped at a factor e per step) and fallback_fraction. None if no line has them (gap_update none,
+    or no run finished)."""
+    found = POSITION_UPDATE.findall(text)
+    if not found:
+        return None
+    steps = sum(int(g[1]) for g in found)
+    fallback = sum(int(g[3]) for g in found)
+    return dict(steps=steps, fallback_steps=fallback, limited=sum(int(g[2]) for g in found),
+                fallback_fraction=fallback / steps if steps else 0.0)
+
+
+def time_step_too_large(counts: dict | None) -> str | None:
+    """A warning when the position update fell back in more than FALLBACK_FRACTION_LIMIT of the steps."""
+    if not counts or counts["fallback_fraction"] <= FALLBACK_FRACTION_LIMIT:
+        return None
+    return ("WARNING: the position update fell back to the straight step in %d of %d steps (%.0f %%): the time "
+            "step is too large for this packing, and the particle stress is then low (12-30 %% at 70-95 %%; "
+            "docs/benchmarks.md, 'What limits the time step'): run again with a smaller dt"
+            % (counts["fallback_steps"], counts["steps"], 100 * counts["fallback_fraction"]))
+
+
 def parse_thermo(text):
     """The per-step thermo rows (THERMO columns) as a dict of numpy arrays; non-finite values are
     kept (nan, inf)."""

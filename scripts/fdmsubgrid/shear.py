@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import output, packing, profiles, rheology
+from . import demonly, output, packing, profiles, rheology
 
 H_LAYER = 5.0    # the default wall layer H_layer in units of a1 (paper section 6.1)
 MIN_SAMPLES = 8  # the fewest snapshots a time average takes (block averaging: 4 blocks of 2)
@@ -251,6 +251,13 @@ def report(run: ShearRun, out: str, extra: dict | None = None, wall_seconds: flo
     it (figure_path), print the summary unless quiet; returns the results."""
     results, (channel, avg, fine, _) = analyse(run, wall_seconds, ranks, h_layer, from_strain)
     results.update(extra or {})
+    # the position update's fallbacks (fdmRun's log.dem, every session): too many mean too large a dt
+    log_dem = os.path.join(run.run_dir, "log.dem")
+    counts = demonly.position_update_counts(_read(log_dem)) if os.path.isfile(log_dem) else None
+    results["position_update"] = counts
+    warning = demonly.time_step_too_large(counts)
+    if warning and not quiet:
+        print(warning)
     figure = figure_path(out)
     profiles.plot_profiles(figure, channel, avg, fine)
     results["figure"] = os.path.basename(figure)
