@@ -55,6 +55,11 @@ def test_tiny_scene_runs_converged_and_integrates_phi_exactly(couette, tiny_run)
                 "inner_iterations_mean", "inner_iterations_max"):
         assert np.isfinite(r[key]), key
     assert len(r["Sigma_c_hat"]) == 3
+    # the position update's counts, read from the run's log.dem: every step, and at this time step
+    # (within the measured limit) the log-gap targets are met in nearly all of them
+    from fdmsubgrid import demonly
+    assert r["position_update"]["steps"] == 20, r["position_update"]
+    assert r["position_update"]["fallback_fraction"] <= demonly.FALLBACK_FRACTION_LIMIT, r["position_update"]
     # the particles are sheared the right way round
     assert 0 < r["gamma_core_over_gamma0"] < 1.5
 
