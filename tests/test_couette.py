@@ -1,5 +1,6 @@
 """cases/couette (paper 6.1) on a tiny scene: a bidisperse frictional suspension between walls at
 -U and +U, run by the real fdmFoam and fdmDEM (about 30 s), and the case's bad input."""
+import json
 import os
 
 import numpy as np
@@ -482,3 +483,21 @@ def test_table8_runs_rows_at_once_and_names_a_stopped_one(tmp_path, monkeypatch)
     assert c0 >= min(a1, b1) - 0.05             # the third when a worker was free
     assert [r["status"] for r in json.loads(out.read_text())["rows"]] == ["not started"] * 3
     assert table8.default_jobs(1) >= table8.default_jobs(2) >= 1
+
+
+def test_particle_side_alone_from_a_written_scene(tmp_path, env):
+    """timeStepWithoutFluid.py --phi: the scene written by couette.py --write-only (not run), then its particle
+    side alone in the background shear; the bulk particle stress holds at least the spheres' own stresslets
+    (eta_r >= 1 + 2.5 phi: lubrication and contacts only add), and the row has the position update's counts."""
+    tool = load_case_module("couette", "timeStepWithoutFluid")
+    out = tmp_path / "t.json"
+    summary = tool.main(["--phi", "0.3", "--size", "8", "12", "7", "--dts", "0.04", "--strain", "4", "--from-strain",
+                         "1", "--workdir", str(tmp_path / "w"), "--out", str(out)])
+    scene = os.path.join(summary["run"], "dem")
+    assert os.path.isfile(os.path.join(scene, "in.couette")) and not os.path.exists(os.path.join(summary["run"], "log.dem"))
+    row = summary["rows"][0]
+    phi = float(os.path.basename(summary["run"]).split("_")[0][3:])
+    assert 0.28 < phi < 0.32
+    assert row["eta_r"] >= 1 + 2.5 * phi, row
+    assert row["position_update"]["steps"] == 100, row["position_update"]
+    assert json.loads(out.read_text())["rows"][0]["dt"] == 0.04

@@ -18,6 +18,7 @@ phi_m = 0.59); the scene is written by fdmsubgrid.suspension.write_case, shared 
   couette.py --acceleration none     the same with the plain inner iteration (issue 13, benchmark c)
   couette.py --table8 0.27           writes the paper's Table 8 scene for phi_bulk = 0.27 (box, N_P, dt)
                                      and stops (run it with fdmRun, or --run)
+  couette.py --phi 0.47 --write-only the scene written, not run (fdmRun, or timeStepWithoutFluid.py --run)
   couette.py --help                  every option
 Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png here (docs/cases.md).
 """
@@ -151,6 +152,8 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--table8", type=float, default=None, metavar="PHI",
                    help="the paper's Table 8 scene for phi_bulk = PHI (box, N_P, dt): written, not run")
     p.add_argument("--run", action="store_true", help="with --table8: run it too")
+    p.add_argument("--write-only", action="store_true", help="write the scene's folder and stop (as --table8 does): "
+                   "run it later with fdmRun, or its particle side alone with timeStepWithoutFluid.py --run")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None,
                    help="analyse this run folder as it stands (a resumed, stopped or running run) and write --out")
@@ -215,8 +218,9 @@ def main(argv: list[str] | None = None) -> dict:
     print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
           "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
                               " x ".join("%g" % v for v in args.size), scene["cells"], scene["steps"], dt, every))
-    if args.table8 is not None and not args.run:
-        print("Table 8 scene written, not run: fdmRun -f N -d M %s" % run_dir)
+    if (args.table8 is not None and not args.run) or args.write_only:
+        print("%s scene written, not run: fdmRun -f N -d M %s" % ("Table 8" if args.table8 is not None else "the",
+                                                                  run_dir))
         return dict(run_dir=run_dir, **scene)
 
     wall = case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)

@@ -12,9 +12,14 @@ range): a testbed in seconds of what the time step does to the particles' dynami
 
   timeStepWithoutFluid.py --run RUN_DIR                  dt 0.04, 0.02, 0.01, 120 strain units each
   timeStepWithoutFluid.py --run RUN_DIR --dts 0.04 --fix "integrator euler"
+  timeStepWithoutFluid.py --phi 0.52 --dts 0.0068 0.0034 0.0017 --strain 40
+                                                          the scene written first: couette.py --phi 0.52
+                                                          --size 10 16 8 --seed 1 --write-only (--size, --seed)
 
 RUN_DIR is a folder couette.py wrote (its dem/spheres.data and dem/in.couette are read; the scene's
-units: a1 = 1, eta = 1, gamma_dot_0 = 1). Writes <workdir>/dt<DT>/ per run and --out (JSON).
+units: a1 = 1, eta = 1, gamma_dot_0 = 1). Writes <workdir>/dt<DT>/ per run and --out (JSON). Each row
+also gives the position update's fallback fraction (demonly.position_update_counts): above a quarter of
+the steps the step is too large (docs/benchmarks.md, "What limits the time step").
 """
 from __future__ import annotations
 
@@ -74,7 +79,12 @@ def viscosity(records_path: str, from_strain: float) -> dict:
 
 def main(argv=None) -> dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--run", required=True, help="a Couette run folder (couette.py's RUN_DIR)")
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--run", help="a Couette run folder (couette.py's RUN_DIR)")
+    source.add_argument("--phi", type=float, help="write the Couette scene of this phi_bulk first (couette.py "
+                        "--write-only, in --workdir) and use it")
+    p.add_argument("--size", type=float, nargs=3, default=(10, 16, 8), help="with --phi: box in a1")
+    p.add_argument("--seed", type=int, default=1, help="with --phi: seed of the packing")
     p.add_argument("--dts", type=float, nargs="+", default=[0.04, 0.02, 0.01], help="time steps [1/gamma_dot_0]")
     p.add_argument("--strain", type=float, default=120.0, help="strain units per run")
     p.add_argument("--from-strain", type=float, default=6.0, help="average from this strain on")
@@ -83,6 +93,17 @@ def main(argv=None) -> dict:
     p.add_argument("--workdir", default=os.path.join(HERE, "runs", "timeStepWithoutFluid"))
     p.add_argument("--out", default="timeStepWithoutFluid.json")
     args = p.parse_args(argv)
+    if args.phi is not None:
+        scenes = os.path.join(args.workdir, "scene")
+        shutil.rmtree(scenes, ignore_errors=True)
+        written = subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--phi", repr(args.phi), "--size",
+                                  *map(repr, args.size), "--seed", str(args.seed), "--a-over-delta",
+                                  repr(args.a_over_delta), "--write-only", "--workdir", scenes],
+                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        print(written.stdout, end="")
+        if written.returncode != 0:
+            raise SystemExit("timeStepWithoutFluid: couette.py could not write the scene of phi_bulk %g" % args.phi)
+        args.run = os.path.join(scenes, os.listdir(scenes)[0])
     dem = os.path.join(args.run, "dem")
     for name in ("spheres.data", "in.couette"):
         if not os.path.isfile(os.path.join(dem, name)):
