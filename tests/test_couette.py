@@ -454,6 +454,14 @@ def test_table8_fits_only_finished_rows_with_a_full_window(tmp_path):
     assert fit["rows"] == [0.27, 0.32, 0.37] and fit["not_fitted"] == [0.47]
     assert abs(fit["alpha"] - alpha) < 1e-6 and abs(fit["phi_m"] - phi_m) < 1e-6
     assert "fit" not in table8.summarise(rows[:2] + rows[3:], args)
+    # a finished row whose position update fell back in most steps (too large a time step, its stress low):
+    # listed, not fitted
+    rows[3].update(status="finished", window_short=False,
+                   position_update=dict(steps=1250, fallback_steps=1040, limited=3300, fallback_fraction=0.832))
+    summary = table8.summarise(rows, args)
+    assert summary["fit"]["not_fitted"] == [0.47]
+    rows[3]["position_update"].update(fallback_steps=160, fallback_fraction=0.128)
+    assert table8.summarise(rows, args)["fit"]["rows"] == [0.27, 0.32, 0.37, 0.47]
 
 
 def test_table8_runs_rows_at_once_and_names_a_stopped_one(tmp_path, monkeypatch):

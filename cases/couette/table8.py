@@ -46,7 +46,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 
-from fdmsubgrid import checkpoint, output, rheology  # noqa: E402
+from fdmsubgrid import checkpoint, demonly, output, rheology  # noqa: E402
 from fdmsubgrid.shear import steps_planned  # noqa: E402
 
 sys.path.insert(0, HERE)
@@ -200,7 +200,7 @@ def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) ->
             "N2_hat N2_hat_err Sigma_c_hat Sigma_c_hat_err steady_from_strain steady_detected strain_units "
             "stress_balance_rel_error stress_balance_rel_error_err stress_gap_rel_error_max n_particles cells dt "
             "wall_seconds core_seconds_per_strain_unit inner_iterations_mean unconverged_steps min_pair_gap "
-            "min_wall_gap table8 springs").split()
+            "min_wall_gap table8 springs position_update").split()
     row.update({k: r.get(k) for k in keep})
     row["status"] = "finished" if done >= planned else "partial"
     row["strain_averaged"] = r["strain_units"] - r["steady_from_strain"]
@@ -208,9 +208,17 @@ def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) ->
     return row
 
 
+def step_too_large(row: Dict) -> bool:
+    """The run's position update fell back in more than demonly.FALLBACK_FRACTION_LIMIT of its steps: its
+    particle stress is low (docs/benchmarks.md, "What limits the time step")."""
+    return demonly.time_step_too_large(row.get("position_update")) is not None
+
+
 def fitted_rows(rows: List[Dict]) -> List[Dict]:
-    """The rows the Maron-Pierce fit takes: finished runs whose window holds --min-average units."""
-    return [r for r in rows if "eta_s" in r and r["status"] == "finished" and not r.get("window_short")]
+    """The rows the Maron-Pierce fit takes: finished runs whose window holds --min-average units and whose
+    time step was not too large."""
+    return [r for r in rows if "eta_s" in r and r["status"] == "finished" and not r.get("window_short")
+            and not step_too_large(r)]
 
 
 def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
@@ -262,10 +270,15 @@ def print_table(summary: Dict) -> None:
         print("Maron-Pierce fit over phi_bulk %s: alpha = %.3f ± %.3f, phi_m = %.3f ± %.3f (chi2 %.2f for %d dof); "
               "paper 0.803, 0.59%s" % (", ".join("%g" % x for x in f["rows"]), f["alpha"], f["alpha_error"], f["phi_m"],
                                        f["phi_m_error"], f["chi2"], f["dof"],
-                                       "; not fitted (partial or short): " + ", ".join("%g" % x for x in f["not_fitted"])
-                                       if f["not_fitted"] else ""))
+                                       "; not fitted (partial, short or too large a step): "
+                                       + ", ".join("%g" % x for x in f["not_fitted"]) if f["not_fitted"] else ""))
     else:
-        print("Maron-Pierce fit: needs 3 finished rows with a full window, has %d" % len(fitted_rows(summary["rows"])))
+        print("Maron-Pierce fit: needs 3 finished rows with a full window and a good step, has %d"
+              % len(fitted_rows(summary["rows"])))
+    for r in summary["rows"]:
+        warning = demonly.time_step_too_large(r.get("position_update"))
+        if warning:
+            print("phi_bulk %g: %s" % (r["phi_bulk_table8"], warning))
 
 
 def main(argv: Optional[List[str]] = None) -> Dict:
