@@ -77,6 +77,26 @@ def viscosity(records_path: str, from_strain: float) -> dict:
                 hydrodynamic=float(hydro[keep].mean()), gamma_core=float(np.mean(rates)), samples=int(keep.sum()))
 
 
+def report_progress(process: subprocess.Popen, log_path: str, dt: float, steps: int, t0: float,
+                    every: float = 60.0) -> None:
+    """Wait for fdmDEM, printing the step it reached (its thermo lines, every 1000 steps) and an ETA every
+    `every` seconds of a long run."""
+    last, shown = t0, 0
+    while process.poll() is None:
+        time.sleep(1.0)
+        if time.time() - last < every:
+            continue
+        last = time.time()
+        with open(log_path) as f:
+            reached = [int(line.split()[0]) for line in f if line.split() and line.split()[0].isdigit()]
+        if reached and reached[-1] > shown:
+            shown = reached[-1]
+            rate = (time.time() - t0) / reached[-1]
+            print("dt %g: step %d of %d (%.0f %%), about %.0f s to go" % (dt, reached[-1], steps,
+                                                                         100.0 * reached[-1] / steps,
+                                                                         rate * (steps - reached[-1])), flush=True)
+
+
 def main(argv=None) -> dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     source = p.add_mutually_exclusive_group(required=True)
@@ -121,8 +141,9 @@ def main(argv=None) -> dict:
             f.write(dem_input(couette_input, dt, steps, args.a_over_delta, args.fix))
         t0 = time.time()
         with open(os.path.join(folder, "log"), "w") as log:
-            done = subprocess.run([program("fdmDEM"), "-in", "in.dem", "-log", "none"], cwd=folder, stdout=log,
-                                  stderr=subprocess.STDOUT, env=run_environment())
+            done = subprocess.Popen([program("fdmDEM"), "-in", "in.dem", "-log", "none"], cwd=folder, stdout=log,
+                                    stderr=subprocess.STDOUT, env=run_environment())
+            report_progress(done, os.path.join(folder, "log"), dt, steps, t0)
         if done.returncode != 0:
             raise SystemExit("timeStepWithoutFluid: fdmDEM stopped at dt %g (exit code %d): see %s"
                              % (dt, done.returncode, os.path.join(folder, "log")))
