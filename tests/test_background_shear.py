@@ -56,13 +56,17 @@ def test_close_pair_across_the_shear_is_symmetric_and_slowed(tmp_path):
 
 
 def test_position_update_counts_are_read_from_the_log(tmp_path):
-    # the run-end line's log-gap counts (demonly.position_update_counts, which table runs and
-    # timeStepWithoutFluid.py report): a close pair sliding in the shear has a log-gap target every step
-    # and, alone, no contradictory targets
+    # the run-end line's log-gap counts (demonly.position_update_counts, which the Couette report, table8.py
+    # and timeStepWithoutFluid.py use): a close pair sliding in the shear has a log-gap target every step
+    # and, alone, no contradictory or limited targets
     logs = []
     run(tmp_path, [[6.0, 6.0 - 1.05, 6.0], [6.0, 6.0 + 1.05, 6.0]], [1.0, 1.0], steps=20, logs=logs)
     counts = demonly.position_update_counts(logs[0])
-    assert counts == dict(steps=20, fallback_steps=0, limited=0, fallback_fraction=0.0), counts
+    assert counts == dict(steps=20, fallback_steps=0, limited=0, fallback_fraction=0.0, particles=2,
+                          limited_per_particle_step=0.0), counts
     assert demonly.time_step_too_large(counts) is None
-    too_many = dict(counts, fallback_steps=15, fallback_fraction=0.75)
-    assert "15 of 20 steps" in demonly.time_step_too_large(too_many)
+    # beyond the limit: the coupled phi 0.47 small scene at dt 0.02 (1050 limited targets in 400 steps of 98)
+    too_large = dict(counts, steps=400, fallback_steps=333, limited=1050, particles=98,
+                     limited_per_particle_step=1050 / (400 * 98))
+    message = demonly.time_step_too_large(too_large)
+    assert "0.0268 gap targets per particle and step" in message and "333 of 400 steps" in message, message

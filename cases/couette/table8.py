@@ -209,8 +209,9 @@ def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) ->
 
 
 def step_too_large(row: Dict) -> bool:
-    """The run's position update fell back in more than demonly.FALLBACK_FRACTION_LIMIT of its steps: its
-    particle stress is low (docs/benchmarks.md, "What limits the time step")."""
+    """The run's position update limited more than demonly.LIMITED_RATE_LIMIT gap targets per particle and
+    step: its time step was too large and its particle stress is low (docs/benchmarks.md, "What limits the
+    time step")."""
     return demonly.time_step_too_large(row.get("position_update")) is not None
 
 

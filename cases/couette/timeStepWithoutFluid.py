@@ -18,8 +18,8 @@ range): a testbed in seconds of what the time step does to the particles' dynami
 
 RUN_DIR is a folder couette.py wrote (its dem/spheres.data and dem/in.couette are read; the scene's
 units: a1 = 1, eta = 1, gamma_dot_0 = 1). Writes <workdir>/dt<DT>/ per run and --out (JSON). Each row
-also gives the position update's fallback fraction (demonly.position_update_counts): above a quarter of
-the steps the step is too large (docs/benchmarks.md, "What limits the time step").
+also gives the position update's counts (demonly.position_update_counts): above 0.005 limited gap targets
+per particle and step the step is too large (docs/benchmarks.md, "What limits the time step").
 """
 from __future__ import annotations
 
@@ -151,13 +151,15 @@ def main(argv=None) -> dict:
         row.update(viscosity(os.path.join(folder, "particles.records"), args.from_strain))
         with open(os.path.join(folder, "log")) as log:
             counts = demonly.position_update_counts(log.read())
-        # the position update's fallbacks: beyond demonly.FALLBACK_FRACTION_LIMIT the step is too large
+        # the position update's counts: beyond demonly.LIMITED_RATE_LIMIT limited targets per particle and
+        # step the time step is too large
         row["position_update"] = counts
         rows.append(row)
         print("dt %-6g eta_r %.2f +- %.2f (contact %.2f, hydrodynamic %.2f), gamma_core %.3f, %d steps in %.0f s%s"
               % (dt, row["eta_r"], row["eta_r_err"], row["contact"], row["hydrodynamic"], row["gamma_core"], steps,
                  row["wall_seconds"], "" if counts is None else
-                 "; position update fell back in %.0f %% of the steps" % (100 * counts["fallback_fraction"])),
+                 "; position update: %.2g limited targets per particle and step, fallback in %.0f %% of the steps"
+                 % (counts["limited_per_particle_step"] or 0.0, 100 * counts["fallback_fraction"])),
               flush=True)
     summary = dict(run=os.path.abspath(args.run), strain=args.strain, from_strain=args.from_strain, rows=rows,
                    command="cases/couette/timeStepWithoutFluid.py " + " ".join(argv if argv is not None else sys.argv[1:]))
