@@ -64,8 +64,10 @@ TABLE8 = {
 # phi_bulk 0.27, 7 % at 0.32, 12-15 % at 0.37 and 21 % at 0.42 (as the coupled runs), dt 0.02 within
 # 3 % of 0.01 and 0.005 up to 0.42; at 0.47 dt 0.02 is 30 % below 0.01, which agrees with 0.005
 # (14.8 +- 0.7, 21.1 +- 0.9, 20.9 +- 0.7, 2026-11-27: "What limits the time step"). What sets the limit
-# is the position update: where its gap targets contradict each other in most steps (70-95 %) the
-# particle stress is low; the good steps have 1-15 % such steps. Beyond the densest measured row the
+# is the position update: where it limits more than 0.005 gap targets per particle and step (gaps asked to
+# change by more than a factor e in a step; 0.010-0.027 in the runs 12-30 % low, 0.0002-0.0027 in the good
+# ones) its targets contradict each other in most steps and the particle stress is low; a run reports it
+# (demonly.position_update_counts, docs/errors.md 27f). Beyond the densest measured row the
 # limit is carried with the stress scale, dt proportional to 1/eta_MP(phi) (Eq. 55): the loads in the
 # contacts, and the closing rates of loaded gaps, grow with it (0.0034 at 0.52, 0.0024 at 0.54).
 MEASURED_DT_LIMITS = {0.27: 0.04, 0.32: 0.02, 0.37: 0.02, 0.42: 0.02, 0.47: 0.01}
