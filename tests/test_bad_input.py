@@ -18,19 +18,22 @@ FDMRUN = os.path.join(PROJECT, "scripts", "fdmRun")
 
 
 def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None, n_particles=-1,
-              fdm_edit=None, fix_options="move no", runs=("run 2",), pair_style="none", dt=1.0):
+              fdm_edit=None, fix_options="move no", runs=("run 2",), pair_style="none", dt=1.0, connect_timeout=20):
+    # connect_timeout: short, so that a case where one code never starts fails quickly, but not so short
+    # that a loaded machine's start-up of the other code exceeds it (5 s did, beside two other jobs)
     box = box or case.Box((0, 0, 0), (4, 4, 4), 0.5)
     root = str(tmp_path / "case")
     fluid = os.path.join(root, "fluid")
     case.write_fluid_case(fluid, box, grad_p0=(-0.01, 0, 0), tol_lambda=1e-3, n_max=50,
                           n_particles=n_particles)
     props = os.path.join(fluid, "constant", "fdmProperties")
-    text = open(props).read().replace("connectTimeout 60", "connectTimeout 5")
+    text = open(props).read().replace("connectTimeout 60", "connectTimeout %d" % connect_timeout)
     if fdm_edit:
         text = fdm_edit(text)
     open(props, "w").write(text)
     case.write_dem_input(os.path.join(root, "dem"), dem_box or box, list(spheres),
-                         fix_options="connect_timeout 5 " + fix_options, runs=runs, pair_style=pair_style, dt=dt)
+                         fix_options="connect_timeout %d " % connect_timeout + fix_options, runs=runs,
+                         pair_style=pair_style, dt=dt)
     return root
 
 
@@ -130,7 +133,7 @@ def test_domain_mismatch(tmp_path, env):
 
 def test_fluid_alone_times_out(tmp_path, env):
     """fdmFoam waits for a particle code that never connects: a clear error within the timeout."""
-    root = make_case(tmp_path)
+    root = make_case(tmp_path, connect_timeout=5)
     subprocess.run(["blockMesh", "-case", os.path.join(root, "fluid")], env=env, check=True,
                    stdout=subprocess.DEVNULL)
     t0 = time.time()
@@ -143,7 +146,7 @@ def test_fluid_alone_times_out(tmp_path, env):
 
 def test_dem_alone_times_out(tmp_path, env):
     """fdmDEM waits for a fluid solver that never starts: a clear error within the timeout."""
-    root = make_case(tmp_path)
+    root = make_case(tmp_path, connect_timeout=5)
     t0 = time.time()
     proc = subprocess.run(["fdmDEM", "-in", "in.dem"], cwd=os.path.join(root, "dem"), env=env, text=True, errors="replace",
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60)
@@ -192,7 +195,7 @@ def fluid_alone(root, env):
     ("innerIterations/firstStep", "innerIterations\n{", "innerIterations\n{\n    firstStep { nmax 10; }", "nmax",
      "tolLambda tolVelocity nMax"),
     ("output", "coupling\n{", "output { particleEvery 2; }\ncoupling\n{", "particleEvery", "particlesEvery"),
-    ("coupling", "connectTimeout 5", "conectTimeout 5", "conectTimeout",
+    ("coupling", "connectTimeout 20", "conectTimeout 20", "conectTimeout",
      "transport host port portFile directory record"),
 ])
 def test_unknown_dictionary_entry(tmp_path, env, where, good, bad, key, valid):
