@@ -455,8 +455,8 @@ def test_table8_fits_only_finished_rows_with_a_full_window(tmp_path):
     assert fit["rows"] == [0.27, 0.32, 0.37] and fit["not_fitted"] == [0.47]
     assert abs(fit["alpha"] - alpha) < 1e-6 and abs(fit["phi_m"] - phi_m) < 1e-6
     assert "fit" not in table8.summarise(rows[:2] + rows[3:], args)
-    # a finished row whose position update fell back in most steps (too large a time step, its stress low):
-    # listed, not fitted
+    # a finished row whose position update limited too many gap targets (too large a time step, its stress
+    # low): listed, not fitted
     # (the counts of the coupled phi 0.47 small scene at dt 0.02 and 0.01, docs/benchmarks.md)
     rows[3].update(status="finished", window_short=False,
                    position_update=dict(steps=400, fallback_steps=333, limited=1050, fallback_fraction=0.8325,

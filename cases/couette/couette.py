@@ -73,13 +73,19 @@ TABLE8 = {
 MEASURED_DT_LIMITS = {0.27: 0.04, 0.32: 0.02, 0.37: 0.02, 0.42: 0.02, 0.47: 0.01}
 
 
-def largest_good_dt(phi: float) -> float:
-    """The largest time step [1/gamma_dot_0] measured good at the nearest measured volume fraction at or
-    above phi (within 0.01; a measured row counts for the packings of its nominal phi_bulk); beyond the
-    densest, that row's limit scaled by eta_MP(densest)/eta_MP(phi)."""
+def measured_reference(phi: float) -> float | None:
+    """The nearest measured volume fraction at or above phi (within 0.01: a measured row counts for the
+    packings of its nominal phi_bulk), None beyond the densest."""
     denser = [p for p in sorted(MEASURED_DT_LIMITS) if p >= phi - 0.01]
-    if denser:
-        return MEASURED_DT_LIMITS[denser[0]]
+    return denser[0] if denser else None
+
+
+def largest_good_dt(phi: float) -> float:
+    """The largest time step [1/gamma_dot_0] measured good at measured_reference(phi); beyond the densest,
+    that row's limit scaled by eta_MP(densest)/eta_MP(phi)."""
+    reference = measured_reference(phi)
+    if reference is not None:
+        return MEASURED_DT_LIMITS[reference]
     densest = max(MEASURED_DT_LIMITS)
     scaled = MEASURED_DT_LIMITS[densest] * (suspension.maron_pierce_viscosity(densest)
                                             / suspension.maron_pierce_viscosity(phi))
@@ -92,9 +98,9 @@ def time_step_warning(phi: float, dt: float) -> str | None:
     limit = largest_good_dt(phi)
     if dt <= limit * (1 + 1e-9):
         return None
-    denser = [p for p in sorted(MEASURED_DT_LIMITS) if p >= phi - 0.01]
-    if denser:
-        where = "the largest time step measured good at phi_bulk %g with these springs, %g" % (denser[0], limit)
+    reference = measured_reference(phi)
+    if reference is not None:
+        where = "the largest time step measured good at phi_bulk %g with these springs, %g" % (reference, limit)
     else:
         where = ("%g, the limit at phi_bulk %g scaled by the stress, 1/eta_MP(phi) (phi_bulk %.3g is denser "
                  "than any measured)" % (limit, max(MEASURED_DT_LIMITS), phi))

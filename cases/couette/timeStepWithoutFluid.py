@@ -38,6 +38,9 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 from fdmsubgrid import case, demonly, output, profiles, timeseries  # noqa: E402
 from fdmsubgrid.environment import program, run_environment  # noqa: E402
 
+sys.path.insert(0, HERE)
+import couette  # noqa: E402  (--phi: the scene is couette.py's, written and not run)
+
 ETA, SHEAR_RATE = 1.0, 1.0   # the Couette scenes' units (couette.py)
 
 
@@ -116,14 +119,8 @@ def main(argv=None) -> dict:
     if args.phi is not None:
         scenes = os.path.join(args.workdir, "scene")
         shutil.rmtree(scenes, ignore_errors=True)
-        written = subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--phi", repr(args.phi), "--size",
-                                  *map(repr, args.size), "--seed", str(args.seed), "--a-over-delta",
-                                  repr(args.a_over_delta), "--write-only", "--workdir", scenes],
-                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        print(written.stdout, end="")
-        if written.returncode != 0:
-            raise SystemExit("timeStepWithoutFluid: couette.py could not write the scene of phi_bulk %g" % args.phi)
-        args.run = os.path.join(scenes, os.listdir(scenes)[0])
+        args.run = couette.main(["--phi", repr(args.phi), "--size", *map(repr, args.size), "--seed", str(args.seed),
+                                 "--a-over-delta", repr(args.a_over_delta), "--write-only", "--workdir", scenes])["run_dir"]
     dem = os.path.join(args.run, "dem")
     for name in ("spheres.data", "in.couette"):
         if not os.path.isfile(os.path.join(dem, name)):

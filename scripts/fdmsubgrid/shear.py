@@ -251,7 +251,7 @@ def report(run: ShearRun, out: str, extra: dict | None = None, wall_seconds: flo
     it (figure_path), print the summary unless quiet; returns the results."""
     results, (channel, avg, fine, _) = analyse(run, wall_seconds, ranks, h_layer, from_strain)
     results.update(extra or {})
-    # the position update's fallbacks (fdmRun's log.dem, every session): too many mean too large a dt
+    # the position update's counts (fdmRun's log.dem, every session): too many limited targets mean too large a dt
     log_dem = os.path.join(run.run_dir, "log.dem")
     counts = demonly.position_update_counts(_read(log_dem)) if os.path.isfile(log_dem) else None
     results["position_update"] = counts
