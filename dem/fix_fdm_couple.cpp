@@ -146,6 +146,12 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
         error->all(FLERR, ("fix fdm/couple: background_shear needs a finite shear rate [1/s], got " +
                            std::string(value(1))).c_str());
       i++;
+    } else if (key == "fluid_every") {
+      fluidEvery_ = force->inumeric(FLERR, value(1));
+      if (fluidEvery_ < 1)
+        error->all(FLERR, ("fix fdm/couple: fluid_every K needs K >= 1 particle steps per fluid step, got " +
+                           std::string(value(1))).c_str());
+      i++;
     } else if (key == "coulomb_tolerance") {
       coulombTolerance_ = force->numeric(FLERR, value(1));
       if (!(coulombTolerance_ > 0 && coulombTolerance_ < 1))
@@ -164,6 +170,8 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   if (options.transport != "none" && backgroundShear_ != 0)
     error->all(FLERR, "fix fdm/couple: background_shear goes with transport none (with the fluid solver the "
                       "walls drive the flow)");
+  if (options.transport == "none" && fluidEvery_ > 1)
+    error->all(FLERR, "fix fdm/couple: fluid_every goes with the fluid solver (transport none has no fluid step)");
   if (options.transport == "none" && stresslets_ && backgroundShear_ == 0)
     error->all(FLERR, "fix fdm/couple: stresslets need the fluid solver, or, with transport none, a "
                       "background_shear (the isolated sphere's stresslet in it)");
@@ -493,7 +501,9 @@ cpl::Step FixFdmCouple::makeStep(const std::vector<Particle> &particles) const
 {
   cpl::Step step;
   step.step = update->ntimestep;
-  step.dt = update->dt;
+  // the fluid's step spans the particle steps since its last one (fluid_every K)
+  step.dt = lastFluidStep_ >= 0 && update->ntimestep > lastFluidStep_ ? double(update->ntimestep - lastFluidStep_) * update->dt
+                                                                      : update->dt;
   step.lastStep = update->laststep;
   step.checkpoint = checkpointDue();  // the fluid writes its own at the end of this step
   step.particles.resize(natoms_);
@@ -748,7 +758,12 @@ void FixFdmCouple::final_integrate()
   assembleSystem(particles);
   run_.solve += MPI_Wtime() - t0;
 
-  if (comm->me == 0 && !hasFluid_) {
+  const bool fluidStep = hasFluid_ && fluidStepDue();
+  if (comm->me == 0 && hasFluid_ && !fluidStep) {
+    t0 = MPI_Wtime();
+    frozenFluidStep(particles);
+    run_.solve += MPI_Wtime() - t0;
+  } else if (comm->me == 0 && !hasFluid_) {
     t0 = MPI_Wtime();
     setVolumes(noFluidVolumes(particles));
     cpl::Integrals atRest;  // no fluid: no fluid force
@@ -834,7 +849,61 @@ void FixFdmCouple::final_integrate()
   scatter();
   run_.gatherScatter += MPI_Wtime() - t0;
   run_.steps++;
+  if (fluidStep) {
+    run_.fluidSteps++;
+    lastFluidStep_ = update->ntimestep;
+  }
   if (checkpointDue()) writeCheckpoint();
+}
+
+bool FixFdmCouple::fluidStepDue() const
+{
+  // fluid_every K: the fluid is solved at every K-th step, and always where the particle side has no
+  // fluid solution to hold yet (a run's first step), at a checkpoint (the fluid writes its own at the
+  // same step, so that a resumed run continues both from one step) and at the last step of a run
+  if (fluidEvery_ <= 1 || lastFluidStep_ < 0 || !haveVelocities_ || hydro_.size() != size_t(6) * natoms_) return true;
+  const bigint step = update->ntimestep;
+  return step % fluidEvery_ == 0 || step == update->laststep || checkpointDue();
+}
+
+void FixFdmCouple::frozenFluidStep(const std::vector<Particle> &particles)
+{
+  // rank 0, a step between fluid steps (fluid_every K, docs/dem.md "Particle steps between fluid
+  // steps"): the fluid's force on each particle is held as the Stokes drag of an isolated sphere toward
+  // the velocity u_b it saw at the last fluid step, F = 6 pi eta a (U_b - U), T = 8 pi eta a^3
+  // (Omega_b - Omega), with U_b = U + F^FDM/(6 pi eta a) from that step's converged U and F^FDM (and
+  // the same for Omega), so that Eq. (31) at unchanged positions gives that step's velocities again (to
+  // the inner iteration's tolerance).
+  // R^SG, the contact springs and the position update follow the particles as in every step: they
+  // change within a fluid step, where the far field does not. The sphere's drag D U_b = D U + F is the
+  // same whichever step of the cycle it is taken from (between fluid steps F = D (U_b - U)), so U_b
+  // needs no state of its own and a resumed run rebuilds it from U and F of its checkpoint.
+  const cpl::Volumes drag = noFluidVolumes(particles);
+  const double rho = session_.rhoFluid(), alpha = session_.alphaLambda();
+  setVolumes(drag);
+  cpl::Integrals held;
+  held.step = update->ntimestep;
+  held.iteration = 1;
+  held.particles.resize(natoms_);
+  for (int p = 0; p < natoms_; p++) {
+    // noFluidVolumes holds D alpha/rho_f in Vu and J: D = rho_f Vu/alpha (Eq. 31's rigid-body blocks)
+    const double translation = rho * drag.particles[p].Vu / alpha, rotation = rho * drag.particles[p].J[0] / alpha;
+    for (int d = 0; d < 3; d++) {
+      held.particles[p].F[d] = translation * currentVelocity_[size_t(6) * p + d] + hydro_[size_t(6) * p + d];
+      held.particles[p].T[d] = rotation * currentVelocity_[size_t(6) * p + 3 + d] + hydro_[size_t(6) * p + 3 + d];
+    }
+  }
+  solveVelocities(held);
+  const std::vector<double> dragTimesU = system_->rigidBlocksTimes(solution_);
+  for (int p = 0; p < natoms_; p++)
+    for (int d = 0; d < 3; d++) {
+      hydro_[size_t(6) * p + d] = held.particles[p].F[d] - dragTimesU[size_t(6) * p + d];
+      hydro_[size_t(6) * p + 3 + d] = held.particles[p].T[d] - dragTimesU[size_t(6) * p + 3 + d];
+    }
+  // the fluid's stresslets (fluidStress_) stay those of the last fluid step; the sub-grid and contact
+  // ones follow the particles
+  subgridResults(particles);
+  lastIterations_ = 0;
 }
 
 void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
@@ -1108,14 +1177,16 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
                 "%s iterations mean %.1f max %ld, %ld factorisations, %ld low-rank downdates, %ld back-substitutions (Coulomb rounds, at most %ld in a solve); last step %ld sub-grid pair blocks, %ld wall "
                 "blocks, %ld contacts; "
-                "%ld contacts began to slide within their step%s; position update %s%s%s\n",
+                "%ld contacts began to slide within their step%s; position update %s%s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves,
                 fdm::ParticleVelocitySystem::solverName(solver_),
                 t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations, t.downdates, t.backSubstitutions, t.coulombRoundsMax,
                 pairBlocks_, wallBlocks_, contacts_, t.contactSlides, chordStats.c_str(),
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
-                notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "");
+                notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "",
+                fluidEvery_ > 1 ? ("; fluid_every " + std::to_string(fluidEvery_) + ": the fluid solved in " +
+                                   std::to_string(t.fluidSteps) + " of the steps").c_str() : "");
   if (screen) fputs(line, screen);
   if (logfile) fputs(line, logfile);
 }

@@ -5,6 +5,7 @@
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
                            [stresslets yes|no] [solver cg|ldlt] [tolerance t] [integrator ab2|euler]
                            [gap_update log|none] [contact_gaps hold|free] [checkpoint N] [walls FILE]
+                           [fluid_every K]
      fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
@@ -13,6 +14,8 @@
    integrals it receives, until fdmFoam reports convergence. Replaces fix nve/sphere. With
    pair_style fdm/subgrid, the sub-grid lubrication blocks R^SG (pairs and walls) are gathered on
    rank 0 once per time step and enter the matrix of Eq. (31) (paper section 4.4.2).
+   With fluid_every K the fluid is solved at every K-th step only; the steps between hold its force on
+   each particle as an isolated sphere's drag toward the velocity the fluid gave it (frozenFluidStep).
    Eq. (31) itself is particle_velocity_system.h; the connection to fdmFoam and what it said at the
    handshake are the process's coupling session (coupling_session.h), which this fix configures.
 
@@ -63,7 +66,7 @@ class FixFdmCouple : public Fix {
   // Wall-clock seconds spent in the three parts of the particle side's work.
   struct Timing {
     double solve, exchange, gatherScatter;
-    long steps, solves, solverIterations, solverIterationsMax;
+    long steps, fluidSteps, solves, solverIterations, solverIterationsMax;
     long gapTargets, gapLimited;   // log-gap targets of the position update, and those limited
     long gapHeld;                  // contact (or closed) gaps held at their straight-step value
     long gapFallbacks;             // steps where the targets contradicted each other (the fallback:
@@ -76,7 +79,7 @@ class FixFdmCouple : public Fix {
     long backSubstitutions;        // of Eq. (31): one per Coulomb round of each solve
     long coulombRoundsMax;         // the most rounds of one solve (100 stops the rounds where they stand)
     double chordForceMax;          // the largest chord term of a pair spring (Eq. C5 of docs/contact.md) [N]
-    Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), solves(0), solverIterations(0), solverIterationsMax(0),
+    Timing() : solve(0), exchange(0), gatherScatter(0), steps(0), fluidSteps(0), solves(0), solverIterations(0), solverIterationsMax(0),
                gapTargets(0), gapLimited(0), gapHeld(0), gapFallbacks(0), gapSweepsMax(0), gapBoundWorst(0),
                contactSlides(0), factorisations(0), downdates(0), backSubstitutions(0), coulombRoundsMax(0),
                chordForceMax(0) {}
@@ -93,6 +96,8 @@ class FixFdmCouple : public Fix {
   void subgridResults(const std::vector<Particle> &particles);
   fdm::coupler::Volumes noFluidVolumes(const std::vector<Particle> &particles) const;
   void backgroundFlow(const std::vector<Particle> &particles, fdm::coupler::Integrals &integrals);
+  bool fluidStepDue() const;
+  void frozenFluidStep(const std::vector<Particle> &particles);
   void storeStepDone(const fdm::coupler::StepDone &done);
   void planNextMove(const std::vector<Particle> &particles);
   void scatter();
@@ -142,6 +147,11 @@ class FixFdmCouple : public Fix {
   long notConverged_;              // steps where the fluid reported converged=0
   Timing run_;                     // this run
   double backgroundShear_ = 0;     // transport none: the simple shear rate the spheres' drag sees
+  // fluid_every K: the fluid is solved every K-th step; the steps between hold its force as the drag
+  // toward the velocities it gave (frozenFluidStep). lastFluidStep_: the last step the fluid solved
+  // (-1: none yet in this session, or a checkpoint's step after a resume)
+  long fluidEvery_ = 1;
+  bigint lastFluidStep_ = -1;
   double runStart_;
   int nmax_;                       // rows allocated in array_atom
   double **perAtom_;

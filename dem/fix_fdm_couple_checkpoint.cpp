@@ -244,6 +244,8 @@ void FixFdmCouple::restoreCheckpoint()
     if (history) history->restoreAtom(i, &c.arrays.at("contactHistory")[offset[t]]);
     for (int k = 0; k < wallWidth; k++) wallHistory->array_atom[i][k] = c.arrays.at("wallHistory")[size_t(wallWidth) * t + k];
   }
+  // a checkpoint's step is always one the fluid solved (fluidStepDue): the next fluid step spans from it
+  lastFluidStep_ = c.step;
   havePlan_ = state[0] != 0;
   haveVelocities_ = state[1] != 0;
   lastIterations_ = int(state[2]);

@@ -147,6 +147,25 @@ def test_table8_scene(couette, tmp_path):
     assert data.min_wall_gap >= 2 * couette.ROUGHNESS * (1 - 1e-12)
 
 
+def test_fluid_every_puts_every_snapshot_on_a_fluid_step(couette, tmp_path):
+    """--fluid-every K: fix fdm/couple gets fluid_every K, the particle snapshots and the ParaView writes
+    fall on multiples of K (steps the fluid solves; fdmFoam's time index is the DEM step, so its
+    writeInterval counts DEM steps too); a snapshot between fluid steps is refused."""
+    scene = couette.main(TINY + ["--fluid-every", "3", "--write-every", "0.2", "--write-only",
+                                 "--workdir", str(tmp_path)])
+    assert scene["fluid_every"] == 3 and scene["dump_every"] == 3 and scene["write_every"] == 9
+    assert scene["run_dir"].endswith("_fluidEvery3")
+    fix = next(l for l in open(os.path.join(scene["run_dir"], "dem", "in.couette")) if "fdm/couple" in l)
+    assert fix.split()[-2:] == ["fluid_every", "3"]
+    control = open(os.path.join(scene["run_dir"], "fluid", "system", "controlDict")).read()
+    assert "writeInterval   9;" in control
+    pack = packing.read_data(os.path.join(scene["run_dir"], "dem", "packing.data"), walls=(1,))
+    springs = couette.choose_springs(pack.phi, 0.02, 1 / 3)
+    with pytest.raises(ValueError, match="dump_every = 5 steps is not a multiple of fluid_every = 2"):
+        couette.write_case(str(tmp_path / "bad"), pack, springs, 3, 0.02, 0.4, 5, 1e-2, "anderson",
+                           write_every=10, fluid_every=2)
+
+
 def test_channel_packing_any_box():
     p = packing.channel_packing((9, 14, 7), phi=0.35, seed=4)
     n1, n2 = np.sum(p.types == 1), np.sum(p.types == 2)
@@ -375,6 +394,7 @@ def test_time_step_beyond_the_measured_limit_is_warned(couette):
     assert couette.time_step_warning(0.47, 0.01) is None
     message = couette.time_step_warning(0.4691, 0.02)          # the small scene of the study at 0.47
     assert "dt = 0.02" in message and "phi_bulk 0.47" in message and "0.01" in message and "viscosity" in message
+    assert message.endswith("--dt 0.01 --fluid-every 2"), message   # the same fluid step, good particle steps
     assert couette.time_step_warning(0.2682, 0.04) is None     # the Table 8 row of phi_bulk 0.27
     assert "phi_bulk 0.32" in couette.time_step_warning(0.3032, 0.04)   # the run time against error scene
     message = couette.time_step_warning(0.3687, 0.04)          # the Table 8 row of phi_bulk 0.37 (ran so)
@@ -390,6 +410,10 @@ def test_time_step_beyond_the_measured_limit_is_warned(couette):
     assert limits == sorted(limits, reverse=True) and limits[-2:] == [0.0034, 0.0024]
     from fdmsubgrid import suspension
     assert limits[-1] <= 0.01 * suspension.maron_pierce_viscosity(0.47) / suspension.maron_pierce_viscosity(0.54)
+    # the fluid every 0.04 up to 0.42, every 0.02 beyond, where the particle step is smaller
+    assert [couette.fluid_dt(phi) for phi in (0.27, 0.42, 0.4691, 0.54)] == [0.04, 0.04, 0.02, 0.02]
+    assert [couette.fluid_every(phi) for phi in (0.27, 0.32, 0.42, 0.47, 0.52, 0.54)] == [1, 2, 2, 2, 6, 8]
+    assert couette.fluid_every(0.47, dt=0.005) == 4
 
 
 def test_table8_names_a_run_that_stopped(tmp_path, env):
@@ -421,6 +445,11 @@ def test_table8_extends_a_run_whose_averaging_window_is_short():
     assert table8.row_dt(0.42, args) == 0.02     # dt 0.04 is 26 % low there (docs/benchmarks.md)
     assert table8.row_dt(0.47, argparse.Namespace(dt=0.02)) == 0.02
     assert table8.row_dt(0.54, args) == 0.0024   # beyond the densest measured: scaled by 1/eta_MP
+    # the fluid every 0.04 up to 0.42 (2 particle steps per fluid step at 0.37), 0.02 beyond (2 at 0.47, 8 at
+    # 0.54); --dt 0.02 at 0.47: every step
+    assert [table8.row_fluid_every(phi, args) for phi in (0.27, 0.37, 0.47, 0.54)] == [1, 2, 2, 8]
+    assert table8.row_fluid_every(0.47, argparse.Namespace(dt=0.02, fluid_every=None)) == 1
+    assert table8.row_fluid_every(0.47, argparse.Namespace(dt=None, fluid_every=3)) == 3
     # 25 strain units (625 steps), transient to strain 12.1: 12.9 averaged, 7.1 short = 177.5 -> 178 steps
     assert table8.extension(dict(steps_done=625, strain_averaged=12.9), args, 0.04) == 625 + 178
     assert table8.extension(dict(steps_done=625, strain_averaged=20.0), args, 0.04) is None
@@ -466,6 +495,18 @@ def test_table8_fits_only_finished_rows_with_a_full_window(tmp_path):
     rows[3]["position_update"].update(steps=800, fallback_steps=104, limited=212, fallback_fraction=0.13,
                                       limited_per_particle_step=212 / (800 * 98))
     assert table8.summarise(rows, args)["fit"]["rows"] == [0.27, 0.32, 0.37, 0.47]
+
+
+def test_table8_finds_the_run_of_its_fluid_every(tmp_path):
+    """A row's run folder is the one of its particle step and fluid_every: the run with the fluid at every
+    step (no suffix) and the one with particle steps between fluid steps are different rows."""
+    table8 = load_case_module("couette", "table8")
+    base = "table8_phi0.47_25x25x20_ad3_dt0.01_seed1_calibrated"
+    for name in (base, base + "_fluidEvery2"):
+        (tmp_path / name).mkdir()
+    assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated") == str(tmp_path / base)
+    assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated", 2) == str(tmp_path / (base + "_fluidEvery2"))
+    assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated", 4) is None
 
 
 def test_table8_runs_rows_at_once_and_names_a_stopped_one(tmp_path, monkeypatch):

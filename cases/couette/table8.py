@@ -3,8 +3,10 @@
 run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq. 55).
 
   table8.py                                 phi_bulk 0.27, 0.37, 0.47 (25 strain units, tolLambda 1e-2,
-                                            each row at the largest time step measured good there:
-                                            0.04, 0.02, 0.01)
+                                            each row's particles at the largest time step measured good
+                                            there: 0.04, 0.02, 0.01, and the fluid every 0.04 up to 0.42,
+                                            0.02 beyond: couette.fluid_every, 1, 2 and 2 particle steps
+                                            per fluid step)
   table8.py --phis 0.27 0.32 0.37 0.42 0.47 0.52 0.54   all seven rows
   table8.py --analyse-only                  the runs as they stand (partial runs reported with the
                                             strain they reached), nothing run
@@ -61,10 +63,19 @@ MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as star
 
 
 def row_dt(phi: float, args: argparse.Namespace) -> float:
-    """The time step of the row phi_bulk: --dt if given, else couette.largest_good_dt(phi)."""
+    """The (particle) time step of the row phi_bulk: --dt if given, else couette.largest_good_dt(phi)."""
     if args.dt is not None:
         return args.dt
     return couette.largest_good_dt(phi)
+
+
+def row_fluid_every(phi: float, args: argparse.Namespace) -> int:
+    """Particle steps per fluid step of the row phi_bulk: --fluid-every if given, else
+    couette.fluid_every(phi, dt) (the fluid every couette.fluid_dt(phi) or so; 1 where the particle step is
+    that large already)."""
+    if getattr(args, "fluid_every", None) is not None:
+        return args.fluid_every
+    return couette.fluid_every(phi, row_dt(phi, args))
 
 
 def default_jobs(np_fluid: int) -> int:
@@ -73,12 +84,14 @@ def default_jobs(np_fluid: int) -> int:
     return max(1, len(os.sched_getaffinity(0)) // max(1, np_fluid))
 
 
-def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int, model: str) -> Optional[str]:
-    """The run folder couette.py --table8 wrote for this row and sub-grid model, if any (a folder
-    without the model in its name is from before the name said it: the cut-off model's)."""
+def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int, model: str,
+             fluid_every: int = 1) -> Optional[str]:
+    """The run folder couette.py --table8 wrote for this row, sub-grid model and fluid_every, if any (a
+    folder without the model in its name is from before the name said it: the cut-off model's)."""
     pattern = os.path.join(workdir, "table8_phi%g_*_ad%g_dt%g_seed%d" % (phi, a_over_delta, dt, seed))
-    found = sorted(d for d in glob.glob(pattern + "_" + model) + (glob.glob(pattern) if model == "cutoff" else [])
-                   if os.path.isdir(d))
+    every = "_fluidEvery%d" % fluid_every if fluid_every > 1 else ""
+    found = sorted(d for d in glob.glob(pattern + "_" + model + every)
+                   + (glob.glob(pattern + every) if model == "cutoff" else []) if os.path.isdir(d))
     return found[0] if found else None
 
 
@@ -152,7 +165,8 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
     or None if none was made (--min-average 0). A run that another process is running is waited for,
     never started a second time."""
     dt = row_dt(phi, args)
-    run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model)
+    every = row_fluid_every(phi, args)
+    run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every)
     if run_dir is not None and running_elsewhere(run_dir):
         print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
         while running_elsewhere(run_dir):
@@ -161,8 +175,8 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
         subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(dt),
                         "--strain", str(args.strain), "--a-over-delta", str(args.a_over_delta),
                         "--seed", str(args.seed), "--n-max", str(args.n_max), "--tol-lambda", str(args.tol_lambda),
-                        "--model", args.model, "--workdir", args.workdir], check=True)
-        run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model)
+                        "--model", args.model, "--fluid-every", str(every), "--workdir", args.workdir], check=True)
+        run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every)
     if steps_done(run_dir) < steps_planned(run_dir):
         print("table8: phi_bulk %g:" % phi, end=" ", flush=True)
         # to the input's last step: an extension killed before its first checkpoint resumes from one
@@ -183,7 +197,7 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
 
 def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) -> Dict:
     """couette.py --analyse of the run as it stands, with the paper's row."""
-    row: Dict = dict(phi_bulk_table8=phi, run_dir=run_dir)
+    row: Dict = dict(phi_bulk_table8=phi, run_dir=run_dir, fluid_every=row_fluid_every(phi, args))
     dt = row_dt(phi, args)
     if run_dir is None:
         return row | dict(status="not started")
@@ -230,6 +244,8 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
     dts = sorted({row_dt(r["phi_bulk_table8"], args) for r in rows})
     summary: Dict = dict(rows=rows, paper_fit=PAPER_FIT, a_over_delta=args.a_over_delta,
                          dt={"%g" % r["phi_bulk_table8"]: row_dt(r["phi_bulk_table8"], args) for r in rows},
+                         fluid_every={"%g" % r["phi_bulk_table8"]: row_fluid_every(r["phi_bulk_table8"], args)
+                                      for r in rows},
                          tol_lambda=args.tol_lambda, strain=args.strain, seed=args.seed)
     fit = None
     if len(fitted) >= 3:
@@ -244,8 +260,9 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
         rheology.plot_viscosity(figure, [r["phi_core"] for r in done], [r["eta_s"] for r in done],
                                 [r["eta_s_err"] for r in done], fit=fit,
                                 phi_core_error=[r.get("phi_core_err") or 0.0 for r in done],
-                                label="this project (a1/Δ = %g, Δt = %s)" % (args.a_over_delta,
-                                                                             ", ".join("%g" % d for d in dts)),
+                                label="this project (a1/Δ = %g, Δt = %s)" % (args.a_over_delta, ", ".join(
+                                    "%g" % d for d in dts) + ("; particle steps between fluid steps"
+                                                              if any(k > 1 for k in summary["fluid_every"].values()) else "")),
                                 title="Fig. 21: η_s(φ_core)", reference=rheology.PAPER_MARON_PIERCE)
         summary["figure"] = os.path.basename(figure)
     return summary
@@ -289,6 +306,10 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 of every row "
                    "(default: the largest measured good at its phi_bulk, couette.largest_good_dt: %s)"
                    % ", ".join("%g at %g" % (couette.largest_good_dt(phi), phi) for phi in sorted(couette.TABLE8)))
+    p.add_argument("--fluid-every", type=int, default=None, metavar="K",
+                   help="particle steps per fluid step of every row (default couette.fluid_every: the fluid every "
+                   "couette.fluid_dt(phi), %s)" % ", ".join(
+                       "%d at %g" % (couette.fluid_every(phi), phi) for phi in sorted(couette.TABLE8)))
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",
@@ -338,7 +359,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                 if row is not None:
                     analysed[phi] = row
     rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args),
-                                                            args.seed, args.model), args)
+                                                            args.seed, args.model, row_fluid_every(phi, args)), args)
             for phi in args.phis]
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])

@@ -421,6 +421,14 @@ TEST(FdmDEMErrors, CoulombToleranceOutOfRange)
                   "fix fdm/couple: coulomb_tolerance (of the sliding contacts' forces) must be in (0, 1), got 2", false);
 }
 
+TEST(FdmDEMErrors, FluidEveryBelowOne)
+{
+    Scene scene;
+    scene.fixOptions = "fluid_every 0";
+    expectFailure("fluid-every", scene, nullptr,
+                  "fix fdm/couple: fluid_every K needs K >= 1 particle steps per fluid step, got 0", false);
+}
+
 TEST(FdmDEMErrors, BackgroundShearWithTheFluid)
 {
     Scene scene;

@@ -119,6 +119,7 @@ int main(int argc, char *argv[])
     // steps of the run before this session (a resumed run continues its count)
     const label stepsBefore = label(resumed.stepsDone);
     label lastCheckpoint = -1;
+    label sessionFirstStep = -1;    // the DEM step of this session's first Step
     const double runStart = wallClock();
     // waiting for the particle code to connect is not part of the run
     const scalar exchangeBeforeRun = coupling.exchangeTime();
@@ -148,6 +149,10 @@ int main(int argc, char *argv[])
     while (coupling.receiveStep(stepParticles))
     {
         const double stepStart = wallClock();
+        if (sessionFirstStep < 0)
+        {
+            sessionFirstStep = coupling.step();
+        }
         const scalar exchangeAtStart = coupling.exchangeTime();
         scalar stepFluidTime = 0, stepParticleTime = 0;
 
@@ -159,6 +164,11 @@ int main(int argc, char *argv[])
         }
         forcing.setParticles(stepParticles);
         runTime.setDeltaT(coupling.dt());
+        // The time index is the DEM step, also where the fluid solves only
+        // every K-th one (fix fdm/couple ... fluid_every K: the step then
+        // spans K of them): writeInterval and the function objects count DEM
+        // steps, and a write time is one of the particles' output steps
+        runTime.setTime(runTime.value(), label(coupling.step()) - 1);
         ++runTime;
 
         // Step 2
@@ -318,15 +328,18 @@ int main(int argc, char *argv[])
         fluidTime += stepFluidTime;
         particleTime += stepParticleTime;
 
+        // the ETA per DEM step: with fix fdm/couple ... fluid_every K the
+        // fluid solves only every K-th of them
         const scalar elapsed = wallClock() - runStart;
         const label remaining = max(label(0), coupling.lastStep() - coupling.step());
+        const label demStepsDone = max(label(1), coupling.step() - sessionFirstStep + 1);
         Info<< "Step " << coupling.step() << " t = " << runTime.timeName()
             << "  inner " << innerIteration << "  residual lambda " << residual
             << "  velocity error " << convergence.errorEstimate()
             << (converged ? "" : " (NOT converged)")
             << "  | fluid " << stepFluidTime << " s, particles "
             << stepParticleTime << " s, exchange " << stepExchangeTime
-            << " s | ETA " << remaining*elapsed/nStepsDone << " s" << endl;
+            << " s | ETA " << remaining*elapsed/demStepsDone << " s" << endl;
 
         if (!converged)
         {

@@ -89,7 +89,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
                text_dump: bool = False, model: str = "calibrated", wall_velocities: tuple[float, float] = (0.0, 0.0),
                grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension",
-               fluid_options: dict | None = None) -> dict:
+               fluid_options: dict | None = None, fluid_every: int = 1) -> dict:
     """fluid/ and dem/ of the run; returns the scene's description. wall_velocities: the x velocities of
     the walls y = 0 and y = L_y; grad_p0: the uniform pressure gradient (Eq. 58) [Pa/m]. model:
     pair_style fdm/subgrid's sub-grid model (calibrated, the default: what the solver resolves, measured;
@@ -97,7 +97,16 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     fdm/output), and written for ParaView with the fluid fields every write_every steps
     (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also the LIGGGHTS text dump
     dem/particles.dump of the same steps (for comparisons). fluid_options: more (or other) arguments
-    of case.write_fluid_case, e.g. first_step or mean_flow_damping."""
+    of case.write_fluid_case, e.g. first_step or mean_flow_damping. fluid_every: the fluid is solved every
+    fluid_every-th particle step (fix fdm/couple ... fluid_every K, docs/dem.md "Particle steps between
+    fluid steps"); dump_every and write_every must then be multiples of it, so that every snapshot is
+    of a step the fluid solved."""
+    if fluid_every < 1:
+        raise ValueError("fluid_every must be at least 1, got %r" % fluid_every)
+    for what, every in (("dump_every", dump_every), ("write_every", write_every)):
+        if every % fluid_every:
+            raise ValueError("%s = %d steps is not a multiple of fluid_every = %d: a snapshot would fall between "
+                             "fluid steps" % (what, every, fluid_every))
     delta = A1 / a_over_delta
     Lx, Ly, Lz = (float(v) for v in pack.box)
     u_lo, u_hi = (float(u) for u in wall_velocities)
@@ -118,9 +127,10 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                "run             %d upto" % steps])   # upto: a resumed run ends at the same step
     # a checkpoint every 10 snapshots and at the end: fdmRun --resume continues a killed run (docs/coupling.md)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
-                         fix_options="stresslets yes checkpoint %d walls walls.dat" % (10 * dump_every), runs=runs,
+                         fix_options="stresslets yes checkpoint %d walls walls.dat%s"
+                         % (10 * dump_every, " fluid_every %d" % fluid_every if fluid_every > 1 else ""), runs=runs,
                          name=name)
     packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
     return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
                 wall_velocities=[u_lo, u_hi], grad_p0=list(grad_p0), dt=dt, dump_every=dump_every,
-                write_every=write_every, subgrid_model=model)
+                write_every=write_every, subgrid_model=model, fluid_every=fluid_every)

@@ -1,0 +1,181 @@
+#!/usr/bin/env python3
+"""Particle steps between fluid steps (fix fdm/couple ... fluid_every K): the time-step error and the
+cost of a sheared suspension, side by side (issue 11; docs/benchmarks.md, "Particle steps between
+fluid steps").
+
+Every variant DT:K is the same Couette scene (couette.py: the same packing for the same phi_bulk, box
+and seed) run for a short strain with the particle step DT (in 1/gamma_dot_0) and the fluid solved
+every K-th step (its step K DT). Over the first strain unit or so the runs start from the same
+packing and stay close: the wall shear stress against strain is then a deterministic curve, and its
+difference from the reference run (the first variant, the finest step) is the time-step error, free
+of the sampling noise of a long average (a run of 8 strain units at phi 0.47 in the small scene
+averages to +-2-5 %, more than the error sought). Past that the trajectories separate as many-body
+trajectories do; --window sets the strain range compared.
+
+  fluidEvery.py --jobs 2                      phi 0.47, the small scene 10 x 16 x 8 a1, variants 0.005:1
+                                              (reference) 0.02:1 0.01:1 0.01:2 0.005:4 0.01:4 0.02:2 0.0025:8
+  fluidEvery.py --phi 0.42 --variants 0.005:1 0.04:1 0.02:1 0.02:2 0.01:4 0.01:2 --jobs 2
+
+Writes <workdir>/<variant>.json per variant (a variant whose file exists is not run again) and --out
+(default docs/benchmarks_fluidEvery_phi<PHI>.json) with a figure beside it (the stress curves, and the
+error against the wall time).
+"""
+import argparse
+import json
+import os
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from typing import Dict, List, Tuple
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PROJECT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(PROJECT, "scripts"))
+sys.path.insert(0, HERE)
+
+from fdmsubgrid import case, demonly, output  # noqa: E402
+import couette  # noqa: E402
+
+DEFAULT_VARIANTS = ["0.005:1", "0.02:1", "0.01:1", "0.01:2", "0.005:4", "0.01:4", "0.02:2", "0.0025:8"]
+
+
+def parse_variant(text: str) -> Tuple[float, int]:
+    """'DT:K' -> (DT, K)."""
+    try:
+        dt, k = text.split(":")
+        dt_value, k_value = float(dt), int(k)
+    except ValueError:
+        raise argparse.ArgumentTypeError("a variant is DT:K (particle step, steps per fluid step), got %r" % text)
+    if dt_value <= 0 or k_value < 1:
+        raise argparse.ArgumentTypeError("%r: DT must be positive and K at least 1" % text)
+    return dt_value, k_value
+
+
+def variant_name(dt: float, k: int) -> str:
+    return "dt%g_every%d" % (dt, k)
+
+
+def wall_stress_curve(run_dir: str) -> Tuple[np.ndarray, np.ndarray]:
+    """Strain (gamma_dot_0 t) and the shear stress of the suspension on the walls (fluid + sub-grid +
+    contact, the mean of both walls' |F_x|/A) at the steps the fluid solved."""
+    loads = output.read_wall_loads(run_dir)
+    fx = np.abs(loads.total[:, :, 0]) / loads.areas[None, :]
+    return loads.times * couette.SHEAR_RATE, fx.mean(axis=1)
+
+
+def run_variant(dt: float, k: int, args: argparse.Namespace) -> Dict:
+    """One variant (or its results file): wall time, fluid steps, inner iterations per fluid step, the
+    position update's counts and the stress curve."""
+    name = variant_name(dt, k)
+    out = os.path.join(args.workdir, name + ".json")
+    if os.path.exists(out):
+        with open(out) as f:
+            return json.load(f)
+    scene = couette.main(["--phi", str(args.phi), "--size", *map(str, args.size), "--seed", str(args.seed),
+                          "--a-over-delta", str(args.a_over_delta), "--dt", str(dt), "--fluid-every", str(k),
+                          "--strain", str(args.strain), "--tol-lambda", str(args.tol_lambda),
+                          "--dump-every", str(args.dump_every), "--write-every", str(args.strain),
+                          "--workdir", os.path.join(args.workdir, name), "--write-only", "--overwrite"])
+    run_dir = scene["run_dir"]
+    wall = case.run(run_dir)
+    strain, stress = wall_stress_curve(run_dir)
+    with open(os.path.join(run_dir, "log.dem"), errors="replace") as f:
+        counts = demonly.position_update_counts(f.read())
+    inner = output.steps(os.path.join(run_dir, "fluid"))["innerIterations"]
+    result = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, run_dir=run_dir, wall_seconds=wall,
+                  steps=scene["steps"], fluid_steps=int(len(inner)), inner_iterations_mean=float(np.mean(inner)),
+                  fluid_solves=int(np.sum(inner)), position_update=counts, strain=strain.tolist(),
+                  wall_stress=stress.tolist())
+    with open(out, "w") as f:
+        json.dump(result, f)
+    print("%s: %.0f s, %d fluid steps, %.1f inner iterations per fluid step" % (name, wall, len(inner),
+                                                                               result["inner_iterations_mean"]),
+          flush=True)
+    return result
+
+
+def compare(results: List[Dict], window: Tuple[float, float]) -> None:
+    """Adds to each result its error against the first over the strain window: the mean and the rms
+    of the relative difference of the stress curves (interpolated on a common strain grid)."""
+    lo, hi = window
+    grid = np.linspace(lo, hi, 200)
+    ref = np.interp(grid, results[0]["strain"], results[0]["wall_stress"])
+    for r in results:
+        curve = np.interp(grid, r["strain"], r["wall_stress"])
+        diff = (curve - ref) / ref.mean()
+        r["window"] = [lo, hi]
+        r["stress_mean"] = float(curve.mean())
+        r["error_mean"] = float(diff.mean())
+        r["error_rms"] = float(np.sqrt(np.mean(diff ** 2)))
+
+
+def plot(results: List[Dict], path: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.5))
+    for r in results:
+        label = "dt %g, fluid every %d (fluid dt %g)" % (r["dt"], r["fluid_every"], r["fluid_dt"])
+        a.plot(r["strain"], r["wall_stress"], lw=0.9, label=label)
+        if r is not results[0]:
+            b.plot(r["wall_seconds"], 100 * r["error_rms"], "o")
+            b.annotate("%g x %d" % (r["dt"], r["fluid_every"]), (r["wall_seconds"], 100 * r["error_rms"]),
+                       textcoords="offset points", xytext=(4, 4), fontsize=8)
+    lo, hi = results[0]["window"]
+    a.axvspan(lo, hi, color="0.92", zorder=0)
+    a.set_xlabel("strain")
+    a.set_ylabel("wall shear stress [Pa]")
+    a.legend(fontsize=7)
+    b.set_xlabel("wall time [s]")
+    b.set_ylabel("rms difference from %g x %d over strain %g-%g [%%]"
+                 % (results[0]["dt"], results[0]["fluid_every"], lo, hi))
+    b.set_ylim(bottom=0)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+
+
+def main(argv=None) -> Dict:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--phi", type=float, default=0.47)
+    p.add_argument("--size", type=float, nargs=3, default=(10, 16, 8))
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--a-over-delta", type=float, default=3.0)
+    p.add_argument("--tol-lambda", type=float, default=0.01)
+    p.add_argument("--strain", type=float, default=1.5, help="strain units each variant runs")
+    p.add_argument("--window", type=float, nargs=2, default=(0.1, 1.2), metavar=("LO", "HI"),
+                   help="strain range over which the curves are compared")
+    p.add_argument("--dump-every", type=float, default=0.5, help="strain between particle snapshots")
+    p.add_argument("--variants", nargs="+", type=parse_variant, default=[parse_variant(v) for v in DEFAULT_VARIANTS],
+                   metavar="DT:K", help="particle step and steps per fluid step; the first is the reference")
+    p.add_argument("--jobs", type=int, default=1, help="variants run at once (each takes two processes)")
+    p.add_argument("--workdir", default=os.path.join(HERE, "runs", "fluidEvery"))
+    p.add_argument("--out", default=None, help="default docs/benchmarks_fluidEvery_phi<PHI>.json")
+    args = p.parse_args(argv)
+    if args.out is None:
+        args.out = os.path.join(PROJECT, "docs", "benchmarks_fluidEvery_phi%g.json" % args.phi)
+    os.makedirs(args.workdir, exist_ok=True)
+    with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        results = list(pool.map(lambda v: run_variant(v[0], v[1], args), args.variants))
+    compare(results, tuple(args.window))
+    summary = dict(command="cases/couette/fluidEvery.py " + " ".join(sys.argv[1:] if argv is None else argv),
+                   phi=args.phi, size=list(args.size), seed=args.seed, a_over_delta=args.a_over_delta,
+                   tol_lambda=args.tol_lambda, strain=args.strain, window=list(args.window),
+                   runs=[{k: v for k, v in r.items() if k not in ("strain", "wall_stress")} for r in results])
+    print("%-18s %9s %8s %8s %11s %10s %9s %9s" % ("variant", "fluid dt", "wall s", "fluid st", "inner/fluid",
+                                                   "limited/ps", "err mean", "err rms"))
+    for r in results:
+        pu = r.get("position_update") or {}
+        print("%-18s %9g %8.0f %8d %11.1f %10.4f %8.1f%% %8.1f%%"
+              % (variant_name(r["dt"], r["fluid_every"]), r["fluid_dt"], r["wall_seconds"], r["fluid_steps"],
+                 r["inner_iterations_mean"], pu.get("limited_per_particle_step") or 0.0, 100 * r["error_mean"],
+                 100 * r["error_rms"]))
+    with open(args.out, "w") as f:
+        json.dump(summary, f, indent=1)
+    plot(results, os.path.splitext(args.out)[0] + ".png")
+    print("wrote", args.out)
+    return summary
+
+
+if __name__ == "__main__":
+    main()
