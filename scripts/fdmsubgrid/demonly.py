@@ -200,7 +200,8 @@ def time_step_too_large(counts: dict | None) -> str | None:
     return ("WARNING: the position update limited %.3g gap targets per particle and step (a gap asked to change "
             "by more than a factor e in one step; %d of %d steps fell back to the straight step): the time step "
             "is too large for this packing, and the particle stress is then low (12-30 %% at 0.010-0.027; "
-            "docs/benchmarks.md, 'What limits the time step'): run again with a smaller dt"
+            "docs/benchmarks.md, 'What limits the time step'): run again with a smaller dt (the fluid may keep "
+            "its step: fix fdm/couple fluid_every, couette.py --fluid-every)"
             % (rate, counts["fallback_steps"], counts["steps"]))
 
 
