@@ -497,6 +497,42 @@ def test_table8_fits_only_finished_rows_with_a_full_window(tmp_path):
     assert table8.summarise(rows, args)["fit"]["rows"] == [0.27, 0.32, 0.37, 0.47]
 
 
+def test_table8_takes_rows_of_earlier_summaries(tmp_path):
+    """--rows-from: rows of earlier summaries (runs made elsewhere, or gone with their machine) join the
+    rows run here for the other phi_bulk; a row whose particle step exceeds the largest good one at its
+    phi_bulk (0.32 at 0.04) is listed, not fitted; each keeps its own dt and fluid_every."""
+    import json
+    table8 = load_case_module("couette", "table8")
+    alpha, phi_m = 0.8, 0.6
+
+    def row(phi_bulk, phi_core, dt):
+        eta = alpha * (1 - phi_core / phi_m) ** -2
+        return dict(phi_bulk_table8=phi_bulk, phi_core=phi_core, eta_s=eta, eta_s_err=0.02 * eta, dt=dt,
+                    status="finished", window_short=False)
+
+    earlier = tmp_path / "earlier.json"
+    earlier.write_text(json.dumps(dict(rows=[row(0.27, 0.31, 0.04), row(0.32, 0.366, 0.04), row(0.37, 0.41, 0.02),
+                                             row(0.47, 0.50, 0.02)])))
+    summary = table8.main(["--analyse-only", "--phis", "0.42", "0.47", "--workdir", str(tmp_path),
+                           "--out", str(tmp_path / "t.json"), "--rows-from", str(earlier)])
+    assert [r["phi_bulk_table8"] for r in summary["rows"]] == [0.27, 0.32, 0.37, 0.42, 0.47]
+    assert [r["status"] for r in summary["rows"]][3:] == ["not started"] * 2   # run here: none yet
+    assert summary["dt"]["0.32"] == 0.04 and summary["fluid_every"]["0.32"] == 1
+    assert summary["dt"]["0.47"] == 0.01 and summary["fluid_every"]["0.47"] == 2   # the rule, run here
+    assert "fit" not in summary                                 # two rows fitted: 0.32 is beyond its good step
+    earlier.write_text(json.dumps(dict(rows=[row(0.27, 0.31, 0.04), row(0.32, 0.366, 0.04), row(0.37, 0.41, 0.02),
+                                             row(0.42, 0.455, 0.02)])))
+    fit = table8.main(["--analyse-only", "--phis", "0.47", "--workdir", str(tmp_path), "--out",
+                       str(tmp_path / "t.json"), "--rows-from", str(earlier)])["fit"]
+    assert fit["rows"] == [0.27, 0.37, 0.42] and fit["not_fitted"] == [0.32]
+    assert abs(fit["alpha"] - alpha) < 1e-6 and abs(fit["phi_m"] - phi_m) < 1e-6
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    with pytest.raises(SystemExit, match="bad.json is not a table8.py summary"):
+        table8.main(["--analyse-only", "--phis", "0.47", "--workdir", str(tmp_path), "--out", str(tmp_path / "t.json"),
+                     "--rows-from", str(bad)])
+
+
 def test_table8_finds_the_run_of_its_fluid_every(tmp_path):
     """A row's run folder is the one of its particle step and fluid_every: the run with the fluid at every
     step (no suffix) and the one with particle steps between fluid steps are different rows."""

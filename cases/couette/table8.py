@@ -27,6 +27,10 @@ over a silently shortened window (a row still short, at --max-strain, says so). 
 time; a row whose run stops is named at the end, after the other rows have run and the summary is
 written. Killing this script (or the session ending) loses at most one checkpoint interval.
 
+--rows-from JSON... adds the rows of earlier summaries (their run folders elsewhere or gone) for the
+phi_bulk not run here; a row whose particle step exceeds couette.largest_good_dt at its phi_bulk (one run
+before that limit was measured) is listed and plotted, not fitted.
+
 Writes --out (default docs/table8.json): per phi_bulk the paper's row, this project's phi_core,
 gamma_core/gamma_0, eta_s, N1_hat, N2_hat, Sigma_c_hat with error bars, the stress balance, the strain
 reached and the cost; the Maron-Pierce fit with its uncertainty against the paper's alpha = 0.803,
@@ -229,11 +233,36 @@ def step_too_large(row: Dict) -> bool:
     return demonly.time_step_too_large(row.get("position_update")) is not None
 
 
+def beyond_good_step(row: Dict) -> bool:
+    """The row's (particle) time step exceeds couette.largest_good_dt at its phi_bulk (a row run before that
+    limit was measured, e.g. phi_bulk 0.32 or 0.37 at 0.04: 7 and 12-15 % low, docs/benchmarks.md)."""
+    dt = row.get("dt")
+    return dt is not None and dt > couette.largest_good_dt(row["phi_bulk_table8"]) * (1 + 1e-9)
+
+
 def fitted_rows(rows: List[Dict]) -> List[Dict]:
     """The rows the Maron-Pierce fit takes: finished runs whose window holds --min-average units and whose
-    time step was not too large."""
+    time step was neither too large for its run (the position update's counts) nor beyond the largest
+    measured good at its phi_bulk."""
     return [r for r in rows if "eta_s" in r and r["status"] == "finished" and not r.get("window_short")
-            and not step_too_large(r)]
+            and not step_too_large(r) and not beyond_good_step(r)]
+
+
+def earlier_rows(paths: List[str], phis: List[float]) -> List[Dict]:
+    """The rows of earlier table8.py summaries (--rows-from; their run folders elsewhere, or gone with
+    another machine) for the phi_bulk not in phis, the first file's row of each phi_bulk; each says where
+    it came from (`from`)."""
+    found: Dict[float, Dict] = {}
+    for path in paths:
+        with open(path) as f:
+            summary = json.load(f)
+        if "rows" not in summary:
+            raise SystemExit("table8: --rows-from %s is not a table8.py summary (no 'rows')" % path)
+        for r in summary["rows"]:
+            phi = r["phi_bulk_table8"]
+            if "eta_s" in r and all(abs(phi - q) > 1e-9 for q in phis) and phi not in found:
+                found[phi] = dict(r, fluid_every=r.get("fluid_every", 1), **{"from": path})
+    return [found[phi] for phi in sorted(found)]
 
 
 def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
@@ -241,11 +270,16 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
     units: a partial or short row is plotted and listed, not fitted) and Fig. 21."""
     done = [r for r in rows if "eta_s" in r]
     fitted = fitted_rows(rows)
-    dts = sorted({row_dt(r["phi_bulk_table8"], args) for r in rows})
+    def dt_of(r: Dict) -> float:       # a row from an earlier summary keeps its own
+        return r["dt"] if "from" in r else row_dt(r["phi_bulk_table8"], args)
+
+    def every_of(r: Dict) -> int:
+        return r["fluid_every"] if "from" in r else row_fluid_every(r["phi_bulk_table8"], args)
+
+    dts = sorted({dt_of(r) for r in rows})
     summary: Dict = dict(rows=rows, paper_fit=PAPER_FIT, a_over_delta=args.a_over_delta,
-                         dt={"%g" % r["phi_bulk_table8"]: row_dt(r["phi_bulk_table8"], args) for r in rows},
-                         fluid_every={"%g" % r["phi_bulk_table8"]: row_fluid_every(r["phi_bulk_table8"], args)
-                                      for r in rows},
+                         dt={"%g" % r["phi_bulk_table8"]: dt_of(r) for r in rows},
+                         fluid_every={"%g" % r["phi_bulk_table8"]: every_of(r) for r in rows},
                          tol_lambda=args.tol_lambda, strain=args.strain, seed=args.seed)
     fit = None
     if len(fitted) >= 3:
@@ -276,19 +310,25 @@ def print_table(summary: Dict) -> None:
         if "eta_s" not in r:
             print("%-6g %-9s (strain %.2f)" % (r["phi_bulk_table8"], r["status"], r.get("strain_reached", 0)))
             continue
-        t = r["table8"] or {}
-        averaged = "%.1f%s" % (r["strain_averaged"], " (short)" if r.get("window_short") else "")
-        print("%-6g %-9s %.3f (%.3f)    %.3f (%.3f)    %.2f ± %.2f    %+.3f ± %.3f %+.3f ± %.3f %5.1f %%  %-8.1f %-15s %.0f" % (
+        t = r.get("table8") or {}
+
+        def v(key: str) -> float:      # a row of an earlier summary may lack a column
+            value = r.get(key)
+            return float("nan") if value is None else value
+
+        averaged = "%.1f%s" % (v("strain_averaged"), " (short)" if r.get("window_short") else "")
+        print("%-6g %-9s %.3f (%.3f)    %.3f (%.3f)    %.2f ± %.2f    %+.3f ± %.3f %+.3f ± %.3f %5.1f %%  %-8.1f %-15s %.0f%s" % (
             r["phi_bulk_table8"], r["status"], r["phi_core"], t.get("phi_core", float("nan")),
-            r["gamma_core_over_gamma0"], t.get("gamma_core_over_gamma0", float("nan")), r["eta_s"], r["eta_s_err"],
-            r["N1_hat"], r["N1_hat_err"], r["N2_hat"], r["N2_hat_err"], 100 * r["stress_balance_rel_error"],
-            r["strain_units"], averaged, r["core_seconds_per_strain_unit"]))
+            v("gamma_core_over_gamma0"), t.get("gamma_core_over_gamma0", float("nan")), r["eta_s"], r["eta_s_err"],
+            v("N1_hat"), v("N1_hat_err"), v("N2_hat"), v("N2_hat_err"), 100 * v("stress_balance_rel_error"),
+            v("strain_units"), averaged, v("core_seconds_per_strain_unit"),
+            "  (from %s)" % os.path.basename(r["from"]) if "from" in r else ""))
     if "fit" in summary:
         f = summary["fit"]
         print("Maron-Pierce fit over phi_bulk %s: alpha = %.3f ± %.3f, phi_m = %.3f ± %.3f (chi2 %.2f for %d dof); "
               "paper 0.803, 0.59%s" % (", ".join("%g" % x for x in f["rows"]), f["alpha"], f["alpha_error"], f["phi_m"],
                                        f["phi_m_error"], f["chi2"], f["dof"],
-                                       "; not fitted (partial, short or too large a step): "
+                                       "; not fitted (partial, short, or a step too large or beyond the good one): "
                                        + ", ".join("%g" % x for x in f["not_fitted"]) if f["not_fitted"] else ""))
     else:
         print("Maron-Pierce fit: needs 3 finished rows with a full window and a good step, has %d"
@@ -329,6 +369,10 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(PROJECT, "docs", "table8.json"))
     p.add_argument("--analyse-only", action="store_true", help="report the runs as they stand; run nothing")
+    p.add_argument("--rows-from", nargs="+", default=[], metavar="JSON",
+                   help="add the rows of earlier table8.py summaries (runs made elsewhere, or whose folders are "
+                   "gone) for the phi_bulk not in --phis, e.g. docs/validation_table8_calibrated.json; fitted by the "
+                   "same rules (a row beyond the largest good time step at its phi_bulk is listed, not fitted)")
     p.add_argument("--session-hours", type=float, default=None,
                    help="launch no further run after this many hours (the run in progress finishes)")
     p.add_argument("--jobs", type=int, default=None,
@@ -361,6 +405,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args),
                                                             args.seed, args.model, row_fluid_every(phi, args)), args)
             for phi in args.phis]
+    rows = sorted(rows + earlier_rows(args.rows_from, args.phis), key=lambda r: r["phi_bulk_table8"])
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
     with open(args.out, "w") as f:
