@@ -99,12 +99,12 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     dem/particles.dump of the same steps (for comparisons). fluid_options: more (or other) arguments
     of case.write_fluid_case, e.g. first_step or mean_flow_damping. fluid_every: the fluid is solved every
     fluid_every-th particle step (fix fdm/couple ... fluid_every K, docs/dem.md "Particle steps between
-    fluid steps"); dump_every and write_every must then be multiples of it, so that every snapshot is
-    of a step the fluid solved."""
+    fluid steps"); dump_every and write_every (unless beyond the run's steps) must then be multiples of it,
+    so that every snapshot is of a step the fluid solved."""
     if fluid_every < 1:
         raise ValueError("fluid_every must be at least 1, got %r" % fluid_every)
     for what, every in (("dump_every", dump_every), ("write_every", write_every)):
-        if every % fluid_every:
+        if every % fluid_every and every <= steps:
             raise ValueError("%s = %d steps is not a multiple of fluid_every = %d: a snapshot would fall between "
                              "fluid steps" % (what, every, fluid_every))
     delta = A1 / a_over_delta
