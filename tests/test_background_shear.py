@@ -70,3 +70,14 @@ def test_position_update_counts_are_read_from_the_log(tmp_path):
                      limited_per_particle_step=1050 / (400 * 98))
     message = demonly.time_step_too_large(too_large)
     assert "0.0268 gap targets per particle and step" in message and "333 of 400 steps" in message, message
+
+
+def test_fluid_every_without_the_fluid_is_refused(tmp_path):
+    """fluid_every K goes with the fluid solver: transport none has no fluid step to space out."""
+    p = packing.Packing([[2.0, 2.5, 6.0]], [1.0], [1], [12.0] * 3)
+    scene = demonly.Scene(p, solver="ldlt", steps=1, dt=1e-3, eta=ETA, delta=DELTA, contact=None,
+                          extra_fix="background_shear %r fluid_every 2" % G)
+    r = demonly.run(scene, str(tmp_path))
+    assert not r["ok"]
+    assert "fix fdm/couple: fluid_every goes with the fluid solver (transport none has no fluid step)" in r["log"], \
+        r["log"][-2000:]
