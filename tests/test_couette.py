@@ -166,6 +166,15 @@ def test_fluid_every_puts_every_snapshot_on_a_fluid_step(couette, tmp_path):
                            write_every=10, fluid_every=2)
 
 
+def test_bad_fluid_every_keeps_the_run_folder(couette, tmp_path):
+    """--fluid-every 0 is refused before anything is written or replaced: with --overwrite the existing
+    run folder stays."""
+    scene = couette.main(TINY + ["--write-only", "--workdir", str(tmp_path)])
+    with pytest.raises(SystemExit):
+        couette.main(TINY + ["--fluid-every", "0", "--overwrite", "--write-only", "--workdir", str(tmp_path)])
+    assert os.path.isfile(os.path.join(scene["run_dir"], "dem", "in.couette"))
+
+
 def test_channel_packing_any_box():
     p = packing.channel_packing((9, 14, 7), phi=0.35, seed=4)
     n1, n2 = np.sum(p.types == 1), np.sum(p.types == 2)

@@ -85,11 +85,18 @@ MEASURED_DT_LIMITS = {0.27: 0.04, 0.32: 0.02, 0.37: 0.02, 0.42: 0.02, 0.47: 0.01
 MEASURED_FLUID_DT = {0.42: 0.04, 0.47: 0.02}
 
 
+def _nearest_denser(measured: dict, phi: float) -> float | None:
+    """The nearest volume fraction of `measured` at or above phi (within 0.01: a measured row counts for the
+    packings of its nominal phi_bulk), None beyond the densest."""
+    denser = [p for p in sorted(measured) if p >= phi - 0.01]
+    return denser[0] if denser else None
+
+
 def fluid_dt(phi: float) -> float:
     """The fluid step [1/gamma_dot_0] at phi_bulk: MEASURED_FLUID_DT of the nearest measured row at or above
     phi (within 0.01), the densest's beyond."""
-    denser = [p for p in sorted(MEASURED_FLUID_DT) if p >= phi - 0.01]
-    return MEASURED_FLUID_DT[denser[0] if denser else max(MEASURED_FLUID_DT)]
+    reference = _nearest_denser(MEASURED_FLUID_DT, phi)
+    return MEASURED_FLUID_DT[max(MEASURED_FLUID_DT) if reference is None else reference]
 
 
 def fluid_every(phi: float, dt: float | None = None) -> int:
@@ -100,10 +107,9 @@ def fluid_every(phi: float, dt: float | None = None) -> int:
 
 
 def measured_reference(phi: float) -> float | None:
-    """The nearest measured volume fraction at or above phi (within 0.01: a measured row counts for the
-    packings of its nominal phi_bulk), None beyond the densest."""
-    denser = [p for p in sorted(MEASURED_DT_LIMITS) if p >= phi - 0.01]
-    return denser[0] if denser else None
+    """The nearest volume fraction of MEASURED_DT_LIMITS at or above phi (within 0.01), None beyond the
+    densest."""
+    return _nearest_denser(MEASURED_DT_LIMITS, phi)
 
 
 def largest_good_dt(phi: float) -> float:
@@ -227,6 +233,8 @@ def main(argv: list[str] | None = None) -> dict:
             p.error("--size: L%s = %g a1 is not a whole number of cells of a1/%g" % (name, L, args.a_over_delta))
     if args.strain <= 0 or dt <= 0:
         p.error("--strain and --dt must be positive")
+    if args.fluid_every < 1:
+        p.error("--fluid-every must be at least 1")
 
     pack = packing.channel_packing(args.size, phi=None if n_particles else phi, n=n_particles, seed=args.seed,
                                    min_gap=2 * ROUGHNESS, wall_gap=2 * ROUGHNESS)
@@ -253,8 +261,6 @@ def main(argv: list[str] | None = None) -> dict:
         if not args.overwrite:
             raise SystemExit("couette: %s already holds a run; --overwrite replaces it" % run_dir)
         shutil.rmtree(run_dir)
-    if args.fluid_every < 1:
-        p.error("--fluid-every must be at least 1")
     # snapshots on steps the fluid solved: multiples of K
     K = args.fluid_every
     every = K * max(1, int(round(args.dump_every / (SHEAR_RATE * dt * K))))
