@@ -66,11 +66,16 @@ def fdm_run(root, env, *options, timeout=300):
                           stderr=subprocess.STDOUT, text=True, errors="replace", timeout=timeout)
 
 
+def dump_frames(root, columns):
+    """{step: the columns (N, len(columns)) by id} of the DEM dump, and the list of steps in file order."""
+    frames = output.read_dump(os.path.join(root, "dem", "particles.dump"))
+    return ({s: np.column_stack([c[k] for k in columns])[np.argsort(c["id"])] for s, c in frames},
+            [s for s, _ in frames])
+
+
 def trajectory(root):
     """{step: positions (N, 3)} of the DEM dump, and the list of steps in file order."""
-    frames = output.read_dump(os.path.join(root, "dem", "particles.dump"))
-    return ({s: np.column_stack([c["x"], c["y"], c["z"]])[np.argsort(c["id"])] for s, c in frames},
-            [s for s, _ in frames])
+    return dump_frames(root, ("x", "y", "z"))
 
 
 def records_once(root):
@@ -336,13 +341,6 @@ def fluid_steps(root):
     return list(output.steps(os.path.join(root, "fluid"))["step"].astype(int))
 
 
-def dump_velocities(root):
-    """{step: (U, Omega) (N, 6)} of the DEM dump, by id."""
-    frames = output.read_dump(os.path.join(root, "dem", "particles.dump"))
-    return {s: np.column_stack([c[k] for k in ("vx", "vy", "vz", "omegax", "omegay", "omegaz")])[np.argsort(c["id"])]
-            for s, c in frames}
-
-
 @pytest.fixture(scope="module")
 def reference_every2(tmp_path_factory, env):
     root = str(tmp_path_factory.mktemp("every2"))
@@ -383,7 +381,7 @@ def test_held_drag_gives_the_fluid_steps_velocities_at_unchanged_positions(tmp_p
     r = fdm_run(root, env)
     assert r.returncode == 0, r.stdout
     assert fluid_steps(root) == [1, 2, 4, 6, 8]
-    u = dump_velocities(root)
+    u, _ = dump_frames(root, ("vx", "vy", "vz", "omegax", "omegay", "omegaz"))
     scale = float(np.max(np.abs(u[2])))
     assert scale > 0.1   # the shear moves them (wall speed 3)
     for held, fluid in ((3, 2), (5, 4), (7, 6)):

@@ -34,7 +34,7 @@ PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 sys.path.insert(0, HERE)
 
-from fdmsubgrid import case, demonly, output  # noqa: E402
+from fdmsubgrid import case, demonly, output, profiles, rheology  # noqa: E402
 import couette  # noqa: E402
 
 DEFAULT_VARIANTS = ["0.005:1", "0.02:1", "0.01:1", "0.01:2", "0.005:4", "0.01:4", "0.02:2", "0.0025:8"]
@@ -56,12 +56,12 @@ def variant_name(dt: float, k: int) -> str:
     return "dt%g_every%d" % (dt, k)
 
 
-def wall_stress_curve(run_dir: str) -> Tuple[np.ndarray, np.ndarray]:
+def wall_stress_curve(run_dir: str, box: List[float]) -> Tuple[np.ndarray, np.ndarray]:
     """Strain (gamma_dot_0 t) and the shear stress of the suspension on the walls (fluid + sub-grid +
-    contact, the mean of both walls' |F_x|/A) at the steps the fluid solved."""
+    contact, rheology.wall_shear_stresses, the mean of both walls) at the steps the fluid solved."""
     loads = output.read_wall_loads(run_dir)
-    fx = np.abs(loads.total[:, :, 0]) / loads.areas[None, :]
-    return loads.times * couette.SHEAR_RATE, fx.mean(axis=1)
+    tau = rheology.wall_shear_stresses(loads, profiles.Channel.centred(box))["total"]
+    return loads.times * couette.SHEAR_RATE, tau.mean(axis=1)
 
 
 def run_variant(dt: float, k: int, args: argparse.Namespace) -> Dict:
@@ -79,7 +79,7 @@ def run_variant(dt: float, k: int, args: argparse.Namespace) -> Dict:
                           "--workdir", os.path.join(args.workdir, name), "--write-only", "--overwrite"])
     run_dir = scene["run_dir"]
     wall = case.run(run_dir)
-    strain, stress = wall_stress_curve(run_dir)
+    strain, stress = wall_stress_curve(run_dir, scene["box"])
     with open(os.path.join(run_dir, "log.dem"), errors="replace") as f:
         counts = demonly.position_update_counts(f.read())
     inner = output.steps(os.path.join(run_dir, "fluid"))["innerIterations"]

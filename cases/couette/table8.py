@@ -273,13 +273,11 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
     def dt_of(r: Dict) -> float:       # a row from an earlier summary keeps its own
         return r["dt"] if "from" in r else row_dt(r["phi_bulk_table8"], args)
 
-    def every_of(r: Dict) -> int:
-        return r["fluid_every"] if "from" in r else row_fluid_every(r["phi_bulk_table8"], args)
-
     dts = sorted({dt_of(r) for r in rows})
     summary: Dict = dict(rows=rows, paper_fit=PAPER_FIT, a_over_delta=args.a_over_delta,
                          dt={"%g" % r["phi_bulk_table8"]: dt_of(r) for r in rows},
-                         fluid_every={"%g" % r["phi_bulk_table8"]: every_of(r) for r in rows},
+                         # analyse_row and earlier_rows give each row its own (a row without one: every step)
+                         fluid_every={"%g" % r["phi_bulk_table8"]: r.get("fluid_every", 1) for r in rows},
                          tol_lambda=args.tol_lambda, strain=args.strain, seed=args.seed)
     fit = None
     if len(fitted) >= 3:
