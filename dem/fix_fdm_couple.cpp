@@ -878,21 +878,17 @@ void FixFdmCouple::frozenFluidStep(const std::vector<Particle> &particles)
   // change within a fluid step, where the far field does not. The sphere's drag D U_b = D U + F is the
   // same whichever step of the cycle it is taken from (between fluid steps F = D (U_b - U)), so U_b
   // needs no state of its own and a resumed run rebuilds it from U and F of its checkpoint.
-  const cpl::Volumes drag = noFluidVolumes(particles);
-  const double rho = session_.rhoFluid(), alpha = session_.alphaLambda();
-  setVolumes(drag);
+  setVolumes(noFluidVolumes(particles));   // Eq. (31)'s rigid-body blocks become D
+  const std::vector<double> dragTimesLastU = system_->rigidBlocksTimes(currentVelocity_);
   cpl::Integrals held;
   held.step = update->ntimestep;
   held.iteration = 1;
   held.particles.resize(natoms_);
-  for (int p = 0; p < natoms_; p++) {
-    // noFluidVolumes holds D alpha/rho_f in Vu and J: D = rho_f Vu/alpha (Eq. 31's rigid-body blocks)
-    const double translation = rho * drag.particles[p].Vu / alpha, rotation = rho * drag.particles[p].J[0] / alpha;
-    for (int d = 0; d < 3; d++) {
-      held.particles[p].F[d] = translation * currentVelocity_[size_t(6) * p + d] + hydro_[size_t(6) * p + d];
-      held.particles[p].T[d] = rotation * currentVelocity_[size_t(6) * p + 3 + d] + hydro_[size_t(6) * p + 3 + d];
+  for (int p = 0; p < natoms_; p++)
+    for (int d = 0; d < 3; d++) {   // D U_b = D U + F^FDM
+      held.particles[p].F[d] = dragTimesLastU[size_t(6) * p + d] + hydro_[size_t(6) * p + d];
+      held.particles[p].T[d] = dragTimesLastU[size_t(6) * p + 3 + d] + hydro_[size_t(6) * p + 3 + d];
     }
-  }
   solveVelocities(held);
   const std::vector<double> dragTimesU = system_->rigidBlocksTimes(solution_);
   for (int p = 0; p < natoms_; p++)
