@@ -3,9 +3,10 @@
 cost of a sheared suspension, side by side (issue 11; docs/benchmarks.md, "Particle steps between
 fluid steps").
 
-Every variant DT:K is the same Couette scene (couette.py: the same packing for the same phi_bulk, box
+Every variant DT:K[:TOL] is the same Couette scene (couette.py: the same packing for the same phi_bulk, box
 and seed) run for a short strain with the particle step DT (in 1/gamma_dot_0) and the fluid solved
-every K-th step (its step K DT). Over the first strain unit or so the runs start from the same
+every K-th step (its step K DT), each fluid step converged to tolLambda TOL (default --tol-lambda).
+Over the first strain unit or so the runs start from the same
 packing and stay close: the wall shear stress against strain is then a deterministic curve, and its
 difference from the reference run (the first variant, the finest step) is the time-step error, free
 of the sampling noise of a long average (a run of 8 strain units at phi 0.47 in the small scene
@@ -15,6 +16,7 @@ trajectories do; --window sets the strain range compared.
   fluidEvery.py --jobs 2                      phi 0.47, the small scene 10 x 16 x 8 a1, variants 0.005:1
                                               (reference) 0.02:1 0.01:1 0.01:2 0.005:4 0.01:4 0.02:2 0.0025:8
   fluidEvery.py --phi 0.42 --variants 0.005:1 0.04:1 0.02:1 0.02:2 0.01:4 0.01:2 --jobs 2
+  fluidEvery.py --variants 0.01:2:0.001 0.01:2:0.01 0.01:2:0.03 --jobs 2     the inner iteration's tolerance
 
 Writes <workdir>/<variant>.json per variant (a variant whose file exists is not run again) and --out
 (default docs/benchmarks_fluidEvery_phi<PHI>.json) with a figure beside it (the stress curves, and the
@@ -25,7 +27,7 @@ import json
 import os
 import sys
 from concurrent.futures import ThreadPoolExecutor
-from typing import Dict, List, Tuple
+from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -40,20 +42,27 @@ import couette  # noqa: E402
 DEFAULT_VARIANTS = ["0.005:1", "0.02:1", "0.01:1", "0.01:2", "0.005:4", "0.01:4", "0.02:2", "0.0025:8"]
 
 
-def parse_variant(text: str) -> Tuple[float, int]:
-    """'DT:K' -> (DT, K)."""
+Variant = Tuple[float, int, Optional[float]]
+
+
+def parse_variant(text: str) -> Variant:
+    """'DT:K' or 'DT:K:TOL' -> (DT, K, TOL or None: the run's --tol-lambda)."""
     try:
-        dt, k = text.split(":")
-        dt_value, k_value = float(dt), int(k)
+        fields = text.split(":")
+        if len(fields) not in (2, 3):
+            raise ValueError
+        dt_value, k_value = float(fields[0]), int(fields[1])
+        tol = float(fields[2]) if len(fields) == 3 else None
     except ValueError:
-        raise argparse.ArgumentTypeError("a variant is DT:K (particle step, steps per fluid step), got %r" % text)
-    if dt_value <= 0 or k_value < 1:
-        raise argparse.ArgumentTypeError("%r: DT must be positive and K at least 1" % text)
-    return dt_value, k_value
+        raise argparse.ArgumentTypeError("a variant is DT:K or DT:K:TOL (particle step, steps per fluid step, "
+                                         "tolLambda), got %r" % text)
+    if dt_value <= 0 or k_value < 1 or (tol is not None and tol <= 0):
+        raise argparse.ArgumentTypeError("%r: DT and TOL must be positive and K at least 1" % text)
+    return dt_value, k_value, tol
 
 
-def variant_name(dt: float, k: int) -> str:
-    return "dt%g_every%d" % (dt, k)
+def variant_name(dt: float, k: int, tol: Optional[float] = None) -> str:
+    return "dt%g_every%d" % (dt, k) + ("" if tol is None else "_tol%g" % tol)
 
 
 def wall_stress_curve(run_dir: str, box: List[float]) -> Tuple[np.ndarray, np.ndarray]:
@@ -64,17 +73,18 @@ def wall_stress_curve(run_dir: str, box: List[float]) -> Tuple[np.ndarray, np.nd
     return loads.times * couette.SHEAR_RATE, tau.mean(axis=1)
 
 
-def run_variant(dt: float, k: int, args: argparse.Namespace) -> Dict:
+def run_variant(dt: float, k: int, tol: Optional[float], args: argparse.Namespace) -> Dict:
     """One variant (or its results file): wall time, fluid steps, inner iterations per fluid step, the
     position update's counts and the stress curve."""
-    name = variant_name(dt, k)
+    name = variant_name(dt, k, tol)
+    tol_lambda = args.tol_lambda if tol is None else tol
     out = os.path.join(args.workdir, name + ".json")
     if os.path.exists(out):
         with open(out) as f:
             return json.load(f)
     scene = couette.main(["--phi", str(args.phi), "--size", *map(str, args.size), "--seed", str(args.seed),
                           "--a-over-delta", str(args.a_over_delta), "--dt", str(dt), "--fluid-every", str(k),
-                          "--strain", str(args.strain), "--tol-lambda", str(args.tol_lambda),
+                          "--strain", str(args.strain), "--tol-lambda", str(tol_lambda),
                           "--dump-every", str(args.dump_every), "--write-every", str(args.strain),
                           "--workdir", os.path.join(args.workdir, name), "--write-only", "--overwrite"])
     run_dir = scene["run_dir"]
@@ -83,7 +93,7 @@ def run_variant(dt: float, k: int, args: argparse.Namespace) -> Dict:
     with open(os.path.join(run_dir, "log.dem"), errors="replace") as f:
         counts = demonly.position_update_counts(f.read())
     inner = output.steps(os.path.join(run_dir, "fluid"))["innerIterations"]
-    result = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, run_dir=run_dir, wall_seconds=wall,
+    result = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, tol_lambda=tol_lambda, run_dir=run_dir, wall_seconds=wall,
                   steps=scene["steps"], fluid_steps=int(len(inner)), inner_iterations_mean=float(np.mean(inner)),
                   fluid_solves=int(np.sum(inner)), position_update=counts, strain=strain.tolist(),
                   wall_stress=stress.tolist())
@@ -116,11 +126,13 @@ def plot(results: List[Dict], path: str) -> None:
     import matplotlib.pyplot as plt
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.5))
     for r in results:
-        label = "dt %g, fluid every %d (fluid dt %g)" % (r["dt"], r["fluid_every"], r["fluid_dt"])
+        label = "dt %g, fluid every %d (fluid dt %g), tolLambda %g" % (r["dt"], r["fluid_every"], r["fluid_dt"],
+                                                                      r.get("tol_lambda", 0.01))
         a.plot(r["strain"], r["wall_stress"], lw=0.9, label=label)
         if r is not results[0]:
             b.plot(r["wall_seconds"], 100 * r["error_rms"], "o")
-            b.annotate("%g x %d" % (r["dt"], r["fluid_every"]), (r["wall_seconds"], 100 * r["error_rms"]),
+            b.annotate(variant_name(r["dt"], r["fluid_every"], r.get("tol_lambda")),
+                       (r["wall_seconds"], 100 * r["error_rms"]),
                        textcoords="offset points", xytext=(4, 4), fontsize=8)
     lo, hi = results[0]["window"]
     a.axvspan(lo, hi, color="0.92", zorder=0)
@@ -128,8 +140,8 @@ def plot(results: List[Dict], path: str) -> None:
     a.set_ylabel("wall shear stress [Pa]")
     a.legend(fontsize=7)
     b.set_xlabel("wall time [s]")
-    b.set_ylabel("rms difference from %g x %d over strain %g-%g [%%]"
-                 % (results[0]["dt"], results[0]["fluid_every"], lo, hi))
+    b.set_ylabel("rms difference from %s over strain %g-%g [%%]"
+                 % (variant_name(results[0]["dt"], results[0]["fluid_every"], results[0].get("tol_lambda")), lo, hi))
     b.set_ylim(bottom=0)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
@@ -147,7 +159,8 @@ def main(argv=None) -> Dict:
                    help="strain range over which the curves are compared")
     p.add_argument("--dump-every", type=float, default=0.5, help="strain between particle snapshots")
     p.add_argument("--variants", nargs="+", type=parse_variant, default=[parse_variant(v) for v in DEFAULT_VARIANTS],
-                   metavar="DT:K", help="particle step and steps per fluid step; the first is the reference")
+                   metavar="DT:K[:TOL]",
+                   help="particle step, steps per fluid step and (optional) tolLambda; the first is the reference")
     p.add_argument("--jobs", type=int, default=1, help="variants run at once (each takes two processes)")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs", "fluidEvery"))
     p.add_argument("--out", default=None, help="default docs/benchmarks_fluidEvery_phi<PHI>.json")
@@ -156,18 +169,18 @@ def main(argv=None) -> Dict:
         args.out = os.path.join(PROJECT, "docs", "benchmarks_fluidEvery_phi%g.json" % args.phi)
     os.makedirs(args.workdir, exist_ok=True)
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        results = list(pool.map(lambda v: run_variant(v[0], v[1], args), args.variants))
+        results = list(pool.map(lambda v: run_variant(v[0], v[1], v[2], args), args.variants))
     compare(results, tuple(args.window))
     summary = dict(command="cases/couette/fluidEvery.py " + " ".join(sys.argv[1:] if argv is None else argv),
                    phi=args.phi, size=list(args.size), seed=args.seed, a_over_delta=args.a_over_delta,
                    tol_lambda=args.tol_lambda, strain=args.strain, window=list(args.window),
                    runs=[{k: v for k, v in r.items() if k not in ("strain", "wall_stress")} for r in results])
-    print("%-18s %9s %8s %8s %11s %10s %9s %9s" % ("variant", "fluid dt", "wall s", "fluid st", "inner/fluid",
+    print("%-26s %9s %8s %8s %11s %10s %9s %9s" % ("variant", "fluid dt", "wall s", "fluid st", "inner/fluid",
                                                    "limited/ps", "err mean", "err rms"))
     for r in results:
         pu = r.get("position_update") or {}
-        print("%-18s %9g %8.0f %8d %11.1f %10.4f %8.1f%% %8.1f%%"
-              % (variant_name(r["dt"], r["fluid_every"]), r["fluid_dt"], r["wall_seconds"], r["fluid_steps"],
+        print("%-26s %9g %8.0f %8d %11.1f %10.4f %8.1f%% %8.1f%%"
+              % (variant_name(r["dt"], r["fluid_every"], r.get("tol_lambda")), r["fluid_dt"], r["wall_seconds"], r["fluid_steps"],
                  r["inner_iterations_mean"], pu.get("limited_per_particle_step") or 0.0, 100 * r["error_mean"],
                  100 * r["error_rms"]))
     with open(args.out, "w") as f:
