@@ -599,3 +599,24 @@ def test_particle_side_alone_from_a_written_scene(tmp_path, env):
     assert row["eta_r"] >= 1 + 2.5 * phi, row
     assert row["position_update"]["steps"] == 100, row["position_update"]
     assert json.loads(out.read_text())["rows"][0]["dt"] == 0.04
+
+
+def test_table8_progress_lines_read_the_runs_own_log(tiny_run, tmp_path):
+    """table8.py's progress line reads fdmFoam's last 'Step N ... | ETA S s' line of a row's log (the tiny
+    run's real log here, copied as table8 names a row's log): the last step done, its strain against the
+    target, the rows still waiting; nothing once no row runs or waits."""
+    table8 = load_case_module("couette", "table8")
+    log = os.path.join(tiny_run["run_dir"], "log.fluid")
+    step, eta = table8.last_progress(log)
+    assert step == tiny_run["steps"] and eta >= 0
+    assert table8.last_progress(str(tmp_path / "missing.log")) is None
+    run_dir = str(tmp_path / "table8_phi0.25_tiny")
+    with open(log) as src, open(run_dir + ".log", "w") as dst:
+        dst.write(src.read())
+    with table8.running(run_dir, 0.25, tiny_run["dt"], 2 * tiny_run["steps"]):
+        line = table8.progress_report([0.54, 0.52])
+        assert "phi_bulk 0.25 at strain %.1f of %.1f, ETA" % (0.4, 0.8) in line
+        assert line.endswith("waiting: 0.52, 0.54")
+        with table8.running(str(tmp_path / "not_started"), 0.3, 0.02, 100):
+            assert "phi_bulk 0.3 starting" in table8.progress_report([])
+    assert table8.progress_report([]) is None

@@ -10,6 +10,8 @@ run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq
   table8.py --phis 0.27 0.32 0.37 0.42 0.47 0.52 0.54   all seven rows
   table8.py --analyse-only                  the runs as they stand (partial runs reported with the
                                             strain they reached), nothing run
+  table8.py --progress-minutes 10           every 10 minutes a line per running row: the strain it
+                                            reached of its target and fdmFoam's ETA (0: none)
   table8.py --session-hours 2.5             stop launching runs after this long (a run in progress is
                                             checkpointed every strain unit; the next call resumes it)
   table8.py --jobs 2                        rows run at once (default: one per --np-fluid cores this
@@ -38,15 +40,18 @@ phi_m = 0.59 (over 3 or more finished rows whose window is full: partial and sho
 and listed, not fitted); and the figure beside it (Fig. 21 with error bars).
 """
 import argparse
+import contextlib
 import glob
 import json
 import math
 import os
+import re
 import subprocess
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
-from typing import Dict, List, Optional
+from typing import Dict, Iterator, List, Optional, Tuple
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
@@ -125,6 +130,64 @@ def running_elsewhere(run_dir: str) -> bool:
     return False
 
 
+# fdmFoam's progress line as fdmRun copies it into a row's log: "Step N t = T  inner ... | ETA S s"
+PROGRESS_LINE = re.compile(r"^Step (\d+) t = \S+\s.*\| ETA (\S+) s\s*$")
+_running: Dict[str, Tuple[float, float, int]] = {}   # run folder -> (phi_bulk, dt, last step) of the runs going
+_running_lock = threading.Lock()
+
+
+def last_progress(log: str) -> Optional[Tuple[int, float]]:
+    """The step and the ETA (s) of the last progress line in a row's log (fdmFoam's, through fdmRun), or
+    None while it has none. Reads the log's last 64 kB only: the logs of long runs grow to many MB."""
+    try:
+        with open(log, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            f.seek(max(0, f.tell() - 65536))
+            tail = f.read().decode(errors="replace")
+    except FileNotFoundError:
+        return None
+    for line in reversed(tail.splitlines()):
+        m = PROGRESS_LINE.match(line.strip())
+        if m:
+            try:
+                return int(m.group(1)), float(m.group(2))
+            except ValueError:
+                continue
+    return None
+
+
+@contextlib.contextmanager
+def running(run_dir: str, phi: float, dt: float, last_step: int) -> Iterator[None]:
+    """Lists the run as going (for progress_report) while the block runs."""
+    with _running_lock:
+        _running[run_dir] = (phi, dt, last_step)
+    try:
+        yield
+    finally:
+        with _running_lock:
+            _running.pop(run_dir, None)
+
+
+def progress_report(waiting: List[float]) -> Optional[str]:
+    """One line on the runs going: per row the strain reached of its target and fdmFoam's ETA for it; then
+    the rows not launched yet. None when nothing runs or waits."""
+    with _running_lock:
+        going = sorted(_running.items(), key=lambda item: item[1][0])
+    parts = []
+    for run_dir, (phi, dt, last_step) in going:
+        progress = last_progress(run_dir + ".log")
+        if progress is None:
+            parts.append("phi_bulk %g starting" % phi)
+            continue
+        step, eta = progress
+        parts.append("phi_bulk %g at strain %.1f of %.1f, ETA %.1f h" % (phi, step * dt, last_step * dt, eta / 3600))
+    if waiting:
+        parts.append("waiting: " + ", ".join("%g" % phi for phi in sorted(waiting)))
+    if not parts:
+        return None
+    return "table8 progress %s: %s" % (time.strftime("%H:%M"), "; ".join(parts))
+
+
 def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None) -> None:
     """Start the run in run_dir, or resume it from its checkpoint (to step `until` if given)."""
     fdmrun = [os.path.join(PROJECT, "scripts", "fdmRun"), "-f", str(args.np_fluid)]
@@ -185,7 +248,8 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
         print("table8: phi_bulk %g:" % phi, end=" ", flush=True)
         # to the input's last step: an extension killed before its first checkpoint resumes from one
         # written for the shorter run, which fdmDEM accepts only with -until
-        _fdmrun(run_dir, args, until=steps_planned(run_dir))
+        with running(run_dir, phi, dt, steps_planned(run_dir)):
+            _fdmrun(run_dir, args, until=steps_planned(run_dir))
     row = None
     while args.min_average > 0:
         row = analyse_row(phi, run_dir, args)
@@ -195,7 +259,8 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
         print("table8: phi_bulk %g: averaged over %.1f strain units after the transient, short of --min-average "
               "%g: extended to strain %g" % (phi, row.get("strain_averaged", 0.0), args.min_average, until * dt),
               flush=True)
-        _fdmrun(run_dir, args, until=until)
+        with running(run_dir, phi, dt, until):
+            _fdmrun(run_dir, args, until=until)
     return row
 
 
@@ -371,6 +436,8 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                    help="add the rows of earlier table8.py summaries (runs made elsewhere, or whose folders are "
                    "gone) for the phi_bulk not in --phis, e.g. docs/validation_table8_calibrated.json; fitted by the "
                    "same rules (a row beyond the largest good time step at its phi_bulk is listed, not fitted)")
+    p.add_argument("--progress-minutes", type=float, default=10.0,
+                   help="minutes between progress lines (each running row's strain and ETA; 0: none)")
     p.add_argument("--session-hours", type=float, default=None,
                    help="launch no further run after this many hours (the run in progress finishes)")
     p.add_argument("--jobs", type=int, default=None,
@@ -380,16 +447,28 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     os.makedirs(args.workdir, exist_ok=True)
     start = time.time()
 
+    waiting = list(args.phis)          # the rows not launched yet (for the progress lines)
+
     def launch(phi: float) -> Optional[Dict]:
+        waiting.remove(phi)
         if args.session_hours is not None and time.time() - start > 3600 * args.session_hours:
             print("table8: phi_bulk %g: --session-hours reached, not launched; the next call continues" % phi,
                   flush=True)
             return None
         return run_row(phi, args)
 
+    def report_progress(stop: threading.Event) -> None:
+        while not stop.wait(60 * args.progress_minutes):
+            line = progress_report(list(waiting))
+            if line:
+                print(line, flush=True)
+
     analysed: Dict[float, Dict] = {}   # the rows run_row analysed as their runs ended
     stopped: List[str] = []            # why the runs that fdmRun stopped ended (run_row's SystemExit)
     if not args.analyse_only:
+        stop_progress = threading.Event()
+        if args.progress_minutes > 0:
+            threading.Thread(target=report_progress, args=(stop_progress,), daemon=True).start()
         with ThreadPoolExecutor(max_workers=args.jobs or default_jobs(args.np_fluid)) as pool:
             launched = [(phi, pool.submit(launch, phi)) for phi in args.phis]
             for phi, future in launched:
@@ -400,6 +479,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                     continue
                 if row is not None:
                     analysed[phi] = row
+        stop_progress.set()
     rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args),
                                                             args.seed, args.model, row_fluid_every(phi, args)), args)
             for phi in args.phis]
