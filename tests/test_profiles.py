@@ -525,3 +525,15 @@ def test_gap_shear_stress_is_the_box_average():
     s = P.Snapshot([[2, 4, 2], [7, 3, 3]], [1.0, 1.4], stresslet_h=sh, stresslet_c=sc)
     assert R.gap_shear_stress(s, channel, eta=2.0, wall_shear_rate=0.5) == pytest.approx(1.0 + 36.0 / 400.0)
     assert R.relative_difference(1.1, 1.0) == pytest.approx(0.1) and math.isnan(R.relative_difference(1.0, 0.0))
+
+
+def test_normal_stress_figure_needs_one_value_of_each_per_row(tmp_path):
+    """Fig. 22's plot writes its PNG, and refuses columns of different lengths by saying which."""
+    path = R.plot_normal_stresses(str(tmp_path / "n.png"), [0.3, 0.4], [-0.05, -0.06], [0.01, 0.01],
+                                  [-0.1, -0.2], [0.01, 0.01], [[-0.2, -0.25, -0.1], [-0.5, -0.55, -0.3]],
+                                  [[0.01] * 3] * 2)
+    with open(path, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ValueError, match="2 phi_core, 2 N1, 1 N2 and 2 contact rows"):
+        R.plot_normal_stresses(str(tmp_path / "m.png"), [0.3, 0.4], [-0.05, -0.06], [0.01, 0.01], [-0.1], [0.01],
+                               [[-0.2, -0.25, -0.1], [-0.5, -0.55, -0.3]], [[0.01] * 3] * 2)

@@ -87,3 +87,23 @@ def test_bad_options_are_refused_by_name(tmp_path, env):
     done = report(["--only", "shearedSphere", "--report-only", "--table8", str(missing), "--out",
                    str(tmp_path / "r.md")], env)
     assert done.returncode == 2 and str(missing) in done.stderr
+
+
+def test_table8_figures_join_the_report(tmp_path, env):
+    """--table8 SUMMARY puts the summary's rows and both its figures (Fig. 21, Fig. 22) into the report,
+    copied beside it; the summary here is table8.py --analyse-only over the rows of a shipped one."""
+    from conftest import load_case_module
+    table8 = load_case_module("couette", "table8")
+    shipped = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs",
+                           "validation_table8_fluidEvery.json")
+    summary = table8.main(["--analyse-only", "--phis", "0.54", "--workdir", str(tmp_path / "runs"),
+                           "--rows-from", shipped, "--out", str(tmp_path / "t8.json")])
+    out = tmp_path / "report" / "r.md"
+    out.parent.mkdir()
+    report(["--only", "shearedSphere", "--report-only", "--table8", str(tmp_path / "t8.json"), "--out", str(out),
+            "--workdir", str(tmp_path / "work")], env)
+    text = out.read_text()
+    for key in ("figure", "figure_normal_stresses"):
+        name = "table8_" + summary[key]
+        assert "![%s](r/%s)" % (name, name) in text
+        assert (out.parent / "r" / name).stat().st_size > 0

@@ -37,7 +37,8 @@ Writes --out (default docs/table8.json): per phi_bulk the paper's row, this proj
 gamma_core/gamma_0, eta_s, N1_hat, N2_hat, Sigma_c_hat with error bars, the stress balance, the strain
 reached and the cost; the Maron-Pierce fit with its uncertainty against the paper's alpha = 0.803,
 phi_m = 0.59 (over 3 or more finished rows whose window is full: partial and short rows are plotted
-and listed, not fitted); and the figure beside it (Fig. 21 with error bars).
+and listed, not fitted); and the figures beside it: Fig. 21 with error bars, and Fig. 22 (the normal
+stress differences and the contact normal stresses with their error bars) as <out>_normal_stresses.png.
 """
 import argparse
 import contextlib
@@ -362,6 +363,17 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
                                                               if any(k > 1 for k in summary["fluid_every"].values()) else "")),
                                 title="Fig. 21: η_s(φ_core)", reference=rheology.PAPER_MARON_PIERCE)
         summary["figure"] = os.path.basename(figure)
+        stressed = [r for r in done if r.get("N1_hat") is not None and r.get("Sigma_c_hat") is not None]
+        if stressed:
+            figure22 = os.path.splitext(args.out)[0] + "_normal_stresses.png"
+            rheology.plot_normal_stresses(figure22, [r["phi_core"] for r in stressed],
+                                          [r["N1_hat"] for r in stressed], [r.get("N1_hat_err") or 0.0 for r in stressed],
+                                          [r["N2_hat"] for r in stressed], [r.get("N2_hat_err") or 0.0 for r in stressed],
+                                          [r["Sigma_c_hat"] for r in stressed],
+                                          [r.get("Sigma_c_hat_err") or [0.0] * 3 for r in stressed],
+                                          label="this project (a1/Δ = %g)" % args.a_over_delta,
+                                          title="Fig. 22: normal stresses and their contact parts")
+            summary["figure_normal_stresses"] = os.path.basename(figure22)
     return summary
 
 

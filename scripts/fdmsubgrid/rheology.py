@@ -329,3 +329,38 @@ def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path
+
+
+def plot_normal_stresses(path: str, phi_core: ArrayLike, n1: ArrayLike, n1_error: ArrayLike, n2: ArrayLike,
+                         n2_error: ArrayLike, sigma_c: ArrayLike, sigma_c_error: ArrayLike,
+                         label: str = "simulations", title: str | None = None) -> str:
+    """PNG of the normalised normal stresses against phi_core with their error bars, laid out as the paper's
+    Fig. 22: top N_hat_1 and N_hat_2 (Eq. 56), bottom the contact parts Sigma_hat^c_11, _22, _33 (Eq. 57;
+    sigma_c and its error are (rows, 3)). Returns path."""
+    from matplotlib.figure import Figure
+
+    phi = np.asarray(phi_core, dtype=float)
+    contact = np.asarray(sigma_c, dtype=float).reshape(-1, 3)
+    contact_error = np.asarray(sigma_c_error, dtype=float).reshape(-1, 3)
+    if not (phi.size == np.size(n1) == np.size(n2) == contact.shape[0]):
+        raise ValueError("plot_normal_stresses: %d phi_core, %d N1, %d N2 and %d contact rows: need one of each "
+                         "per row" % (phi.size, np.size(n1), np.size(n2), contact.shape[0]))
+    fig = Figure(figsize=(5.5, 7.0))
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    top.errorbar(phi, n1, yerr=n1_error, fmt="o", ms=5, capsize=3, label=r"$\hat N_1$")
+    top.errorbar(phi, n2, yerr=n2_error, fmt="s", ms=5, capsize=3, label=r"$\hat N_2$")
+    top.axhline(0.0, color="0.6", lw=0.8)
+    top.set_ylabel(r"$\hat N_1$, $\hat N_2$ (Eq. 56)")
+    top.legend(fontsize=8, title=label, title_fontsize=8)
+    for k, (marker, name) in enumerate(zip("o^s", ("11", "22", "33"))):
+        bottom.errorbar(phi, contact[:, k], yerr=contact_error[:, k], fmt=marker, ms=5, capsize=3,
+                        label=r"$\hat\Sigma^c_{%s}$" % name)
+    bottom.axhline(0.0, color="0.6", lw=0.8)
+    bottom.set_xlabel(r"$\phi_{core}$")
+    bottom.set_ylabel(r"contact part $\hat\Sigma^c$ (Eq. 57)")
+    bottom.legend(fontsize=8)
+    if title:
+        top.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path

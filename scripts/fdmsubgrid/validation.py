@@ -440,9 +440,18 @@ def markdown(results: List[CaseResult], table8: Optional[dict], info: dict, figu
             shutil.copyfile(fig, os.path.join(figures_dir, name))
             lines += ["![%s](%s)" % (name, os.path.relpath(os.path.join(figures_dir, name), os.path.dirname(out))), ""]
     if table8 is not None:
-        lines += ["## 6.1 suspensions in simple shear: Table 8 and Fig. 21 (`cases/couette/table8.py`)", "",
+        lines += ["## 6.1 suspensions in simple shear: Table 8, Figs. 21 and 22 (`cases/couette/table8.py`)", "",
                   "From %s (the runs as they stand; a row's strain units say how far it got)." % info["table8"], ""]
         lines += table(table8_rows(table8))
+        # the summary's own figures (Fig. 21; Fig. 22, the normal stresses), beside its JSON
+        where = os.path.dirname(os.path.join(PROJECT, info["table8"]))
+        for key in ("figure", "figure_normal_stresses"):
+            fig = os.path.join(where, table8[key]) if table8.get(key) else None
+            if fig and os.path.exists(fig):
+                name = "table8_" + os.path.basename(fig)
+                shutil.copyfile(fig, os.path.join(figures_dir, name))
+                lines += ["![%s](%s)" % (name, os.path.relpath(os.path.join(figures_dir, name), os.path.dirname(out))),
+                          ""]
     return "\n".join(lines) + "\n"
 
 
