@@ -537,3 +537,9 @@ def test_normal_stress_figure_needs_one_value_of_each_per_row(tmp_path):
     with pytest.raises(ValueError, match="2 phi_core, 2 N1, 1 N2 and 2 contact rows"):
         R.plot_normal_stresses(str(tmp_path / "m.png"), [0.3, 0.4], [-0.05, -0.06], [0.01, 0.01], [-0.1], [0.01],
                                [[-0.2, -0.25, -0.1], [-0.5, -0.55, -0.3]], [[0.01] * 3] * 2)
+    # a row listed but not fitted is drawn hollow: one flag per row
+    R.plot_normal_stresses(str(tmp_path / "h.png"), [0.3, 0.4], [-0.05, -0.06], [0.01, 0.01], [-0.1, -0.2],
+                           [0.01, 0.01], [[-0.2, -0.25, -0.1], [-0.5, -0.55, -0.3]], [[0.01] * 3] * 2,
+                           not_fitted=[True, False])
+    with pytest.raises(ValueError, match="1 flags for 2 points"):
+        R.plot_viscosity(str(tmp_path / "v.png"), [0.3, 0.4], [3.0, 6.0], [0.1, 0.2], not_fitted=[True])

@@ -361,7 +361,8 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
                                 label="this project (a1/Δ = %g, Δt = %s)" % (args.a_over_delta, ", ".join(
                                     "%g" % d for d in dts) + ("; particle steps between fluid steps"
                                                               if any(k > 1 for k in summary["fluid_every"].values()) else "")),
-                                title="Fig. 21: η_s(φ_core)", reference=rheology.PAPER_MARON_PIERCE)
+                                title="Fig. 21: η_s(φ_core)", reference=rheology.PAPER_MARON_PIERCE,
+                                not_fitted=[r not in fitted for r in done] if fit is not None else None)
         summary["figure"] = os.path.basename(figure)
         stressed = [r for r in done if r.get("N1_hat") is not None and r.get("Sigma_c_hat") is not None]
         if stressed:
@@ -372,7 +373,9 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
                                           [r["Sigma_c_hat"] for r in stressed],
                                           [r.get("Sigma_c_hat_err") or [0.0] * 3 for r in stressed],
                                           label="this project (a1/Δ = %g)" % args.a_over_delta,
-                                          title="Fig. 22: normal stresses and their contact parts")
+                                          title="Fig. 22: normal stresses and their contact parts",
+                                          not_fitted=[r not in fitted for r in stressed] if fit is not None
+                                          else None)
             summary["figure_normal_stresses"] = os.path.basename(figure22)
     return summary
 

@@ -299,15 +299,17 @@ def fit_maron_pierce(phi: ArrayLike, eta_s: ArrayLike, eta_s_error: ArrayLike,
 def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error: ArrayLike | None = None,
                    fit: MaronPierceFit | None = None, phi_core_error: ArrayLike | None = None,
                    label: str = "simulations", title: str | None = None,
-                   reference: tuple[float, float] | None = None, reference_label: str = "paper") -> str:
+                   reference: tuple[float, float] | None = None, reference_label: str = "paper",
+                   not_fitted: ArrayLike | None = None) -> str:
     """PNG of eta_s against phi_core with error bars and, if given, the Maron-Pierce curve of `fit`
     and a reference curve Eq. 55 with reference = (alpha, phi_m), e.g. PAPER_MARON_PIERCE (Fig. 21).
-    Returns path."""
+    not_fitted (booleans, one per point): points drawn hollow, "listed, not fitted". Returns path."""
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(5.5, 4.2))
     ax = fig.subplots()
-    ax.errorbar(phi_core, eta_s, yerr=eta_s_error, xerr=phi_core_error, fmt="o", ms=5, capsize=3, label=label)
+    _errorbars(ax, phi_core, eta_s, eta_s_error, phi_core_error, "o", label, not_fitted,
+               "listed, not fitted (a step too large, or a short window)")
     eta_data = np.asarray(eta_s, dtype=float)
     if fit is not None:
         grid = np.linspace(0.0, 0.998 * fit.phi_m, 400)
@@ -331,12 +333,33 @@ def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error
     return path
 
 
+def _errorbars(ax, x: ArrayLike, y: ArrayLike, yerr: ArrayLike | None, xerr: ArrayLike | None, marker: str,
+               label: str, not_fitted: ArrayLike | None, hollow_label: str | None = None) -> None:
+    """Points with error bars; those flagged in not_fitted hollow, in the same colour, labelled hollow_label
+    (default: label + ": not fitted")."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    hollow = np.zeros(x.size, bool) if not_fitted is None else np.asarray(not_fitted, dtype=bool)
+    if hollow.size != x.size:
+        raise ValueError("not_fitted: %d flags for %d points" % (hollow.size, x.size))
+
+    def pick(err: ArrayLike | None, keep: np.ndarray):
+        return None if err is None else np.asarray(err, dtype=float)[keep]
+
+    full = ax.errorbar(x[~hollow], y[~hollow], yerr=pick(yerr, ~hollow), xerr=pick(xerr, ~hollow), fmt=marker,
+                       ms=5, capsize=3, label=label)
+    if hollow.any():
+        ax.errorbar(x[hollow], y[hollow], yerr=pick(yerr, hollow), xerr=pick(xerr, hollow), fmt=marker, ms=5,
+                    capsize=3, mfc="none", color=full[0].get_color(),
+                    label=hollow_label if hollow_label is not None else label + ": not fitted")
+
+
 def plot_normal_stresses(path: str, phi_core: ArrayLike, n1: ArrayLike, n1_error: ArrayLike, n2: ArrayLike,
                          n2_error: ArrayLike, sigma_c: ArrayLike, sigma_c_error: ArrayLike,
-                         label: str = "simulations", title: str | None = None) -> str:
+                         label: str = "simulations", title: str | None = None,
+                         not_fitted: ArrayLike | None = None) -> str:
     """PNG of the normalised normal stresses against phi_core with their error bars, laid out as the paper's
     Fig. 22: top N_hat_1 and N_hat_2 (Eq. 56), bottom the contact parts Sigma_hat^c_11, _22, _33 (Eq. 57;
-    sigma_c and its error are (rows, 3)). Returns path."""
+    sigma_c and its error are (rows, 3)); the rows flagged in not_fitted hollow. Returns path."""
     from matplotlib.figure import Figure
 
     phi = np.asarray(phi_core, dtype=float)
@@ -347,14 +370,14 @@ def plot_normal_stresses(path: str, phi_core: ArrayLike, n1: ArrayLike, n1_error
                          "per row" % (phi.size, np.size(n1), np.size(n2), contact.shape[0]))
     fig = Figure(figsize=(5.5, 7.0))
     top, bottom = fig.subplots(2, 1, sharex=True)
-    top.errorbar(phi, n1, yerr=n1_error, fmt="o", ms=5, capsize=3, label=r"$\hat N_1$")
-    top.errorbar(phi, n2, yerr=n2_error, fmt="s", ms=5, capsize=3, label=r"$\hat N_2$")
+    _errorbars(top, phi, n1, n1_error, None, "o", r"$\hat N_1$", not_fitted, r"$\hat N_1$ (row not in Fig. 21's fit)")
+    _errorbars(top, phi, n2, n2_error, None, "s", r"$\hat N_2$", not_fitted, r"$\hat N_2$ (row not in Fig. 21's fit)")
     top.axhline(0.0, color="0.6", lw=0.8)
     top.set_ylabel(r"$\hat N_1$, $\hat N_2$ (Eq. 56)")
     top.legend(fontsize=8, title=label, title_fontsize=8)
     for k, (marker, name) in enumerate(zip("o^s", ("11", "22", "33"))):
-        bottom.errorbar(phi, contact[:, k], yerr=contact_error[:, k], fmt=marker, ms=5, capsize=3,
-                        label=r"$\hat\Sigma^c_{%s}$" % name)
+        _errorbars(bottom, phi, contact[:, k], contact_error[:, k], None, marker, r"$\hat\Sigma^c_{%s}$" % name,
+                   not_fitted, r"$\hat\Sigma^c_{%s}$ (row not in Fig. 21's fit)" % name)
     bottom.axhline(0.0, color="0.6", lw=0.8)
     bottom.set_xlabel(r"$\phi_{core}$")
     bottom.set_ylabel(r"contact part $\hat\Sigma^c$ (Eq. 57)")
