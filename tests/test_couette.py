@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from conftest import load_case_module
+from conftest import PROJECT, load_case_module
 from fdmsubgrid import case, output, packing, profiles
 
 TINY = ["--phi", "0.25", "--size", "7", "11", "7", "--a-over-delta", "3", "--dt", "0.02", "--strain", "0.4",
@@ -627,8 +627,7 @@ def test_table8_summary_draws_fig21_and_fig22_from_earlier_rows(tmp_path):
     0.27-0.42) writes the summary with both figures, Fig. 21 and Fig. 22 (normal stresses), and refits the
     same Maron-Pierce parameters from the same rows."""
     table8 = load_case_module("couette", "table8")
-    shipped = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs",
-                           "validation_table8_fluidEvery.json")
+    shipped = os.path.join(PROJECT, "docs", "validation_table8_fluidEvery.json")
     out = tmp_path / "t8.json"
     summary = table8.main(["--analyse-only", "--phis", "0.54", "--workdir", str(tmp_path / "runs"),
                            "--rows-from", shipped, "--out", str(out)])

@@ -94,8 +94,7 @@ def test_table8_figures_join_the_report(tmp_path, env):
     copied beside it; the summary here is table8.py --analyse-only over the rows of a shipped one."""
     from conftest import load_case_module
     table8 = load_case_module("couette", "table8")
-    shipped = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs",
-                           "validation_table8_fluidEvery.json")
+    shipped = os.path.join(PROJECT, "docs", "validation_table8_fluidEvery.json")
     summary = table8.main(["--analyse-only", "--phis", "0.54", "--workdir", str(tmp_path / "runs"),
                            "--rows-from", shipped, "--out", str(tmp_path / "t8.json")])
     out = tmp_path / "report" / "r.md"

@@ -65,6 +65,12 @@ def variant_name(dt: float, k: int, tol: Optional[float] = None) -> str:
     return "dt%g_every%d" % (dt, k) + ("" if tol is None else "_tol%g" % tol)
 
 
+def result_name(r: Dict) -> str:
+    """The name of a variant's result: its results file's name (results written before 2026-11-28 hold none:
+    then from its step, K and, where it says one, tolLambda)."""
+    return r.get("name") or variant_name(r["dt"], r["fluid_every"], r.get("tol_lambda"))
+
+
 def wall_stress_curve(run_dir: str, box: List[float]) -> Tuple[np.ndarray, np.ndarray]:
     """Strain (gamma_dot_0 t) and the shear stress of the suspension on the walls (fluid + sub-grid +
     contact, rheology.wall_shear_stresses, the mean of both walls) at the steps the fluid solved."""
@@ -93,7 +99,8 @@ def run_variant(dt: float, k: int, tol: Optional[float], args: argparse.Namespac
     with open(os.path.join(run_dir, "log.dem"), errors="replace") as f:
         counts = demonly.position_update_counts(f.read())
     inner = output.steps(os.path.join(run_dir, "fluid"))["innerIterations"]
-    result = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, tol_lambda=tol_lambda, run_dir=run_dir, wall_seconds=wall,
+    result = dict(name=name, dt=dt, fluid_every=k, fluid_dt=dt * k, tol_lambda=tol_lambda, run_dir=run_dir,
+                  wall_seconds=wall,
                   steps=scene["steps"], fluid_steps=int(len(inner)), inner_iterations_mean=float(np.mean(inner)),
                   fluid_solves=int(np.sum(inner)), position_update=counts, strain=strain.tolist(),
                   wall_stress=stress.tolist())
@@ -131,8 +138,7 @@ def plot(results: List[Dict], path: str) -> None:
         a.plot(r["strain"], r["wall_stress"], lw=0.9, label=label)
         if r is not results[0]:
             b.plot(r["wall_seconds"], 100 * r["error_rms"], "o")
-            b.annotate(variant_name(r["dt"], r["fluid_every"], r.get("tol_lambda")),
-                       (r["wall_seconds"], 100 * r["error_rms"]),
+            b.annotate(result_name(r), (r["wall_seconds"], 100 * r["error_rms"]),
                        textcoords="offset points", xytext=(4, 4), fontsize=8)
     lo, hi = results[0]["window"]
     a.axvspan(lo, hi, color="0.92", zorder=0)
@@ -141,7 +147,7 @@ def plot(results: List[Dict], path: str) -> None:
     a.legend(fontsize=7)
     b.set_xlabel("wall time [s]")
     b.set_ylabel("rms difference from %s over strain %g-%g [%%]"
-                 % (variant_name(results[0]["dt"], results[0]["fluid_every"], results[0].get("tol_lambda")), lo, hi))
+                 % (result_name(results[0]), lo, hi))
     b.set_ylim(bottom=0)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
@@ -180,7 +186,7 @@ def main(argv=None) -> Dict:
     for r in results:
         pu = r.get("position_update") or {}
         print("%-26s %9g %8.0f %8d %11.1f %10.4f %8.1f%% %8.1f%%"
-              % (variant_name(r["dt"], r["fluid_every"], r.get("tol_lambda")), r["fluid_dt"], r["wall_seconds"], r["fluid_steps"],
+              % (result_name(r), r["fluid_dt"], r["wall_seconds"], r["fluid_steps"],
                  r["inner_iterations_mean"], pu.get("limited_per_particle_step") or 0.0, 100 * r["error_mean"],
                  100 * r["error_rms"]))
     with open(args.out, "w") as f:

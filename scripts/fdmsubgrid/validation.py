@@ -436,9 +436,7 @@ def markdown(results: List[CaseResult], table8: Optional[dict], info: dict, figu
             lines += ["**%s**: %s" % (r.status, r.message), ""]
         lines += table(r.rows)
         for fig in r.figures:
-            name = "%s_%s" % (r.key, os.path.basename(fig))
-            shutil.copyfile(fig, os.path.join(figures_dir, name))
-            lines += ["![%s](%s)" % (name, os.path.relpath(os.path.join(figures_dir, name), os.path.dirname(out))), ""]
+            lines += figure_lines(fig, r.key, figures_dir, out)
     if table8 is not None:
         lines += ["## 6.1 suspensions in simple shear: Table 8, Figs. 21 and 22 (`cases/couette/table8.py`)", "",
                   "From %s (the runs as they stand; a row's strain units say how far it got)." % info["table8"], ""]
@@ -448,11 +446,16 @@ def markdown(results: List[CaseResult], table8: Optional[dict], info: dict, figu
         for key in ("figure", "figure_normal_stresses"):
             fig = os.path.join(where, table8[key]) if table8.get(key) else None
             if fig and os.path.exists(fig):
-                name = "table8_" + os.path.basename(fig)
-                shutil.copyfile(fig, os.path.join(figures_dir, name))
-                lines += ["![%s](%s)" % (name, os.path.relpath(os.path.join(figures_dir, name), os.path.dirname(out))),
-                          ""]
+                lines += figure_lines(fig, "table8", figures_dir, out)
     return "\n".join(lines) + "\n"
+
+
+def figure_lines(fig: str, prefix: str, figures_dir: str, out: str) -> List[str]:
+    """Copies a figure into the report's folder as PREFIX_NAME and returns its Markdown lines, linked
+    relative to the report."""
+    name = "%s_%s" % (prefix, os.path.basename(fig))
+    shutil.copyfile(fig, os.path.join(figures_dir, name))
+    return ["![%s](%s)" % (name, os.path.relpath(os.path.join(figures_dir, name), os.path.dirname(out))), ""]
 
 
 def table(rows: List[Row]) -> List[str]:
