@@ -47,7 +47,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 sys.path.insert(0, HERE)
-from fdmsubgrid import case, wallcalibration  # noqa: E402
+from fdmsubgrid import case, squeeze, wallcalibration  # noqa: E402
 import freeSphereWall  # noqa: E402
 import wallShear  # noqa: E402
 
@@ -75,18 +75,26 @@ def theory_factors(eps: float) -> dict:
     return dict(Ft=ft, Fr=fr, Tt=tt, Tr=tr, Fs=fs, Ts=ts)
 
 
-def run_box(workdir: str, L: float, eps_values: Sequence[float], offsets, options) -> dict:
-    """Per gap, the factors averaged over the offsets in the cube L^3 (a1/Delta of options): one
-    coupled run of the free sphere in the shear (all offsets) and one loaded run per offset. The
-    result is kept as <workdir>/box<L>.json and read back by a later call with the same scene."""
-    kept_path = os.path.join(workdir, "box%g_ad%g.json" % (L, options.a_over_delta))
-    scene_key = dict(eps=sorted(eps_values, reverse=True), offsets=[list(o) for o in offsets],
-                     a_over_delta=options.a_over_delta, tol_lambda=options.tol_lambda)
-    if os.path.exists(kept_path):
-        with open(kept_path) as f:
+def _kept(path: str, scene_key: dict) -> dict | None:
+    """The result a call kept as <path>.json for the same scene, else None (a killed run resumes)."""
+    if os.path.isfile(path + ".json"):
+        with open(path + ".json") as f:
             kept = json.load(f)
         if kept.get("scene") == scene_key:
             return kept
+    return None
+
+
+def run_box(workdir: str, L: float, eps_values: Sequence[float], offsets, options) -> dict:
+    """Per gap, the factors averaged over the offsets in the cube L^3 (a1/Delta of options): one
+    coupled run of the free sphere in the shear (all offsets) and one loaded run per offset. The
+    result is kept as <workdir>/box<L>_ad<A>.json and read back by a later call with the same scene."""
+    kept_path = os.path.join(workdir, "box%g_ad%g" % (L, options.a_over_delta))
+    scene_key = dict(eps=sorted(eps_values, reverse=True), offsets=[list(o) for o in offsets],
+                     a_over_delta=options.a_over_delta, tol_lambda=options.tol_lambda)
+    kept = _kept(kept_path, scene_key)
+    if kept is not None:
+        return kept
     t0 = time.time()
     epss = scene_key["eps"]
     shear = wallShear.run_scene(workdir, (L, L, L), 1.0, False, epss, offsets, options)
@@ -108,8 +116,7 @@ def run_box(workdir: str, L: float, eps_values: Sequence[float], offsets, option
             row[q], row[q + "_std"] = float(np.mean(values)), float(np.std(values))
         rows.append(row)
     result = dict(scene=scene_key, box=L, rows=rows, wall_seconds=time.time() - t0)
-    with open(kept_path, "w") as f:
-        json.dump(result, f, indent=1)
+    squeeze.keep_result(kept_path, result)
     return result
 
 
@@ -117,14 +124,12 @@ def run_corrected(workdir: str, L: float, eps_values: Sequence[float], offsets, 
     """The free sphere with the sub-grid correction on (options.model) in the cube L^3, the same gaps and
     offsets: per gap the mean Ux_norm and Wz_norm, to set beside what the exact R with the solver's F^s
     gives. Kept as <workdir>/box<L>_ad<A>_<model>.json like run_box."""
-    kept_path = os.path.join(workdir, "box%g_ad%g_%s.json" % (L, options.a_over_delta, options.model))
+    kept_path = os.path.join(workdir, "box%g_ad%g_%s" % (L, options.a_over_delta, options.model))
     scene_key = dict(eps=sorted(eps_values, reverse=True), offsets=[list(o) for o in offsets],
                      a_over_delta=options.a_over_delta, tol_lambda=options.tol_lambda, model=options.model)
-    if os.path.exists(kept_path):
-        with open(kept_path) as f:
-            kept = json.load(f)
-        if kept.get("scene") == scene_key:
-            return kept
+    kept = _kept(kept_path, scene_key)
+    if kept is not None:
+        return kept
     t0 = time.time()
     scene = wallShear.run_scene(os.path.join(workdir, "corrected"), (L, L, L), 1.0, True, scene_key["eps"],
                                 offsets, options)
@@ -134,8 +139,7 @@ def run_corrected(workdir: str, L: float, eps_values: Sequence[float], offsets, 
         rows.append(dict(eps=eps, Ux_norm=float(np.mean([s["Ux_norm"] for s in group])),
                          Wz_norm=float(np.mean([s["Wz_norm"] for s in group]))))
     result = dict(scene=scene_key, box=L, rows=rows, wall_seconds=time.time() - t0)
-    with open(kept_path, "w") as f:
-        json.dump(result, f, indent=1)
+    squeeze.keep_result(kept_path, result)
     return result
 
 
