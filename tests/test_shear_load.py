@@ -58,7 +58,7 @@ def test_solver_misses_the_gap_but_not_the_load(small_scene):
 def test_split_predicts_the_corrected_sphere(small_scene):
     # linearity in one box: the solver's R and F^s (correction off) plus the model's R^SG must give the free sphere
     # the corrected solver computes. Measured: within 0.003 % (U) and 0.12 % (Omega) at eps 0.1; 0.8 % and 1.7 % at
-    # 0.01 (unexplained, docs/validation.md)
+    # 0.01 (likely the off-plane motion the 2 x 2 split leaves out, docs/validation.md)
     for eps, tol in ((0.1, 0.005), (0.01, 0.03)):
         row = small_scene[eps]
         for q in ("Ux", "Wz"):

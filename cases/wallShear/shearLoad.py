@@ -22,7 +22,8 @@ solver, by linearity, in one box and at one offset at a time, the correction off
    and offsets (`--no-corrected` skips it).
 5. with the calibrated model, the free sphere the split predicts with the model's R^SG (its fits, and
    the calibration's measured points instead): it accounts for the corrected sphere of 4 (within 0.5 % for
-   eps >= 0.01; 1-1.5 % below, unexplained).
+   eps >= 0.01; 1-1.5 % below, likely the off-plane motion
+   at a generic offset, which the 2 x 2 block leaves out).
 
 Over the offsets it averages Fs, Ts and the four resistance factors; over three cubic boxes L^3 it
 extrapolates them to an infinite box as Q(L) = Q_inf + c2 L^-2 + c3 L^-3 (the calibration's rule for the
