@@ -19,6 +19,7 @@ between fluid steps gives the velocities of the fluid step before it; with movin
 trajectory stays close to the one with the fluid at every step; killed and resumed, it is the
 uninterrupted run's.
 """
+import json
 import os
 import random
 import shutil
@@ -331,6 +332,72 @@ def test_set_last_step_rewrites_only_the_run_command(tmp_path):
         f.write("run 5\n")
     with pytest.raises(checkpoint.CheckpointError, match="has 2 run commands"):
         checkpoint.set_last_step(path, 900, 830)
+
+
+def test_calibration_table_the_input_reads(tmp_path, monkeypatch):
+    """checkpoint.calibration_table on input text (no codes run): the shipped table by default, the input's
+    own `calibration FILE` (relative to the input), none with the cut-off model or the lubrication off."""
+    monkeypatch.setenv("FDM_ROOT", "/somewhere")
+    path = str(tmp_path / "in.scene")
+
+    def table(pair_style):
+        with open(path, "w") as f:
+            f.write("units si\n# pair_style fdm/subgrid calibration commented.dat\n" + pair_style + "\nrun 5 upto\n")
+        return checkpoint.calibration_table(path)
+    shipped = "/somewhere/dem/resistance/data/subgrid_calibration.dat"
+    assert table("pair_style      fdm/subgrid contact 1 1 0.5 0.005 wall ylo 0 0 0") == shipped
+    assert table("pair_style fdm/subgrid model calibrated") == shipped
+    assert table("pair_style fdm/subgrid model cutoff contact 1 1 0.5 0.005") is None
+    assert table("pair_style fdm/subgrid lubrication no") is None
+    assert table("pair_style fdm/subgrid &\n  calibration my.dat cutoff 0.5") == str(tmp_path / "my.dat")
+    assert table("pair_style gran model hertz tangential history") is None
+
+
+def test_changed_calibration_table_refuses_a_resume(tmp_path):
+    """A run records its table when it starts (checkpoint.stamp); a resume whose table changed since is
+    refused naming the table and the record, and goes on only with accept_new (fdmRun --new-calibration),
+    which records the new one; a run started before the record existed gets it at its resume."""
+    case_dir = tmp_path / "run"
+    (case_dir / "dem").mkdir(parents=True)
+    dem_input = str(case_dir / "dem" / "in.scene")
+    with open(dem_input, "w") as f:
+        f.write("pair_style fdm/subgrid calibration table.dat contact 1 1 0.5 0.005\n")
+    table = case_dir / "dem" / "table.dat"
+    table.write_text("# squeeze table\n1 2 3\n")
+    assert "no record" in checkpoint.check_stamp(str(case_dir), dem_input)      # an older run: recorded now
+    assert checkpoint.check_stamp(str(case_dir), dem_input) == "the same calibration table as at the start"
+    table.write_text("# squeeze table, refitted\n1 2 4\n")
+    with pytest.raises(checkpoint.CheckpointError) as e:
+        checkpoint.check_stamp(str(case_dir), dem_input)
+    message = str(e.value)
+    assert str(table) in message and checkpoint.CALIBRATION_STAMP in message and "--new-calibration" in message
+    assert "--new-calibration: continues with" in checkpoint.check_stamp(str(case_dir), dem_input, accept_new=True)
+    assert checkpoint.check_stamp(str(case_dir), dem_input) == "the same calibration table as at the start"
+    table.unlink()
+    with pytest.raises(checkpoint.CheckpointError, match="table.dat .*is missing"):
+        checkpoint.check_stamp(str(case_dir), dem_input)
+
+
+def test_fdmRun_refuses_a_resume_whose_table_changed_and_loses_nothing(tmp_path, env, reference):
+    """fdmRun --resume on a run whose record names another table than the input reads: refused before the
+    records are cut (every file as it was); with --new-calibration it resumes (here the cut-off model reads no
+    table, so the run is the reference's)."""
+    root = str(tmp_path / "run")
+    shutil.copytree(reference, root)
+    stamp = os.path.join(root, checkpoint.CALIBRATION_STAMP)
+    assert json.load(open(stamp)) == {"table": None, "sha256": None}        # written when the reference started
+    with open(stamp, "w") as f:
+        json.dump({"table": "/elsewhere/subgrid_calibration.dat", "sha256": "0" * 64}, f)
+    before = {os.path.join(d, p): os.path.getsize(os.path.join(d, p)) for d, _, files in os.walk(root) for p in files}
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode != 0 and "the sub-grid calibration table changed since this run started" in r.stdout, r.stdout
+    assert "/elsewhere/subgrid_calibration.dat" in r.stdout
+    after = {os.path.join(d, p): os.path.getsize(os.path.join(d, p)) for d, _, files in os.walk(root) for p in files}
+    assert after == before
+    r = fdm_run(root, env, "--resume", "--new-calibration")
+    assert r.returncode == 0, r.stdout
+    assert json.load(open(stamp)) == {"table": None, "sha256": None}
+    assert_same_trajectory(root, reference)
 
 
 # ------------------------------------------------------------------------------------------------

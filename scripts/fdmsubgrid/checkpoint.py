@@ -17,9 +17,17 @@ each code keeps its two newest.
     python3 -m fdmsubgrid.checkpoint until INPUT L STEP  the run resumed from STEP to end at step L: the
                                                  LIGGGHTS input's `run N upto` becomes `run L upto`
                                                  (prints N; fdmRun --resume --until L)
+    python3 -m fdmsubgrid.checkpoint stamp CASE INPUT    record which sub-grid calibration table the run
+                                                 starts with (its path and SHA-256, CASE/.fdmRun-calibration)
+    python3 -m fdmsubgrid.checkpoint check-stamp CASE INPUT [--new-calibration]
+                                                 on a resume: refuse if that table changed since (a run
+                                                 never mixes two sub-grid models), unless asked
 """
+import hashlib
+import json
 import os
 import re
+import shlex
 import shutil
 import sys
 import zlib
@@ -298,6 +306,78 @@ def truncate(case_dir, step):
     return summary
 
 
+CALIBRATION_STAMP = ".fdmRun-calibration"
+
+
+def calibration_table(dem_input: str) -> str | None:
+    """The sub-grid calibration table the LIGGGHTS input's `pair_style fdm/subgrid` reads: its `calibration
+    FILE` (relative to the input's folder), else the shipped table ($FDM_ROOT/dem/resistance/data/
+    subgrid_calibration.dat, as the pair style finds it); None without that pair style, with `model cutoff`
+    or with `lubrication no` (no table enters the run)."""
+    with open(dem_input) as f:
+        text = f.read().replace("&\n", " ")          # LIGGGHTS joins a line ending in '&' to the next
+    table = None
+    for line in text.splitlines():
+        words = shlex.split(line.split("#", 1)[0])
+        if len(words) < 2 or words[0] != "pair_style" or words[1] != "fdm/subgrid":
+            continue
+        keys = {k: v for k, v in zip(words[2:], words[3:]) if k in ("model", "calibration", "lubrication")}
+        if keys.get("lubrication") == "no" or (keys.get("model") == "cutoff" and "calibration" not in keys):
+            table = None
+        elif "calibration" in keys:
+            table = os.path.join(os.path.dirname(os.path.abspath(dem_input)), keys["calibration"])
+        else:
+            root = os.environ.get("FDM_ROOT") or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+            table = os.path.normpath(os.path.join(root, "dem", "resistance", "data", "subgrid_calibration.dat"))
+    return table
+
+
+def _table_identity(table: str | None) -> dict:
+    """{"table": path, "sha256": hex digest of its bytes} (None, None without a table)."""
+    if table is None:
+        return dict(table=None, sha256=None)
+    if not os.path.isfile(table):
+        raise CheckpointError("the sub-grid calibration table %s (pair_style fdm/subgrid) is missing" % table)
+    with open(table, "rb") as f:
+        return dict(table=table, sha256=hashlib.sha256(f.read()).hexdigest())
+
+
+def stamp(case_dir: str, dem_input: str) -> str:
+    """Record in CASE/.fdmRun-calibration the calibration table the run starts with; returns a line for the log."""
+    identity = _table_identity(calibration_table(dem_input))
+    path = os.path.join(case_dir, CALIBRATION_STAMP)
+    with open(path + ".tmp", "w") as f:
+        json.dump(identity, f)
+    os.replace(path + ".tmp", path)
+    if identity["table"] is None:
+        return "no sub-grid calibration table"
+    return "calibration table %s (sha256 %s)" % (identity["table"], identity["sha256"][:12])
+
+
+def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
+    """On a resume: the table the input reads now against the one recorded when the run started. Raises
+    CheckpointError naming both if it changed (unless accept_new, which records the new one). A run started
+    before the record existed gets it now. Returns a line for the log."""
+    path = os.path.join(case_dir, CALIBRATION_STAMP)
+    now = _table_identity(calibration_table(dem_input))
+    if not os.path.isfile(path):
+        stamp(case_dir, dem_input)
+        return "no record of the calibration table the run started with (a run older than the record): recorded now"
+    with open(path) as f:
+        then = json.load(f)
+    if then == now:
+        return "the same calibration table as at the start"
+    describe = lambda d: "no table" if d["table"] is None else "%s with sha256 %s" % (d["table"], d["sha256"][:12])
+    if not accept_new:
+        raise CheckpointError(
+            "the sub-grid calibration table changed since this run started: it began with %s (recorded in %s), "
+            "the input now reads %s. Resuming would mix two sub-grid models in one run: restore the table the run "
+            "started with (git log -- dem/resistance/data), or resume with --new-calibration to continue with "
+            "the new one knowingly" % (describe(then), path, describe(now)))
+    stamp(case_dir, dem_input)
+    return "--new-calibration: continues with %s (it began with %s)" % (describe(now), describe(then))
+
+
 def main(argv):
     if len(argv) >= 2 and argv[0] == "select":
         try:
@@ -316,6 +396,16 @@ def main(argv):
     if len(argv) >= 4 and argv[0] == "until":
         try:
             print(set_last_step(argv[1], int(argv[2]), int(argv[3])))
+        except CheckpointError as e:
+            print(e, file=sys.stderr)
+            return 1
+        return 0
+    if len(argv) >= 3 and argv[0] in ("stamp", "check-stamp"):
+        try:
+            if argv[0] == "stamp":
+                print(stamp(argv[1], argv[2]))
+            else:
+                print(check_stamp(argv[1], argv[2], accept_new="--new-calibration" in argv[3:]))
         except CheckpointError as e:
             print(e, file=sys.stderr)
             return 1
