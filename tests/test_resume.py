@@ -400,6 +400,37 @@ def test_fdmRun_refuses_a_resume_whose_table_changed_and_loses_nothing(tmp_path,
     assert_same_trajectory(root, reference)
 
 
+def test_fdmRun_edited_in_place_during_a_run_ends_it_normally(tmp_path, env):
+    """A copy of fdmRun (beside an etc/bashrc that sources the project's) runs the small scene; while it
+    runs, its file is rewritten in place with 40 comment lines more at the top (an editor saving it, a
+    careless update): bash reads a script at byte offsets as it goes, so without fdmRun's { ... } group
+    the running fdmRun would read shifted text at its end (seen 2026-11-28: 'syntax error near unexpected
+    token' after a Table 8 row had finished). It must end normally, with its summary."""
+    tools = tmp_path / "tools"
+    (tools / "scripts").mkdir(parents=True)
+    (tools / "etc").mkdir()
+    (tools / "etc" / "bashrc").write_text(". '%s/etc/bashrc'\n" % PROJECT)
+    os.symlink(os.path.join(PROJECT, "scripts", "fdmsubgrid"), str(tools / "scripts" / "fdmsubgrid"))
+    copy = tools / "scripts" / "fdmRun"
+    shutil.copy(FDMRUN, str(copy))
+    root = make_scene(str(tmp_path / "run"), steps=30)
+    proc = subprocess.Popen([str(copy), root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            errors="replace")
+    deadline = time.time() + 120
+    while steps_done(root) < 3 and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.2)
+    assert proc.poll() is None, "fdmRun ended before the edit: " + proc.communicate()[0][-2000:]
+    text = open(FDMRUN).read()
+    with open(str(copy), "r+") as f:          # in place: the same file, the running bash's offsets now shifted
+        f.seek(0)
+        f.write("".join("# an edit made while a run was going, line %d\n" % k for k in range(40)) + text)
+        f.truncate()
+    out, _ = proc.communicate(timeout=300)
+    assert proc.returncode == 0, out[-3000:]
+    assert "syntax error" not in out and "fdm/couple timing" in out, out[-3000:]
+    assert steps_done(root) == 30
+
+
 # ------------------------------------------------------------------------------------------------
 # fluid_every K: particle steps between fluid steps
 # ------------------------------------------------------------------------------------------------
