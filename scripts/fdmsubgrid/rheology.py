@@ -325,7 +325,8 @@ def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error
     ax.set_ylim(0.7 * low, 3.0 * eta_data.max())
     ax.set_xlabel(r"$\phi_{core}$")
     ax.set_ylabel(r"$\eta_s$")
-    ax.legend(fontsize=8)
+    # lower right: the curve rises to the upper right, where the densest row's point is
+    ax.legend(fontsize=8, loc="lower right")
     if title:
         ax.set_title(title)
     fig.tight_layout()
