@@ -180,11 +180,16 @@ def set_last_step(dem_input: str, last_step: int, resume_step: int) -> int:
     planned = int(found.group(2))
     start, end = commands[0].span()
     line = found.group(1) + str(last_step) + found.group(3)
-    tmp = dem_input + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text[:start] + line + text[end:])
-    os.replace(tmp, dem_input)
+    _write_atomically(dem_input, text[:start] + line + text[end:])
     return planned
+
+
+def _write_atomically(path, data):
+    """Write `data` (str or bytes) to path whole or not at all: a temporary file renamed over it."""
+    tmp = path + ".tmp"
+    with open(tmp, "wb" if isinstance(data, bytes) else "w") as f:
+        f.write(data)
+    os.replace(tmp, path)
 
 
 def _is_time(name):
@@ -217,10 +222,7 @@ def _cut_lines(path, keep):
             out.append(line)
         else:
             dropped += 1
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.writelines(out)
-    os.replace(tmp, path)
+    _write_atomically(path, "".join(out))
     return dropped
 
 
@@ -240,10 +242,7 @@ def _cut_dump(path, step):
             keep_to = min(keep_to, s)
             dropped += 1
     if keep_to < len(data):
-        tmp = path + ".tmp"
-        with open(tmp, "wb") as f:
-            f.write(data[:keep_to])
-        os.replace(tmp, path)
+        _write_atomically(path, data[:keep_to])
     return dropped
 
 
@@ -345,10 +344,7 @@ def _table_identity(table: str | None) -> dict:
 def stamp(case_dir: str, dem_input: str) -> str:
     """Record in CASE/.fdmRun-calibration the calibration table the run starts with; returns a line for the log."""
     identity = _table_identity(calibration_table(dem_input))
-    path = os.path.join(case_dir, CALIBRATION_STAMP)
-    with open(path + ".tmp", "w") as f:
-        json.dump(identity, f)
-    os.replace(path + ".tmp", path)
+    _write_atomically(os.path.join(case_dir, CALIBRATION_STAMP), json.dumps(identity))
     if identity["table"] is None:
         return "no sub-grid calibration table"
     return "calibration table %s (sha256 %s)" % (identity["table"], identity["sha256"][:12])
@@ -361,7 +357,7 @@ def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
     path = os.path.join(case_dir, CALIBRATION_STAMP)
     now = _table_identity(calibration_table(dem_input))
     if not os.path.isfile(path):
-        stamp(case_dir, dem_input)
+        _write_atomically(path, json.dumps(now))
         return "no record of the calibration table the run started with (a run older than the record): recorded now"
     with open(path) as f:
         then = json.load(f)
@@ -374,7 +370,7 @@ def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
             "the input now reads %s. Resuming would mix two sub-grid models in one run: restore the table the run "
             "started with (git log -- dem/resistance/data), or resume with --new-calibration to continue with "
             "the new one knowingly" % (describe(then), path, describe(now)))
-    stamp(case_dir, dem_input)
+    _write_atomically(path, json.dumps(now))
     return "--new-calibration: continues with %s (it began with %s)" % (describe(now), describe(then))
 
 
