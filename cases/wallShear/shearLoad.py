@@ -179,14 +179,19 @@ def model_corrections(a_over_delta: float):
 
 def split_prediction(row: dict, correction: dict) -> tuple[float, float]:
     """(U_x/(gamma_dot d), Omega_z/(gamma_dot/2)) of the free sphere from the split: the solver's R plus the
-    correction R^SG (Kim-Karrila: R11 += 6 pi Y^A, R12 += -4 pi Y^B, R22 += 8 pi Y^C; wallcalibration's frame)
-    against the solver's load F^s."""
-    d = 1.0 + row["eps"]
-    r = np.array([[6 * math.pi * (row["Ft"]), 6 * math.pi * row["Fr"]], [6 * math.pi * row["Fr"], 8 * math.pi * row["Tr"]]])
-    r += np.array([[6 * math.pi * correction["YA"], -4 * math.pi * correction["YB"]],
-                   [-4 * math.pi * correction["YB"], 8 * math.pi * correction["YC"]]])
-    u, w = np.linalg.solve(r, [6 * math.pi * d * row["Fs"], -4 * math.pi * row["Ts"]])
-    return float(u / d), float(w / 0.5)
+    correction R^SG against the solver's load F^s, by the reference's own Eq. (R3) (freeSphereWall.free_sphere).
+    R^SG in GCB's factors (Kim-Karrila: R11 += 6 pi Y^A, R12 += -4 pi Y^B, R22 += 8 pi Y^C, wallcalibration's
+    frame): Ft + Y^A, Fr - (2/3) Y^B, Tt = (3/4) Fr (reciprocity), Tr + Y^C."""
+    fr = row["Fr"] - 2.0 / 3.0 * correction["YB"]
+    u, w = freeSphereWall.free_sphere(row["eps"], row["Ft"] + correction["YA"], 0.75 * fr, fr, row["Tr"] + correction["YC"],
+                                      row["Fs"], row["Ts"])
+    return u, -w
+
+
+def _infinite_box(values: Sequence[float], sizes: Sequence[float]) -> float:
+    """A quantity at an infinite box from its values in the boxes (three: wallcalibration.extrapolate3;
+    else the largest box's value)."""
+    return float(wallcalibration.extrapolate3(values, sizes)) if len(values) == 3 else float(values[-1])
 
 
 def extrapolated_rows(boxes: Sequence[dict], corrected: Sequence[dict] = (), corrections=None) -> list[dict]:
@@ -202,7 +207,7 @@ def extrapolated_rows(boxes: Sequence[dict], corrected: Sequence[dict] = (), cor
         row = dict(eps=eps)
         for q in FACTORS:
             values = [b["rows"][k][q] for b in boxes]
-            inf = float(wallcalibration.extrapolate3(values, sizes)) if len(boxes) == 3 else values[-1]
+            inf = _infinite_box(values, sizes)
             row[q] = inf
             row[q + "_by_box"] = values
             row[q + "_theory"] = th[q]
@@ -222,7 +227,7 @@ def extrapolated_rows(boxes: Sequence[dict], corrected: Sequence[dict] = (), cor
         # the free sphere with the correction, measured in the same boxes and extrapolated the same way
         for q in ("Ux_norm", "Wz_norm") if corrected else ():
             values = [c["rows"][k][q] for c in corrected]
-            inf = float(wallcalibration.extrapolate3(values, sizes)) if len(corrected) == 3 else values[-1]
+            inf = _infinite_box(values, sizes)
             row.update({q + "_corrected": inf, q + "_corrected_by_box": values,
                         q + "_corrected_rel_error": inf / ref[q] - 1.0})
         out.append(row)
