@@ -25,6 +25,19 @@ def load_case_module(name, script=None):
     return module
 
 
+def assert_refused(main, options, messages, tmp_path, capsys, extra=()):
+    """A case script's main(options) stops as argparse does (exit code 2) before running anything,
+    its error names every one of `messages` (a string or a list), and no results file is written."""
+    out = tmp_path / "r.json"
+    with pytest.raises(SystemExit) as exit_info:
+        main(list(options) + ["--workdir", str(tmp_path), "--out", str(out)] + list(extra))
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    for message in [messages] if isinstance(messages, str) else messages:
+        assert message in err, (message, err)
+    assert not out.exists()
+
+
 @pytest.fixture(scope="session")
 def env():
     """The project's environment (etc/bashrc) as a dict, for subprocesses."""

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import load_case_module
+from conftest import assert_refused, load_case_module
 
 
 @pytest.fixture(scope="module")
@@ -82,11 +82,7 @@ def test_sign_changes(pp):
     (["--d2-over-a", "0.9"], "d2/a"),
 ])
 def test_bad_options_refused_by_name(pp, argv, named, tmp_path, capsys):
-    with pytest.raises(SystemExit) as exit_info:
-        pp.main(argv + ["--workdir", str(tmp_path), "--out", str(tmp_path / "r.json"), "--no-plot"])
-    assert exit_info.value.code == 2
-    assert named in capsys.readouterr().err
-    assert not (tmp_path / "r.json").exists()
+    assert_refused(pp.main, argv, named, tmp_path, capsys, extra=["--no-plot"])
 
 
 # ------------------------------------------------------------------------------------------------

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import load_case_module
+from conftest import assert_refused, load_case_module
 
 
 @pytest.fixture(scope="module")
@@ -206,8 +206,4 @@ def test_single_sphere_box_effect(small_scene):
     (["--reference", "--r", "2"], "overlap or touch"),
 ])
 def test_bad_options_refused(three_spheres, tmp_path, capsys, options, message):
-    with pytest.raises(SystemExit) as exit_info:
-        three_spheres.main(options + ["--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
-    assert exit_info.value.code == 2
-    assert message in capsys.readouterr().err
-    assert not (tmp_path / "r.json").exists()
+    assert_refused(three_spheres.main, options, message, tmp_path, capsys)

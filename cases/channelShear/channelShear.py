@@ -46,7 +46,6 @@ the K^2 midpoints of a K x K grid on [0, 1/2]^2, each standing for four; N = 16 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import shutil
@@ -58,7 +57,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output, theory  # noqa: E402
+from fdmsubgrid import case, files, output, theory  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0
@@ -332,10 +331,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
         print_row(rows[-1])
     results = dict(case="channelShear", size_over_a=args.size, a_over_delta=args.a_over_delta,
                    positions=args.positions, tol_lambda=args.tol_lambda, model=args.model,
-                   rows=rows, wall_seconds=time.time() - t0)
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    with open(args.out, "w") as f:
-        json.dump(results, f, indent=1)
+                   rows=rows)
+    files.write_results(args.out, results, t0)
     png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_channelShear.png")
     plot(rows, png, "Free sphere at the centre of a sheared channel: walls %g a x %g a, a1/Delta = %g, %d positions"
          % (args.size[0], args.size[1], args.a_over_delta, args.positions))

@@ -66,7 +66,6 @@ Writes results.json and results_pairPoiseuille.png here (docs/cases.md).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import shutil
@@ -78,7 +77,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case  # noqa: E402
+from fdmsubgrid import case, files  # noqa: E402
 
 ETA = 1.0                         # Pa s
 U_C = 1.0                         # m/s, centre-line velocity of Eq. (47)
@@ -604,8 +603,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
     if args.convergence:
         args.subgrid = args.modes[0]
         scenes, changes = convergence(args, offsets, represented)
-        out = dict(common, study="convergence", scenes=scenes, changes=changes, wall_seconds=time.time() - t0,
-                   date=time.strftime("%Y-%m-%d"))
+        out = dict(common, study="convergence", scenes=scenes, changes=changes)
     else:
         scenes = []
         for subgrid in args.modes:
@@ -614,8 +612,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
             print_scene(sc)
             scenes.append(sc)
         out = dict(common, scenes=scenes, summary=summary(scenes), box=scene.size_over_a,
-                   a_over_delta=scene.a_over_delta, cells=scene.cells, wall_seconds=time.time() - t0,
-                   date=time.strftime("%Y-%m-%d"))
+                   a_over_delta=scene.a_over_delta, cells=scene.cells)
         for mode, e in out["summary"].items():
             print("%s: U_y1 changes sign at rho12/H = %s, U_y2 at %s; nearest (xi %.2g): Un/Uc %+.3e (%s of the "
                   "isolated spheres')" % (mode, ", ".join("%.3f" % v for v in e["Uy1_sign_change_rho_over_H"]) or "-",
@@ -623,8 +620,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                                           e["nearest"]["xi"], e["nearest"]["Un"],
                                           "-" if e["nearest"]["Un_ratio"] is None else
                                           "%.4f" % e["nearest"]["Un_ratio"]))
-    with open(args.out, "w") as f:
-        json.dump(out, f, indent=1)
+    files.write_results(args.out, out, t0)
     if not args.no_plot and not args.convergence:
         png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_pairPoiseuille.png")
         plot(scenes, png)

@@ -29,7 +29,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case  # noqa: E402
+from fdmsubgrid import case, files  # noqa: E402
 
 
 # The paper's contact case (section 5.3, Figs. 14-15): a2/a1 = 1.4, r^0 = (-3.48, 0.93) a1
@@ -221,9 +221,7 @@ def main(argv=None):
         results["trajectories"].append(t)
         results["summaries"].append(s)
         print(json.dumps(s))
-    results["wall_seconds"] = time.time() - t0
-    with open(args.out, "w") as f:
-        json.dump(results, f, indent=1)
+    files.write_results(args.out, results, t0)
     plot(results, os.path.join(os.path.dirname(args.out), "results_pairShear.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))
     return results

@@ -15,14 +15,13 @@ fdm/subgrid and once with its lubrication switched off.
 Writes results.json and results_pairSqueeze.png here (docs/cases.md).
 """
 import argparse
-import json
 import os
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, theory  # noqa: E402
+from fdmsubgrid import case, files, theory  # noqa: E402
 from fdmsubgrid import squeeze  # noqa: E402
 from fdmsubgrid.squeeze import box_extrapolated, run_pair  # noqa: E402
 
@@ -96,9 +95,7 @@ def main(argv=None):
             for xi, v, ref, e in zip(args.xi, r["velocity"], reference, r["rel_error"]):
                 print("  xi %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (xi, v, ref, 100 * e))
         results["cases"].append(entry)
-    results["wall_seconds"] = time.time() - t0
-    with open(args.out, "w") as f:
-        json.dump(results, f, indent=1)
+    files.write_results(args.out, results, t0)
     if "nosubgrid" in results["cases"][0]:
         plot(results, os.path.join(os.path.dirname(args.out), "results_pairSqueeze.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))

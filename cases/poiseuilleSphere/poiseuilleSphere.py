@@ -71,7 +71,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import json
 import math
 import os
 import shutil
@@ -83,7 +82,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case  # noqa: E402
+from fdmsubgrid import case, files  # noqa: E402
 
 ETA = 1.0                         # Pa s
 U_C = 1.0                         # m/s, centre-line velocity of the undisturbed flow (Eq. 47)
@@ -658,8 +657,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
     if args.convergence:
         rows, changes = convergence(args, offsets, represented, staben)
         out = dict(case="poiseuilleSphere", study="convergence", rows=rows, changes=changes, n_positions=represented,
-                   offsets=[list(o) for o in offsets], tol_lambda=args.tol_lambda, subgrid=args.subgrid,
-                   wall_seconds=time.time() - t0, date=time.strftime("%Y-%m-%d"))
+                   offsets=[list(o) for o in offsets], tol_lambda=args.tol_lambda, subgrid=args.subgrid)
     else:
         rows, channels = run_all(args.workdir, args.radius, args.two_a_over_H, d_words, offsets, represented, args,
                                  staben)
@@ -669,9 +667,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
                    rows=rows, channels=channels, size_over_a=args.size, a1_over_delta=args.a_over_delta,
                    n_positions=represented, offsets=[list(o) for o in offsets], subgrid=args.subgrid,
                    model=args.model, cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda,
-                   staben=staben, wall_seconds=time.time() - t0, date=time.strftime("%Y-%m-%d"))
-    with open(args.out, "w") as f:
-        json.dump(out, f, indent=1)
+                   staben=staben)
+    files.write_results(args.out, out, t0)
     if not args.no_plot and not args.convergence:
         png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_poiseuilleSphere.png")
         plot(rows, png, staben)

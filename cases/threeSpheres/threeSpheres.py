@@ -54,7 +54,6 @@ Writes results.json here (docs/cases.md, docs/validation.md "Three spheres (pape
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import shutil
@@ -67,7 +66,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 sys.path.insert(0, HERE)
-from fdmsubgrid import case  # noqa: E402
+from fdmsubgrid import case, files  # noqa: E402
 import channelImages  # noqa: E402
 import farField  # noqa: E402
 
@@ -463,10 +462,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
                "F/(6 pi eta a^2)", rows=results[0]["rows"], box=results[0]["box"], a_over_delta=args.a_over_delta,
                n_positions=represented, offsets=[list(o) for o in offsets], subgrid=args.subgrid, model=args.model,
                cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda, single=results[0]["single"],
-               far_field=results[0]["far_field"], boxes=results, box_comparison=comparison,
-               wall_seconds=time.time() - t0, date=time.strftime("%Y-%m-%d"))
-    with open(args.out, "w") as f:
-        json.dump(out, f, indent=1)
+               far_field=results[0]["far_field"], boxes=results, box_comparison=comparison)
+    files.write_results(args.out, out, t0)
     print("wrote %s (%.0f s)" % (args.out, out["wall_seconds"]))
     return out
 

@@ -52,7 +52,7 @@ from scipy.interpolate import CubicSpline
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 sys.path.insert(0, HERE)
-from fdmsubgrid import case, squeeze, wallcalibration  # noqa: E402
+from fdmsubgrid import case, files, squeeze, wallcalibration  # noqa: E402
 import freeSphereWall  # noqa: E402
 import wallShear  # noqa: E402
 
@@ -295,10 +295,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
                offsets=[list(o) for o in offsets], tol_lambda=args.tol_lambda, model=args.model, rows=rows,
                by_box=boxes, corrected_by_box=corrected,
                conventions="GCB's factors in the case's frame (module docstring); rel_error = solver/theory - 1; "
-                           "Ux_norm_exactR, Wz_norm_exactR: the free sphere with the exact R and the solver's Fs, Ts",
-               wall_seconds=time.time() - t0, date=time.strftime("%Y-%m-%d"))
-    with open(args.out, "w") as f:
-        json.dump(out, f, indent=1)
+                           "Ux_norm_exactR, Wz_norm_exactR: the free sphere with the exact R and the solver's Fs, Ts")
+    files.write_results(args.out, out, t0)
     print("wrote %s (%.0f s)" % (args.out, out["wall_seconds"]))
     return out
 

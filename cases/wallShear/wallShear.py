@@ -64,7 +64,6 @@ Writes results.json and results_wallShear.png here (docs/cases.md, docs/validati
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import shutil
@@ -77,7 +76,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 sys.path.insert(0, HERE)
-from fdmsubgrid import case, output  # noqa: E402
+from fdmsubgrid import case, files, output  # noqa: E402
 import freeSphereWall  # noqa: E402
 
 ETA = 1.0
@@ -446,9 +445,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
                a_over_delta=args.a_over_delta, n_positions=represented, offsets=[list(o) for o in offsets],
                radii=args.radius, subgrid_modes=subgrid_modes, model=args.model, cutoff_cells=args.cutoff or "default",
                wall_cutoff_cells=args.wall_cutoff or "default", tol_lambda=args.tol_lambda, boxes=results,
-               box_comparison=comparison, wall_seconds=time.time() - t0, date=time.strftime("%Y-%m-%d"))
-    with open(args.out, "w") as f:
-        json.dump(out, f, indent=1)
+               box_comparison=comparison)
+    files.write_results(args.out, out, t0)
     png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_wallShear.png")
     plot(results[0]["rows"], png, "Free sphere in shear near a wall (paper 5.2.1): box %g x %g x %g a1, a1/Delta %g, "
          "%d offsets" % (*results[0]["box"], args.a_over_delta, represented))

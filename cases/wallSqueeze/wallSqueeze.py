@@ -15,14 +15,13 @@ fdm/subgrid and once with its lubrication switched off.
 Writes results.json and results_wallSqueeze.png here (docs/cases.md).
 """
 import argparse
-import json
 import os
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, theory  # noqa: E402
+from fdmsubgrid import case, files, theory  # noqa: E402
 from fdmsubgrid import squeeze  # noqa: E402
 from fdmsubgrid.squeeze import box_extrapolated, run_wall  # noqa: E402
 
@@ -91,9 +90,7 @@ def main(argv=None):
         print("sub-grid %s: %.0f s" % ("on" if subgrid else "off", r["wall_seconds"]))
         for eps, v, ref, e in zip(args.eps, r["velocity"], reference, r["rel_error"]):
             print("  eps %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (eps, v, ref, 100 * e))
-    results["wall_seconds"] = time.time() - t0
-    with open(args.out, "w") as f:
-        json.dump(results, f, indent=1)
+    files.write_results(args.out, results, t0)
     if "nosubgrid" in results:
         plot(results, os.path.join(os.path.dirname(args.out), "results_wallSqueeze.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))

@@ -32,6 +32,8 @@ import shutil
 import sys
 import zlib
 
+from .files import write_atomically
+
 DEM_MAGIC = b"FDM-DEM-CHECKPOINT 1\n"
 DEM_TRAILER = b"end FDM-DEM-CHECKPOINT\n"
 FLUID_KEYS = ("step", "time", "timeIndex", "timeName", "stepsDone", "cells", "processors", "particles")
@@ -180,16 +182,8 @@ def set_last_step(dem_input: str, last_step: int, resume_step: int) -> int:
     planned = int(found.group(2))
     start, end = commands[0].span()
     line = found.group(1) + str(last_step) + found.group(3)
-    _write_atomically(dem_input, text[:start] + line + text[end:])
+    write_atomically(dem_input, text[:start] + line + text[end:])
     return planned
-
-
-def _write_atomically(path, data):
-    """Write `data` (str or bytes) to path whole or not at all: a temporary file renamed over it."""
-    tmp = path + ".tmp"
-    with open(tmp, "wb" if isinstance(data, bytes) else "w") as f:
-        f.write(data)
-    os.replace(tmp, path)
 
 
 def _is_time(name):
@@ -222,7 +216,7 @@ def _cut_lines(path, keep):
             out.append(line)
         else:
             dropped += 1
-    _write_atomically(path, "".join(out))
+    write_atomically(path, "".join(out))
     return dropped
 
 
@@ -242,7 +236,7 @@ def _cut_dump(path, step):
             keep_to = min(keep_to, s)
             dropped += 1
     if keep_to < len(data):
-        _write_atomically(path, data[:keep_to])
+        write_atomically(path, data[:keep_to])
     return dropped
 
 
@@ -344,7 +338,7 @@ def _table_identity(table: str | None) -> dict:
 def stamp(case_dir: str, dem_input: str) -> str:
     """Record in CASE/.fdmRun-calibration the calibration table the run starts with; returns a line for the log."""
     identity = _table_identity(calibration_table(dem_input))
-    _write_atomically(os.path.join(case_dir, CALIBRATION_STAMP), json.dumps(identity))
+    write_atomically(os.path.join(case_dir, CALIBRATION_STAMP), json.dumps(identity))
     if identity["table"] is None:
         return "no sub-grid calibration table"
     return "calibration table %s (sha256 %s)" % (identity["table"], identity["sha256"][:12])
@@ -357,7 +351,7 @@ def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
     path = os.path.join(case_dir, CALIBRATION_STAMP)
     now = _table_identity(calibration_table(dem_input))
     if not os.path.isfile(path):
-        _write_atomically(path, json.dumps(now))
+        write_atomically(path, json.dumps(now))
         return "no record of the calibration table the run started with (a run older than the record): recorded now"
     with open(path) as f:
         then = json.load(f)
@@ -370,7 +364,7 @@ def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
             "the input now reads %s. Resuming would mix two sub-grid models in one run: restore the table the run "
             "started with (git log -- dem/resistance/data), or resume with --new-calibration to continue with "
             "the new one knowingly" % (describe(then), path, describe(now)))
-    _write_atomically(path, json.dumps(now))
+    write_atomically(path, json.dumps(now))
     return "--new-calibration: continues with %s (it began with %s)" % (describe(now), describe(then))
 
 

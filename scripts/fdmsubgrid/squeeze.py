@@ -20,7 +20,7 @@ from typing import Sequence
 
 import numpy as np
 
-from . import case
+from . import case, files
 
 # Where the scene sits inside its first mesh cell (fractions of Delta along x, y, z): off the mesh's
 # symmetry planes, as the squeeze cases have always used.
@@ -59,10 +59,7 @@ def kept_result(run_dir: str, gaps: Sequence[float], tol_lambda: float) -> dict 
 
 def keep_result(run_dir: str, result: dict) -> None:
     """Write `result` as <run_dir>.json, whole or absent (through a temporary file)."""
-    kept = run_dir + ".json"
-    with open(kept + ".tmp", "w") as f:
-        json.dump(result, f)
-    os.replace(kept + ".tmp", kept)
+    files.write_json(run_dir + ".json", result, indent=None)
 
 
 def _result(velocity, wall_seconds: float, box, steps) -> dict:

@@ -1,0 +1,38 @@
+"""Writing result and record files whole or not at all.
+
+A run can be killed at any moment (Ctrl-C, a session's end, a full disk). A reader of its files (the
+validation report, `fdmRun --resume`, a notebook) must then find either the previous file or the new
+one, never half of one: every file is written to `<path>.tmp` and renamed over `path`, which POSIX
+makes atomic on one file system.
+"""
+from __future__ import annotations
+
+import json
+import os
+import time
+
+
+def write_atomically(path: str, data: str | bytes) -> None:
+    """Write `data` (str or bytes) to `path` whole or not at all: a temporary file renamed over it."""
+    tmp = path + ".tmp"
+    with open(tmp, "wb" if isinstance(data, bytes) else "w") as f:
+        f.write(data)
+    os.replace(tmp, path)
+
+
+def write_json(path: str, obj, indent: int | None = 1, **dump_options) -> None:
+    """`obj` as JSON in `path`, whole or not at all; its folder is made if missing.
+
+    `dump_options` go to json.dumps (e.g. `default=` for numpy values)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    os.makedirs(folder, exist_ok=True)
+    write_atomically(path, json.dumps(obj, indent=indent, **dump_options))
+
+
+def write_results(path: str, results: dict, started: float) -> dict:
+    """A case's results file: `results` stamped with its wall time since `started` (time.time()) and
+    today's date, written whole (write_json). Returns `results`, stamped."""
+    results["wall_seconds"] = time.time() - started
+    results["date"] = time.strftime("%Y-%m-%d")
+    write_json(path, results)
+    return results
