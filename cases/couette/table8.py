@@ -58,7 +58,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 
-from fdmsubgrid import checkpoint, demonly, output, rheology  # noqa: E402
+from fdmsubgrid import checkpoint, demonly, files, output, rheology  # noqa: E402
 from fdmsubgrid.shear import steps_planned  # noqa: E402
 
 sys.path.insert(0, HERE)
@@ -460,6 +460,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                         "the cores this process may use divided by --np-fluid)")
     args = p.parse_args(argv)
     os.makedirs(args.workdir, exist_ok=True)
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)   # the figures are written first
     start = time.time()
 
     waiting = list(args.phis)          # the rows not launched yet (for the progress lines)
@@ -501,8 +502,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     rows = sorted(rows + earlier_rows(args.rows_from, args.phis), key=lambda r: r["phi_bulk_table8"])
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    with open(args.out, "w") as f:
-        json.dump(summary, f, indent=1)
+    files.write_json(args.out, summary)
     print_table(summary)
     print("wrote %s" % args.out)
     if stopped:
