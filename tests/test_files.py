@@ -1,4 +1,4 @@
-"""fdmsubgrid.files: result and record files are written whole or not at all (docs/python.md)."""
+"""fdmsubgrid.files: result and record files are written whole or not at all (docs/cases.md)."""
 import json
 import time
 
@@ -22,7 +22,7 @@ def test_a_failed_write_leaves_the_previous_file_whole(tmp_path):
     files.write_json(str(out), dict(rows=[1, 2, 3]))
     before = out.read_text()
     with pytest.raises(TypeError):
-        files.write_json(str(out), dict(rows=[object()]))   # not serialisable: fails mid-way
+        files.write_json(str(out), dict(rows=[object()]))   # not serialisable: fails before the file is touched
     assert out.read_text() == before
     files.write_atomically(str(out), b"\x00bytes")
     assert out.read_bytes() == b"\x00bytes"

@@ -36,7 +36,7 @@ PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 sys.path.insert(0, HERE)
 
-from fdmsubgrid import case, demonly, output, profiles, rheology  # noqa: E402
+from fdmsubgrid import case, demonly, files, output, profiles, rheology  # noqa: E402
 import couette  # noqa: E402
 
 DEFAULT_VARIANTS = ["0.005:1", "0.02:1", "0.01:1", "0.01:2", "0.005:4", "0.01:4", "0.02:2", "0.0025:8"]
@@ -104,8 +104,7 @@ def run_variant(dt: float, k: int, tol: Optional[float], args: argparse.Namespac
                   steps=scene["steps"], fluid_steps=int(len(inner)), inner_iterations_mean=float(np.mean(inner)),
                   fluid_solves=int(np.sum(inner)), position_update=counts, strain=strain.tolist(),
                   wall_stress=stress.tolist())
-    with open(out, "w") as f:
-        json.dump(result, f)
+    files.write_json(out, result, indent=None)   # whole or absent: a rerun takes it instead of running
     print("%s: %.0f s, %d fluid steps, %.1f inner iterations per fluid step" % (name, wall, len(inner),
                                                                                result["inner_iterations_mean"]),
           flush=True)

@@ -27,7 +27,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 
-from fdmsubgrid import output  # noqa: E402
+from fdmsubgrid import files, output  # noqa: E402
 
 sys.path.insert(0, HERE)
 import couette  # noqa: E402
@@ -93,8 +93,7 @@ def run_one(phi: float, dt: float, stiffness: float, args: argparse.Namespace) -
         for k in ("min_pair_gap", "min_wall_gap", "eta_s", "eta_s_err", "stress_balance_rel_error", "springs",
                   "core_seconds_per_strain_unit", "n_particles"):
             row[k] = r.get(k)
-    with open(out, "w") as f:
-        json.dump(row, f, indent=1)
+    files.write_json(out, row)   # whole or absent: a rerun takes it instead of running
     return row
 
 

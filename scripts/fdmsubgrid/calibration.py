@@ -60,7 +60,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import pairtangential, squeeze, theory, wallcalibration
+from . import files, pairtangential, squeeze, theory, wallcalibration
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
 # positions of the gap centre inside its mesh cell (fractions of Delta)
@@ -368,8 +368,7 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                     + ([] if args.no_wall else [("wall", 1.0)]))
             for kind, ratio in jobs:
                 cals.append(measure(kind, ad, ratio, args.workdir, boxes=args.boxes, offsets=OFFSETS[:args.offsets]))
-                with open(raw_path, "w") as f:   # kept before any analysis
-                    json.dump([c.__dict__ for c in cals], f)
+                files.write_json(raw_path, [c.__dict__ for c in cals], indent=None)   # kept before any analysis
     fits = [c.fit() for c in cals]
     tables = [c.table(fit) for c, fit in zip(cals, fits)]
     summaries = [summary(c, fit, table) for c, fit, table in zip(cals, fits, tables)]
@@ -387,8 +386,8 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
         for ad in args.a_over_delta:
             tangential.append(wallcalibration.summary(wallcalibration.measure(
                 ad, args.workdir, offsets=wallcalibration.OFFSETS[:args.offsets])))
-            with open(os.path.join(args.workdir, "wall_tangential.json"), "w") as f:   # kept before the table
-                json.dump(tangential, f)
+            files.write_json(os.path.join(args.workdir, "wall_tangential.json"), tangential,
+                             indent=None)   # kept before the table
     pair_tangential: List[Dict] = []
     if args.pair_tangential_from_raw:
         for path in args.pair_tangential_from_raw:
@@ -401,8 +400,8 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
             for ratio in args.ratios:
                 pair_tangential.append(pairtangential.measure(ratio, ad, args.workdir,
                                                               offsets=pairtangential.OFFSETS[:args.offsets]))
-                with open(os.path.join(args.workdir, "pair_tangential.json"), "w") as f:   # kept before the table
-                    json.dump(pair_tangential, f)
+                files.write_json(os.path.join(args.workdir, "pair_tangential.json"), pair_tangential,
+                                 indent=None)   # kept before the table
     pair_tangential = [pairtangential.add_fits(s) for s in pair_tangential]
     command = "python3 -m fdmsubgrid.calibration " + " ".join(argv if argv is not None else sys.argv[1:])
     write_table(args.out, cals, fits, tables, command, tangential, pair_tangential)

@@ -42,7 +42,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import case, squeeze, theory
+from . import case, files, squeeze, theory
 from .squeeze import pair_centres
 from .wallcalibration import seen_gap
 
@@ -460,8 +460,7 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
         for ratio in args.ratio:
             out.append(measure(ratio, args.a_over_delta, args.workdir, args.gaps, args.boxes, OFFSETS[:args.offsets],
                                args.tol_lambda))
-            with open(args.out, "w") as f:
-                json.dump(out, f, indent=1)
+            files.write_json(args.out, out)   # each ratio's hours kept whole before the next
     out = [add_fits(s) for s in out]
     with open(args.out, "w") as f:
         json.dump(out, f, indent=1)
