@@ -189,8 +189,9 @@ def progress_report(waiting: List[float]) -> Optional[str]:
     return "table8 progress %s: %s" % (time.strftime("%H:%M"), "; ".join(parts))
 
 
-def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None) -> None:
-    """Start the run in run_dir, or resume it from its checkpoint (to step `until` if given)."""
+def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None, phi: Optional[float] = None) -> None:
+    """Start the run in run_dir, or resume it from its checkpoint (to step `until` if given); phi names the
+    row in the line that says so (one print: with --jobs 2 the rows' lines must not interleave)."""
     fdmrun = [os.path.join(PROJECT, "scripts", "fdmRun"), "-f", str(args.np_fluid)]
     try:
         checkpoint.select(run_dir)
@@ -200,7 +201,7 @@ def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None)
             raise   # a finished run without a checkpoint cannot be extended
         cmd = fdmrun + (["--overwrite"] if steps_done(run_dir) else []) + [run_dir]
     log = run_dir + ".log"
-    print("table8: %s (log %s)" % (" ".join(cmd), log), flush=True)
+    print("table8: %s%s (log %s)" % ("" if phi is None else "phi_bulk %g: " % phi, " ".join(cmd), log), flush=True)
     with open(log, "a") as f:
         done = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
     if done.returncode != 0:
@@ -246,11 +247,10 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
                         "--model", args.model, "--fluid-every", str(every), "--workdir", args.workdir], check=True)
         run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every)
     if steps_done(run_dir) < steps_planned(run_dir):
-        print("table8: phi_bulk %g:" % phi, end=" ", flush=True)
         # to the input's last step: an extension killed before its first checkpoint resumes from one
         # written for the shorter run, which fdmDEM accepts only with -until
         with running(run_dir, phi, dt, steps_planned(run_dir)):
-            _fdmrun(run_dir, args, until=steps_planned(run_dir))
+            _fdmrun(run_dir, args, until=steps_planned(run_dir), phi=phi)
     row = None
     while args.min_average > 0:
         row = analyse_row(phi, run_dir, args)
@@ -261,7 +261,7 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
               "%g: extended to strain %g" % (phi, row.get("strain_averaged", 0.0), args.min_average, until * dt),
               flush=True)
         with running(run_dir, phi, dt, until):
-            _fdmrun(run_dir, args, until=until)
+            _fdmrun(run_dir, args, until=until, phi=phi)
     return row
 
 
