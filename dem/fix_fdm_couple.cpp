@@ -152,6 +152,12 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
         error->all(FLERR, ("fix fdm/couple: fluid_every K needs K >= 1 particle steps per fluid step, got " +
                            std::string(value(1))).c_str());
       i++;
+    } else if (key == "held_drag") {
+      const std::string v = value(1);
+      if (v != "constant" && v != "extrapolated")
+        error->all(FLERR, ("fix fdm/couple: held_drag must be constant or extrapolated, got " + v).c_str());
+      heldExtrapolated_ = (v == "extrapolated");
+      i++;
     } else if (key == "coulomb_tolerance") {
       coulombTolerance_ = force->numeric(FLERR, value(1));
       if (!(coulombTolerance_ > 0 && coulombTolerance_ < 1))
@@ -889,6 +895,7 @@ void FixFdmCouple::frozenFluidStep(const std::vector<Particle> &particles)
       held.particles[p].F[d] = dragTimesLastU[size_t(6) * p + d] + hydro_[size_t(6) * p + d];
       held.particles[p].T[d] = dragTimesLastU[size_t(6) * p + 3 + d] + hydro_[size_t(6) * p + 3 + d];
     }
+  if (heldExtrapolated_) extrapolateHeldDrag(held);
   solveVelocities(held);
   const std::vector<double> dragTimesU = system_->rigidBlocksTimes(solution_);
   for (int p = 0; p < natoms_; p++)
@@ -900,6 +907,40 @@ void FixFdmCouple::frozenFluidStep(const std::vector<Particle> &particles)
   // ones follow the particles
   subgridResults(particles);
   lastIterations_ = 0;
+}
+
+void FixFdmCouple::extrapolateHeldDrag(cpl::Integrals &held)
+{
+  // rank 0, held_drag extrapolated (docs/dem.md, "Particle steps between fluid steps"): the drag target
+  // D U_b of a held step is extrapolated linearly in time from the last two fluid steps, s_n and s_{n-1}:
+  // D U_b(s) = b_n + f (b_n - b_{n-1}), f = (s - s_n)/(s_n - s_{n-1}), at most 1. The fluid's force on a
+  // particle changes along the step as the particles move (a pair turning about its contact sees the
+  // normal load of the shear change sign): held constant that change is lost for K - 1 steps, first order
+  // in the fluid's step; extrapolated it is lost to second order. b_n is D U + F^FDM of the fluid step,
+  // which held carries at the first held step after it (the same at every held step for constant drag).
+  if (heldDragStep_ != lastFluidStep_) {
+    heldDragBefore_.swap(heldDrag_);
+    heldDragStepBefore_ = heldDragStep_;
+    heldDrag_.assign(size_t(6) * natoms_, 0.0);
+    for (int p = 0; p < natoms_; p++)
+      for (int d = 0; d < 3; d++) {
+        heldDrag_[size_t(6) * p + d] = held.particles[p].F[d];
+        heldDrag_[size_t(6) * p + 3 + d] = held.particles[p].T[d];
+      }
+    heldDragStep_ = lastFluidStep_;
+  }
+  // a fluid step forced between the regular ones (a run's end, a checkpoint) leaves a short interval:
+  // f is capped at 1 so that its slope is not stretched over a longer one
+  const bool twoSteps = heldDragStepBefore_ >= 0 && heldDragStepBefore_ < heldDragStep_ &&
+                        heldDragBefore_.size() == heldDrag_.size();
+  const double f = twoSteps ? std::min(1.0, double(update->ntimestep - heldDragStep_) /
+                                                double(heldDragStep_ - heldDragStepBefore_)) : 0.0;
+  for (int p = 0; p < natoms_; p++)
+    for (int d = 0; d < 3; d++) {
+      const size_t force = size_t(6) * p + d, torque = force + 3;
+      held.particles[p].F[d] = heldDrag_[force] + (twoSteps ? f * (heldDrag_[force] - heldDragBefore_[force]) : 0.0);
+      held.particles[p].T[d] = heldDrag_[torque] + (twoSteps ? f * (heldDrag_[torque] - heldDragBefore_[torque]) : 0.0);
+    }
 }
 
 void FixFdmCouple::planNextMove(const std::vector<Particle> &particles)
@@ -1182,7 +1223,8 @@ void FixFdmCouple::printTiming(const char *what, const Timing &t, double wall, i
                 adamsBashforth_ ? "ab2" : "euler", gapStats.c_str(),
                 notConverged_ ? (", " + std::to_string(notConverged_) + " steps not converged").c_str() : "",
                 fluidEvery_ > 1 ? ("; fluid_every " + std::to_string(fluidEvery_) + ": the fluid solved in " +
-                                   std::to_string(t.fluidSteps) + " of the steps").c_str() : "");
+                                   std::to_string(t.fluidSteps) + " of the steps" +
+                                   (heldExtrapolated_ ? ", the held drag extrapolated" : "")).c_str() : "");
   if (screen) fputs(line, screen);
   if (logfile) fputs(line, logfile);
 }

@@ -5,7 +5,7 @@
                            [connect_timeout s] [timeout s] [record FILE] [gravity gx gy gz] [move yes|no]
                            [stresslets yes|no] [solver cg|ldlt] [tolerance t] [integrator ab2|euler]
                            [gap_update log|none] [contact_gaps hold|free] [checkpoint N] [walls FILE]
-                           [fluid_every K]
+                           [fluid_every K] [held_drag constant|extrapolated]
      fix ID all fdm/couple transport none viscosity eta mesh Delta [fluid_density rho_f] ...   (DEM only)
 
    Every time step: moves the particles with their velocity (initial_integrate, paper 4.3 step 1),
@@ -15,7 +15,8 @@
    pair_style fdm/subgrid, the sub-grid lubrication blocks R^SG (pairs and walls) are gathered on
    rank 0 once per time step and enter the matrix of Eq. (31) (paper section 4.4.2).
    With fluid_every K the fluid is solved at every K-th step only; the steps between hold its force on
-   each particle as an isolated sphere's drag toward the velocity the fluid gave it (frozenFluidStep).
+   each particle as an isolated sphere's drag toward the velocity the fluid gave it (frozenFluidStep),
+   or, with held_drag extrapolated, toward that velocity extrapolated from the last two fluid steps.
    Eq. (31) itself is particle_velocity_system.h; the connection to fdmFoam and what it said at the
    handshake are the process's coupling session (coupling_session.h), which this fix configures.
 
@@ -98,6 +99,7 @@ class FixFdmCouple : public Fix {
   void backgroundFlow(const std::vector<Particle> &particles, fdm::coupler::Integrals &integrals);
   bool fluidStepDue() const;
   void frozenFluidStep(const std::vector<Particle> &particles);
+  void extrapolateHeldDrag(fdm::coupler::Integrals &held);
   void storeStepDone(const fdm::coupler::StepDone &done);
   void planNextMove(const std::vector<Particle> &particles);
   void scatter();
@@ -152,6 +154,11 @@ class FixFdmCouple : public Fix {
   // (-1: none yet in this session, or a checkpoint's step after a resume)
   long fluidEvery_ = 1;
   bigint lastFluidStep_ = -1;
+  // held_drag extrapolated: D U_b of the last two fluid steps (6N each, by tag) and their steps, taken at
+  // the first held step after each fluid step; -1: none yet (the held drag is then constant)
+  bool heldExtrapolated_ = false;
+  std::vector<double> heldDrag_, heldDragBefore_;
+  bigint heldDragStep_ = -1, heldDragStepBefore_ = -1;
   double runStart_;
   int nmax_;                       // rows allocated in array_atom
   double **perAtom_;

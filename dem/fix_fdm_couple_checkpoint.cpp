@@ -129,6 +129,11 @@ void FixFdmCouple::writeCheckpoint()
     c.arrays["subgrid"] = subgrid_;
     c.arrays["fluidStress"] = fluidStress_;
     c.arrays["stress"] = stress_;
+    // held_drag: the mode (a resume must hold the drag as the run did) and, extrapolated, the last two
+    // fluid steps' drag targets (a resumed run extrapolates as the one it continues)
+    c.arrays["heldDrag"] = {heldExtrapolated_ ? 1.0 : 0.0, double(heldDragStep_), double(heldDragStepBefore_)};
+    c.arrays["heldDragLast"] = heldDrag_;
+    c.arrays["heldDragBefore"] = heldDragBefore_;
     const std::string file = std::string(directory) + "/" + prefix + std::to_string((long long) c.step);
     try {
       ::mkdir(directory, 0755);
@@ -200,6 +205,15 @@ void FixFdmCouple::readResumeCheckpoint()
     problem = other + "particle " + std::to_string(bad) + " has radius " + fdm::text::number(r[10]) + " and density " +
               fdm::text::number(r[12]) + " there but not in the LIGGGHTS input";
   }
+  if (problem.empty()) {
+    // written before held_drag existed: the drag was held constant
+    const auto held = c.arrays.find("heldDrag");
+    const bool extrapolated = held != c.arrays.end() && !held->second.empty() && held->second[0] != 0;
+    if (extrapolated != heldExtrapolated_)
+      problem = resumeFile_ + " was written with held_drag " + (extrapolated ? "extrapolated" : "constant") +
+                " but the input has held_drag " + (heldExtrapolated_ ? "extrapolated" : "constant") +
+                ": a resumed run must hold the fluid's force between fluid steps as the run it continues";
+  }
   if (!problem.empty()) error->all(FLERR, ("fdm/couple: cannot resume: " + problem).c_str());
 
   update->reset_timestep(bigint(c.step));
@@ -259,4 +273,11 @@ void FixFdmCouple::restoreCheckpoint()
   subgrid_ = c.arrays.at("subgrid");
   fluidStress_ = c.arrays.at("fluidStress");
   stress_ = c.arrays.at("stress");
+  const auto held = c.arrays.find("heldDrag");
+  if (held != c.arrays.end() && held->second.size() == 3) {
+    heldDragStep_ = bigint(held->second[1]);
+    heldDragStepBefore_ = bigint(held->second[2]);
+    heldDrag_ = c.arrays.at("heldDragLast");
+    heldDragBefore_ = c.arrays.at("heldDragBefore");
+  }
 }

@@ -152,15 +152,16 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
 def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
                strain: float, dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50,
                write_every: int = 100000, text_dump: bool = False, model: str = "calibrated",
-               fluid_options: dict | None = None, fluid_every: int = 1) -> dict:
+               fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated") -> dict:
     """fluid/ and dem/ of the run (suspension.write_case with the walls at -U and +U); returns the
     scene's description. fluid_options: more arguments of case.write_fluid_case; fluid_every: particle
-    steps per fluid step."""
+    steps per fluid step; held_drag: how the steps between hold the fluid's force (fix fdm/couple)."""
     U = SHEAR_RATE * float(pack.box[1]) / 2
     steps = int(round(strain / (SHEAR_RATE * dt)))
     scene = suspension.write_case(run_dir, pack, springs, a_over_delta, dt, steps, dump_every, tol_lambda,
                                   acceleration, n_max, write_every, text_dump, model, wall_velocities=(-U, U),
-                                  name="in.couette", fluid_options=fluid_options, fluid_every=fluid_every)
+                                  name="in.couette", fluid_options=fluid_options, fluid_every=fluid_every,
+                                  held_drag=held_drag)
     scene.update(wall_velocity=U)
     return scene
 
@@ -182,6 +183,9 @@ def main(argv: list[str] | None = None) -> dict:
                    help="solve the fluid every K-th particle step (its step K dt); the steps between hold its "
                    "force on each particle as a drag toward the velocity it gave (docs/dem.md, 'Particle steps "
                    "between fluid steps')")
+    p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
+                   help="with --fluid-every: the held force's drag target extrapolated from the last two fluid "
+                   "steps (default) or constant (fix fdm/couple held_drag, docs/dem.md)")
     p.add_argument("--strain", type=float, default=3.0, help="strain units to run")
     p.add_argument("--seed", type=int, default=1, help="seed of the random packing")
     p.add_argument("--dump-every", type=float, default=0.1, help="strain between two particle snapshots")
@@ -267,7 +271,7 @@ def main(argv: list[str] | None = None) -> dict:
     write_every = K * max(1, int(round(args.write_every / (SHEAR_RATE * dt * K))))
     scene = write_case(run_dir, pack, springs, args.a_over_delta, dt, args.strain, every, args.tol_lambda,
                        args.acceleration, args.n_max, write_every, args.text_dump, args.model,
-                       fluid_every=args.fluid_every)
+                       fluid_every=args.fluid_every, held_drag=args.held_drag)
     print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
           "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
                               " x ".join("%g" % v for v in args.size), scene["cells"], scene["steps"], dt, every))

@@ -17,6 +17,12 @@ trajectories do; --window sets the strain range compared.
                                               (reference) 0.02:1 0.01:1 0.01:2 0.005:4 0.01:4 0.02:2 0.0025:8
   fluidEvery.py --phi 0.42 --variants 0.005:1 0.04:1 0.02:1 0.02:2 0.01:4 0.01:2 --jobs 2
   fluidEvery.py --variants 0.01:2:0.001 0.01:2:0.01 0.01:2:0.03 --jobs 2     the inner iteration's tolerance
+  fluidEvery.py --strain 0.4 --window 0.05 0.4 --dump-every 0.02 --variants 0.005:1 0.005:4 --held-drag constant
+                                              the held drag constant instead of extrapolated (fix fdm/couple
+                                              held_drag), the particles compared every 0.02 strain
+
+Besides the stress curves, each variant's particles are compared with the reference's at the window's end
+(the last common record): mean position and velocity differences (trajectory_difference).
 
 Writes <workdir>/<variant>.json per variant (a variant whose file exists is not run again) and --out
 (default docs/benchmarks_fluidEvery_phi<PHI>.json) with a figure beside it (the stress curves, and the
@@ -61,8 +67,16 @@ def parse_variant(text: str) -> Variant:
     return dt_value, k_value, tol
 
 
-def variant_name(dt: float, k: int, tol: Optional[float] = None) -> str:
-    return "dt%g_every%d" % (dt, k) + ("" if tol is None else "_tol%g" % tol)
+def variant_name(dt: float, k: int, tol: Optional[float] = None, held_drag: str = "extrapolated") -> str:
+    """dt<DT>_every<K>[_tol<TOL>], and _constant for a variant whose held drag is constant (K > 1)."""
+    return ("dt%g_every%d" % (dt, k) + ("" if tol is None else "_tol%g" % tol)
+            + ("_constant" if k > 1 and held_drag == "constant" else ""))
+
+
+def result_held_drag(r: Dict) -> Optional[str]:
+    """How a variant's steps between fluid steps held the fluid's force (None: K = 1, no such steps); results
+    written before 2026-11-28 (no held_drag) held it constant, the only way there was."""
+    return None if r["fluid_every"] <= 1 else r.get("held_drag", "constant")
 
 
 def result_name(r: Dict) -> str:
@@ -82,14 +96,18 @@ def wall_stress_curve(run_dir: str, box: List[float]) -> Tuple[np.ndarray, np.nd
 def run_variant(dt: float, k: int, tol: Optional[float], args: argparse.Namespace) -> Dict:
     """One variant (or its results file): wall time, fluid steps, inner iterations per fluid step, the
     position update's counts and the stress curve."""
-    name = variant_name(dt, k, tol)
+    name = variant_name(dt, k, tol, args.held_drag)
     tol_lambda = args.tol_lambda if tol is None else tol
     out = os.path.join(args.workdir, name + ".json")
     if os.path.exists(out):
         with open(out) as f:
-            return json.load(f)
+            kept = json.load(f)
+        if result_held_drag(kept) == (args.held_drag if k > 1 else None):
+            return kept
+        print("%s: %s held its drag %s, not %s: run again" % (name, out, result_held_drag(kept), args.held_drag))
     scene = couette.main(["--phi", str(args.phi), "--size", *map(str, args.size), "--seed", str(args.seed),
                           "--a-over-delta", str(args.a_over_delta), "--dt", str(dt), "--fluid-every", str(k),
+                          "--held-drag", args.held_drag,
                           "--strain", str(args.strain), "--tol-lambda", str(tol_lambda),
                           "--dump-every", str(args.dump_every), "--write-every", str(args.strain),
                           "--workdir", os.path.join(args.workdir, name), "--write-only", "--overwrite"])
@@ -100,6 +118,7 @@ def run_variant(dt: float, k: int, tol: Optional[float], args: argparse.Namespac
         counts = demonly.position_update_counts(f.read())
     inner = output.steps(os.path.join(run_dir, "fluid"))["innerIterations"]
     result = dict(name=name, dt=dt, fluid_every=k, fluid_dt=dt * k, tol_lambda=tol_lambda, run_dir=run_dir,
+                  held_drag=args.held_drag if k > 1 else None,
                   wall_seconds=wall,
                   steps=scene["steps"], fluid_steps=int(len(inner)), inner_iterations_mean=float(np.mean(inner)),
                   fluid_solves=int(np.sum(inner)), position_update=counts, strain=strain.tolist(),
@@ -111,9 +130,34 @@ def run_variant(dt: float, k: int, tol: Optional[float], args: argparse.Namespac
     return result
 
 
+def trajectory_difference(reference: Dict, result: Dict, strain: float) -> Optional[Dict]:
+    """The particles of two variants compared at their last common record at or before `strain`: the mean over
+    the particles of |x - x_ref| (a1; the minimum image in the periodic directions) and of |U - U_ref| over the
+    wall speed. None where a run has no records left (its folder deleted) or none in common."""
+    paths = [os.path.join(r["run_dir"], "dem", "particles.records") for r in (reference, result)]
+    if not all(os.path.isfile(path) for path in paths):
+        return None
+    ref, other = (output.read_particle_records(path, mmap=False) for path in paths)
+    times, i, j = np.intersect1d(np.round(ref.times, 9), np.round(other.times, 9), return_indices=True)
+    keep = (times > 0) & (times * couette.SHEAR_RATE <= strain + 1e-9)
+    if not keep.any():
+        return None
+    k = int(np.nonzero(keep)[0][-1])
+    lo, hi = np.array(ref.header["box_lo"], float), np.array(ref.header["box_hi"], float)
+    length = np.where(np.array(ref.header["periodic"], bool), hi - lo, 0.0)
+    dx = other["x"][j[k]] - ref["x"][i[k]]
+    dx -= length * np.round(np.divide(dx, length, out=np.zeros_like(dx), where=length > 0))
+    wall_speed = couette.SHEAR_RATE * (hi[1] - lo[1]) / 2
+    return dict(strain=float(times[k] * couette.SHEAR_RATE),
+                position=float(np.linalg.norm(dx, axis=1).mean()),
+                velocity=float(np.linalg.norm(other["U"][j[k]] - ref["U"][i[k]], axis=1).mean() / wall_speed))
+
+
 def compare(results: List[Dict], window: Tuple[float, float]) -> None:
     """Adds to each result its error against the first over the strain window: the mean and the rms
-    of the relative difference of the stress curves (interpolated on a common strain grid)."""
+    of the relative difference of the stress curves (interpolated on a common strain grid), and the
+    particles' mean position and velocity differences at the window's end (trajectory_difference; finer
+    with a smaller --dump-every)."""
     lo, hi = window
     grid = np.linspace(lo, hi, 200)
     ref = np.interp(grid, results[0]["strain"], results[0]["wall_stress"])
@@ -124,6 +168,8 @@ def compare(results: List[Dict], window: Tuple[float, float]) -> None:
         r["stress_mean"] = float(curve.mean())
         r["error_mean"] = float(diff.mean())
         r["error_rms"] = float(np.sqrt(np.mean(diff ** 2)))
+        r["particles_difference"] = trajectory_difference(results[0], r, hi)
+        r["fluid_solves_per_step"] = r["fluid_solves"] / r["steps"]
 
 
 def plot(results: List[Dict], path: str) -> None:
@@ -166,6 +212,8 @@ def main(argv=None) -> Dict:
     p.add_argument("--variants", nargs="+", type=parse_variant, default=[parse_variant(v) for v in DEFAULT_VARIANTS],
                    metavar="DT:K[:TOL]",
                    help="particle step, steps per fluid step and (optional) tolLambda; the first is the reference")
+    p.add_argument("--held-drag", choices=("extrapolated", "constant"), default="extrapolated",
+                   help="how the steps between fluid steps hold the fluid's force (fix fdm/couple held_drag)")
     p.add_argument("--jobs", type=int, default=1, help="variants run at once (each takes two processes)")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs", "fluidEvery"))
     p.add_argument("--out", default=None, help="default docs/benchmarks_fluidEvery_phi<PHI>.json")
@@ -178,18 +226,20 @@ def main(argv=None) -> Dict:
     compare(results, tuple(args.window))
     summary = dict(command="cases/couette/fluidEvery.py " + " ".join(sys.argv[1:] if argv is None else argv),
                    phi=args.phi, size=list(args.size), seed=args.seed, a_over_delta=args.a_over_delta,
-                   tol_lambda=args.tol_lambda, strain=args.strain, window=list(args.window),
+                   tol_lambda=args.tol_lambda, strain=args.strain, window=list(args.window), held_drag=args.held_drag,
                    runs=[{k: v for k, v in r.items() if k not in ("strain", "wall_stress")} for r in results])
-    print("%-26s %9s %8s %8s %11s %10s %9s %9s" % ("variant", "fluid dt", "wall s", "fluid st", "inner/fluid",
-                                                   "limited/ps", "err mean", "err rms"))
+    print("%-26s %9s %8s %8s %11s %11s %10s %9s %9s %9s %9s" % (
+        "variant", "fluid dt", "wall s", "fluid st", "inner/fluid", "solves/step", "limited/ps", "err mean", "err rms",
+        "|dx| a1", "|dU|/U"))
     for r in results:
         pu = r.get("position_update") or {}
-        print("%-26s %9g %8.0f %8d %11.1f %10.4f %8.1f%% %8.1f%%"
+        moved = r.get("particles_difference") or {}
+        print("%-26s %9g %8.0f %8d %11.1f %11.2f %10.4f %8.1f%% %8.1f%% %9.1e %9.1e"
               % (result_name(r), r["fluid_dt"], r["wall_seconds"], r["fluid_steps"],
-                 r["inner_iterations_mean"], pu.get("limited_per_particle_step") or 0.0, 100 * r["error_mean"],
-                 100 * r["error_rms"]))
-    with open(args.out, "w") as f:
-        json.dump(summary, f, indent=1)
+                 r["inner_iterations_mean"], r["fluid_solves_per_step"], pu.get("limited_per_particle_step") or 0.0,
+                 100 * r["error_mean"], 100 * r["error_rms"], moved.get("position", np.nan),
+                 moved.get("velocity", np.nan)))
+    files.write_json(args.out, summary, indent=1)
     plot(results, os.path.splitext(args.out)[0] + ".png")
     print("wrote", args.out)
     return summary

@@ -14,6 +14,7 @@ r_y0 = 0.93, h_r = 5e-3 a1, mu_s = 0.5) and leave on a higher streamline.
   pairShear.py --contact       lambda = 1.4, h_r = 5e-3 a1, mu_s = 0.5 (kn = 2e4, kt = 200 N/m)
   pairShear.py --contact --size 20 12 10     the same with room: the paper's contact window
   pairShear.py --full          both, a1/Delta = 5, 20 x 12 x 8, several impact parameters
+  pairShear.py --contact --fluid-every 3     the fluid solved every 3rd step only (fix fdm/couple fluid_every)
   pairShear.py --help          every option
 Writes results.json and results_pairShear.png here (docs/cases.md).
 """
@@ -29,7 +30,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, files  # noqa: E402
+from fdmsubgrid import case, files, output  # noqa: E402
 
 
 # The paper's contact case (section 5.3, Figs. 14-15): a2/a1 = 1.4, r^0 = (-3.48, 0.93) a1
@@ -51,10 +52,15 @@ def paper_contact(a1=1.0, kn=2e4, kt=200.0):
 def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0, size=(12.0, 8.0, 6.0), dt=0.05,
                    tol_lambda=1e-3, n_max=50, cutoff=None, np_fluid=1, keep=False, max_steps=4000, lubrication=True,
                    gap_update="log", integrator="ab2", r_x0=None, acceleration="anderson",
-                   mean_flow_correction=True, tol_velocity=0.0, model="calibrated"):
+                   mean_flow_correction=True, tol_velocity=0.0, model="calibrated", fluid_every=1,
+                   held_drag="extrapolated"):
     """One coupled run from r_x = r_x0 (default -r_x_end) to +r_x_end (r_x_end = 6, the paper's, or
     less in a box shorter than 14 a1: the minimum image in the periodic x must stay unambiguous);
-    returns the relative trajectory and the gaps."""
+    returns the relative trajectory and the gaps. fluid_every K: the fluid is solved every K-th particle
+    step (fix fdm/couple ... fluid_every, docs/dem.md), the steps between holding its force with held_drag
+    (extrapolated or constant); the trajectory is read from the particle records of every step either way."""
+    if fluid_every < 1:
+        raise ValueError("pairShear: fluid_every must be at least 1, got %r" % fluid_every)
     a1, a2 = 1.0, ratio
     delta = a1 / a_over_delta
     Lx, H, Lz = size
@@ -65,6 +71,8 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
                                                 "" if lubrication else "_nolub", dt, integrator, gap_update)
     if r_x0 is not None:
         name += "_rx%g" % r_x0
+    if fluid_every > 1:
+        name += "_fluidEvery%d%s" % (fluid_every, "" if held_drag == "extrapolated" else "_" + held_drag)
     run_dir = os.path.join(workdir, name)
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
@@ -89,30 +97,41 @@ def run_trajectory(workdir, ratio=1.0, r_y0=0.5, contact=None, a_over_delta=3.0,
     if contact:
         kn, kt, mu, hr = contact
         pair += " contact %r %r %r %r" % (kn, kt, mu, hr)
-    # runs of 5 steps until sphere 2 has passed r_x_end (x2 - x1, minimum image in the periodic x;
-    # 5 steps move r_x by much less than the 1.5 a1 left before the minimum image flips)
+    # runs of about 5 steps until sphere 2 has passed r_x_end (x2 - x1, minimum image in the periodic x;
+    # 5 steps move r_x by much less than the 1.5 a1 left before the minimum image flips); a multiple of
+    # fluid_every, since the fluid is also solved at the last step of every run
+    chunk = fluid_every * int(math.ceil(5.0 / fluid_every))
     rx = "variable        rx equal x[2]-x[1]-%(L)r*round((x[2]-x[1])/%(L)r)" % dict(L=Lx)
     loop = ["thermo_style    custom step v_rx f_couple[1] f_couple[5] f_couple[6] f_couple[8]",
             "thermo          20",
-            "variable        chunk loop %d" % int(math.ceil(steps / 5.0)),
+            "variable        chunk loop %d" % int(math.ceil(steps / float(chunk))),
             "label           advance",
-            "run             5",
+            "run             %d" % chunk,
             'if              "${rx} > %r" then "jump SELF finished"' % r_x_end,
             "next            chunk",
             "jump            SELF advance",
             "label           finished"]
+    fix = "integrator %s gap_update %s" % (integrator, gap_update)
+    if fluid_every > 1:
+        fix += " fluid_every %d held_drag %s" % (fluid_every, held_drag)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=dt, pair_style=pair,
-                         fix_options="integrator %s gap_update %s" % (integrator, gap_update), before_run=rx, runs=loop, name="in.pairShear")
-    wall, parts, steps_data = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
-    one, two = parts["tag"] == 1, parts["tag"] == 2
-    rel = np.stack([parts[c][two] - parts[c][one] for c in ("x", "y", "z")], axis=1)
+                         fix_options=fix, before_run=rx + "\n" + case.RECORD_EVERY_STEP, runs=loop,
+                         name="in.pairShear")
+    wall, _, steps_data = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    records = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"), mmap=False)
+    stepped = records.steps >= 1   # a block at step 0 holds the start, not a step
+    rel = records["x"][stepped, 1, :] - records["x"][stepped, 0, :]
     rel[:, 0] -= Lx * np.round(rel[:, 0] / Lx)
     r = np.linalg.norm(rel, axis=1)
     xi = 2 * r / (a1 + a2) - 2
     gap = r - a1 - a2
     return dict(ratio=ratio, r_y0=r_y0, contact=contact, dt=dt, integrator=integrator, gap_update=gap_update, a_over_delta=a_over_delta, size=list(size),
                 cells=box.n[0] * box.n[1] * box.n[2], steps=int(len(r)), wall_seconds=wall,
+                fluid_every=fluid_every, held_drag=held_drag if fluid_every > 1 else None,
+                fluid_steps=int(len(steps_data["innerIterations"])),
                 inner_iterations_mean=float(steps_data["innerIterations"].mean()),
+                # the cost per particle step: with fluid_every K the fluid's solves spread over K steps
+                fluid_solves_per_step=float(steps_data["innerIterations"].sum() / max(len(rel), 1)),
                 unconverged_steps=int((steps_data["converged"] == 0).sum()),
                 r_x=rel[:, 0].tolist(), r_y=rel[:, 1].tolist(), r_z=rel[:, 2].tolist(), xi=xi.tolist(),
                 gap_over_a1=(gap / a1).tolist())
@@ -189,7 +208,13 @@ def main(argv=None):
                    help="initial r_x / a1 (default: -3.48 with contact, the paper's Fig. 15; without, -6 or less in a short box)")
     p.add_argument("--integrator", choices=("ab2", "euler"), default="ab2", help="fix fdm/couple integrator")
     p.add_argument("--gap-update", choices=("log", "none"), default="log", help="fix fdm/couple gap_update")
+    p.add_argument("--fluid-every", type=int, default=1, metavar="K",
+                   help="solve the fluid every K-th particle step only (fix fdm/couple fluid_every, docs/dem.md)")
+    p.add_argument("--held-drag", choices=("extrapolated", "constant"), default="extrapolated",
+                   help="with --fluid-every: how the steps between fluid steps hold its force (fix fdm/couple held_drag)")
     args = p.parse_args(argv)
+    if args.fluid_every < 1:
+        p.error("--fluid-every must be at least 1, got %d" % args.fluid_every)
 
     a1 = 1.0
     contact = paper_contact(a1, args.kn, args.kt)
@@ -213,11 +238,13 @@ def main(argv=None):
         t = run_trajectory(args.workdir, ratio, ry, cont, args.a_over_delta, tuple(args.size), args.dt,
                            tol_lambda=args.tol_lambda, cutoff=args.cutoff, np_fluid=args.np_fluid, keep=args.keep,
                            gap_update=args.gap_update, integrator=args.integrator,
-                           r_x0=contact_r_x0 if cont else args.r_x0, acceleration=args.acceleration, model=args.model)
+                           r_x0=contact_r_x0 if cont else args.r_x0, acceleration=args.acceleration, model=args.model,
+                           fluid_every=args.fluid_every, held_drag=args.held_drag)
         s = summarise(t, cont[3] / a1 if cont else None)
         s.update(ratio=ratio, r_y0=ry, contact=bool(cont), wall_seconds=t["wall_seconds"], steps=t["steps"],
                  inner_iterations_mean=t["inner_iterations_mean"], unconverged_steps=t["unconverged_steps"],
-                 dt=args.dt, integrator=args.integrator, gap_update=args.gap_update)
+                 fluid_every=t["fluid_every"], held_drag=t["held_drag"],
+                 fluid_solves_per_step=t["fluid_solves_per_step"], dt=args.dt, integrator=args.integrator, gap_update=args.gap_update)
         results["trajectories"].append(t)
         results["summaries"].append(s)
         print(json.dumps(s))

@@ -429,6 +429,14 @@ TEST(FdmDEMErrors, FluidEveryBelowOne)
                   "fix fdm/couple: fluid_every K needs K >= 1 particle steps per fluid step, got 0", false);
 }
 
+TEST(FdmDEMErrors, HeldDragUnknown)
+{
+    Scene scene;
+    scene.fixOptions = "fluid_every 2 held_drag linear";
+    expectFailure("held-drag", scene, nullptr,
+                  "fix fdm/couple: held_drag must be constant or extrapolated, got linear", false);
+}
+
 TEST(FdmDEMErrors, BackgroundShearWithTheFluid)
 {
     Scene scene;

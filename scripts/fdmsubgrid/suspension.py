@@ -85,11 +85,16 @@ def choose_springs(stress: float, dt: float, delta: float, kn: float | None = No
     return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
 
 
+# fix fdm/couple's held_drag: how the particle steps between fluid steps hold the fluid's force; the first
+# is what the toolkit writes (closer to solving the fluid at every step, docs/benchmarks.md)
+HELD_DRAG = ("extrapolated", "constant")
+
+
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, steps: int,
                dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
                text_dump: bool = False, model: str = "calibrated", wall_velocities: tuple[float, float] = (0.0, 0.0),
                grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension",
-               fluid_options: dict | None = None, fluid_every: int = 1) -> dict:
+               fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated") -> dict:
     """fluid/ and dem/ of the run; returns the scene's description. wall_velocities: the x velocities of
     the walls y = 0 and y = L_y; grad_p0: the uniform pressure gradient (Eq. 58) [Pa/m]. model:
     pair_style fdm/subgrid's sub-grid model (calibrated, the default: what the solver resolves, measured;
@@ -100,9 +105,13 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     of case.write_fluid_case, e.g. first_step or mean_flow_damping. fluid_every: the fluid is solved every
     fluid_every-th particle step (fix fdm/couple ... fluid_every K, docs/dem.md "Particle steps between
     fluid steps"); dump_every and write_every (unless beyond the run's steps) must then be multiples of it,
-    so that every snapshot is of a step the fluid solved."""
+    so that every snapshot is of a step the fluid solved. held_drag: how the steps between fluid steps hold
+    the fluid's force (fix fdm/couple ... held_drag: extrapolated, from the last two fluid steps, or constant;
+    docs/benchmarks.md "The held drag extrapolated")."""
     if fluid_every < 1:
         raise ValueError("fluid_every must be at least 1, got %r" % fluid_every)
+    if held_drag not in HELD_DRAG:
+        raise ValueError("held_drag must be one of %s, got %r" % (", ".join(HELD_DRAG), held_drag))
     for what, every in (("dump_every", dump_every), ("write_every", write_every)):
         if every % fluid_every and every <= steps:
             raise ValueError("%s = %d steps is not a multiple of fluid_every = %d: a snapshot would fall between "
@@ -128,9 +137,11 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     # a checkpoint every 10 snapshots and at the end: fdmRun --resume continues a killed run (docs/coupling.md)
     case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
                          fix_options="stresslets yes checkpoint %d walls walls.dat%s"
-                         % (10 * dump_every, " fluid_every %d" % fluid_every if fluid_every > 1 else ""), runs=runs,
+                         % (10 * dump_every, " fluid_every %d held_drag %s" % (fluid_every, held_drag)
+                            if fluid_every > 1 else ""), runs=runs,
                          name=name)
     packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
     return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
                 wall_velocities=[u_lo, u_hi], grad_p0=list(grad_p0), dt=dt, dump_every=dump_every,
-                write_every=write_every, subgrid_model=model, fluid_every=fluid_every)
+                write_every=write_every, subgrid_model=model, fluid_every=fluid_every,
+                held_drag=held_drag if fluid_every > 1 else None)
