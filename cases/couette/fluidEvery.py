@@ -42,7 +42,7 @@ PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 sys.path.insert(0, HERE)
 
-from fdmsubgrid import case, demonly, files, output, profiles, rheology  # noqa: E402
+from fdmsubgrid import case, demonly, files, output, profiles, rheology, suspension  # noqa: E402
 import couette  # noqa: E402
 
 DEFAULT_VARIANTS = ["0.005:1", "0.02:1", "0.01:1", "0.01:2", "0.005:4", "0.01:4", "0.02:2", "0.0025:8"]
@@ -212,7 +212,7 @@ def main(argv=None) -> Dict:
     p.add_argument("--variants", nargs="+", type=parse_variant, default=[parse_variant(v) for v in DEFAULT_VARIANTS],
                    metavar="DT:K[:TOL]",
                    help="particle step, steps per fluid step and (optional) tolLambda; the first is the reference")
-    p.add_argument("--held-drag", choices=("extrapolated", "constant"), default="extrapolated",
+    p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
                    help="how the steps between fluid steps hold the fluid's force (fix fdm/couple held_drag)")
     p.add_argument("--jobs", type=int, default=1, help="variants run at once (each takes two processes)")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs", "fluidEvery"))

@@ -30,7 +30,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, files, output  # noqa: E402
+from fdmsubgrid import case, files, output, suspension  # noqa: E402
 
 
 # The paper's contact case (section 5.3, Figs. 14-15): a2/a1 = 1.4, r^0 = (-3.48, 0.93) a1
@@ -210,7 +210,7 @@ def main(argv=None):
     p.add_argument("--gap-update", choices=("log", "none"), default="log", help="fix fdm/couple gap_update")
     p.add_argument("--fluid-every", type=int, default=1, metavar="K",
                    help="solve the fluid every K-th particle step only (fix fdm/couple fluid_every, docs/dem.md)")
-    p.add_argument("--held-drag", choices=("extrapolated", "constant"), default="extrapolated",
+    p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
                    help="with --fluid-every: how the steps between fluid steps hold its force (fix fdm/couple held_drag)")
     args = p.parse_args(argv)
     if args.fluid_every < 1:
