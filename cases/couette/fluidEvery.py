@@ -42,7 +42,7 @@ PROJECT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 sys.path.insert(0, HERE)
 
-from fdmsubgrid import case, demonly, files, output, profiles, rheology, suspension  # noqa: E402
+from fdmsubgrid import case, contacts, demonly, files, output, profiles, rheology, suspension  # noqa: E402
 import couette  # noqa: E402
 
 DEFAULT_VARIANTS = ["0.005:1", "0.02:1", "0.01:1", "0.01:2", "0.005:4", "0.01:4", "0.02:2", "0.0025:8"]
@@ -130,24 +130,26 @@ def run_variant(dt: float, k: int, tol: Optional[float], args: argparse.Namespac
     return result
 
 
-def trajectory_difference(reference: Dict, result: Dict, strain: float) -> Optional[Dict]:
-    """The particles of two variants compared at their last common record at or before `strain`: the mean over
-    the particles of |x - x_ref| (a1; the minimum image in the periodic directions) and of |U - U_ref| over the
-    wall speed. None where a run has no records left (its folder deleted) or none in common."""
-    paths = [os.path.join(r["run_dir"], "dem", "particles.records") for r in (reference, result)]
-    if not all(os.path.isfile(path) for path in paths):
+def variant_records(result: Dict) -> Optional[output.ParticleRecords]:
+    """A variant's particle records, None where its run folder no longer holds them."""
+    path = os.path.join(result["run_dir"], "dem", "particles.records")
+    return output.read_particle_records(path, mmap=False) if os.path.isfile(path) else None
+
+
+def trajectory_difference(ref: Optional[output.ParticleRecords], result: Dict, strain: float) -> Optional[Dict]:
+    """A variant's particles compared with the reference's records `ref` at their last common record at or before
+    `strain`: the mean over the particles of |x - x_ref| (a1; the minimum image in the periodic directions) and of
+    |U - U_ref| over the wall speed. None where a run has no records left or none in common."""
+    other = variant_records(result)
+    if ref is None or other is None:
         return None
-    ref, other = (output.read_particle_records(path, mmap=False) for path in paths)
     times, i, j = np.intersect1d(np.round(ref.times, 9), np.round(other.times, 9), return_indices=True)
     keep = (times > 0) & (times * couette.SHEAR_RATE <= strain + 1e-9)
     if not keep.any():
         return None
     k = int(np.nonzero(keep)[0][-1])
-    lo, hi = np.array(ref.header["box_lo"], float), np.array(ref.header["box_hi"], float)
-    length = np.where(np.array(ref.header["periodic"], bool), hi - lo, 0.0)
-    dx = other["x"][j[k]] - ref["x"][i[k]]
-    dx -= length * np.round(np.divide(dx, length, out=np.zeros_like(dx), where=length > 0))
-    wall_speed = couette.SHEAR_RATE * (hi[1] - lo[1]) / 2
+    dx = contacts.minimum_image(other["x"][j[k]] - ref["x"][i[k]], ref.period)
+    wall_speed = couette.SHEAR_RATE * (ref.header["box_hi"][1] - ref.header["box_lo"][1]) / 2
     return dict(strain=float(times[k] * couette.SHEAR_RATE),
                 position=float(np.linalg.norm(dx, axis=1).mean()),
                 velocity=float(np.linalg.norm(other["U"][j[k]] - ref["U"][i[k]], axis=1).mean() / wall_speed))
@@ -161,6 +163,7 @@ def compare(results: List[Dict], window: Tuple[float, float]) -> None:
     lo, hi = window
     grid = np.linspace(lo, hi, 200)
     ref = np.interp(grid, results[0]["strain"], results[0]["wall_stress"])
+    ref_records = variant_records(results[0])   # read once for every variant's comparison
     for r in results:
         curve = np.interp(grid, r["strain"], r["wall_stress"])
         diff = (curve - ref) / ref.mean()
@@ -168,7 +171,7 @@ def compare(results: List[Dict], window: Tuple[float, float]) -> None:
         r["stress_mean"] = float(curve.mean())
         r["error_mean"] = float(diff.mean())
         r["error_rms"] = float(np.sqrt(np.mean(diff ** 2)))
-        r["particles_difference"] = trajectory_difference(results[0], r, hi)
+        r["particles_difference"] = trajectory_difference(ref_records, r, hi)
         r["fluid_solves_per_step"] = r["fluid_solves"] / r["steps"]
 
 

@@ -29,16 +29,9 @@ from . import packing
 from .output import ParticleRecords, read_particle_records
 
 
-def _period(records: ParticleRecords) -> NDArray:
-    """Box lengths of the periodic directions, 0 where the box is not periodic."""
-    lo = np.asarray(records.header["box_lo"], dtype=float)
-    hi = np.asarray(records.header["box_hi"], dtype=float)
-    periodic = np.asarray(records.header.get("periodic", [0, 0, 0]), dtype=bool)
-    return np.where(periodic, hi - lo, 0.0)
-
-
-def _minimum_image(d: NDArray, period: NDArray) -> NDArray:
-    """Separations d (..., 3) brought to their nearest periodic image (period 0: not periodic)."""
+def minimum_image(d: NDArray, period: NDArray) -> NDArray:
+    """Separations d (..., 3) brought to their nearest periodic image (period 0: not periodic; a records
+    file's period is ParticleRecords.period)."""
     return packing._minimum_image(np.asarray(d, dtype=float), np.where(period > 0, period, 1.0), period > 0)
 
 
@@ -92,7 +85,7 @@ def contact_statistics(records: ParticleRecords | str, roughness: float, from_ti
         spacing = float(np.median(np.diff(times[use])))
     wanted = np.arange(times[use[0]], times[use[-1]] + 0.5 * spacing, spacing)
     index = np.unique([int(use[np.argmin(np.abs(times[use] - t))]) for t in wanted])
-    period = _period(rec)
+    period = rec.period
     sets = [contact_set(rec["x"][k], rec["radius"][k], period, roughness) for k in index]
     n = rec.n_particles
     formed = np.array([len(b - a) for a, b in zip(sets[:-1], sets[1:])], dtype=float)
@@ -128,7 +121,7 @@ def contact_breaks(records: ParticleRecords | str, roughness: float, from_time: 
     rec = read_particle_records(records) if isinstance(records, str) else records
     times = np.asarray(rec.times, dtype=float)
     steps = np.asarray(rec.steps)
-    period = _period(rec)
+    period = rec.period
     total = broken = by_chord = 0
     chords, margins = [], []
     for k in range(len(rec) - 1):
@@ -138,8 +131,8 @@ def contact_breaks(records: ParticleRecords | str, roughness: float, from_time: 
         pairs, h0 = close_pairs(x0, radii, period, roughness)
         if len(pairs) == 0:
             continue
-        d0 = _minimum_image(x0[pairs[:, 1]] - x0[pairs[:, 0]], period)
-        d1 = _minimum_image(x1[pairs[:, 1]] - x1[pairs[:, 0]], period)
+        d0 = minimum_image(x0[pairs[:, 1]] - x0[pairs[:, 0]], period)
+        d1 = minimum_image(x1[pairs[:, 1]] - x1[pairs[:, 0]], period)
         contact = radii[pairs[:, 0]] + radii[pairs[:, 1]]
         h1 = np.linalg.norm(d1, axis=1) - contact
         normal = d0 / np.linalg.norm(d0, axis=1)[:, None]

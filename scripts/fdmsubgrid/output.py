@@ -309,6 +309,13 @@ class ParticleRecords:
         return self.blocks["step"]
 
     @property
+    def period(self) -> np.ndarray:
+        """(3,) box lengths of the periodic directions, 0 where the box is not periodic (contacts.minimum_image)."""
+        lo = np.asarray(self.header["box_lo"], dtype=float)
+        hi = np.asarray(self.header["box_hi"], dtype=float)
+        return np.where(np.asarray(self.header.get("periodic", [0, 0, 0]), dtype=bool), hi - lo, 0.0)
+
+    @property
     def times(self) -> np.ndarray:
         return self.blocks["time"]
 

@@ -442,8 +442,7 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
         for ratio in args.ratio:
             out.append(validate(ratio, args.a_over_delta, args.workdir, args.validate, args.gaps, args.boxes,
                                 args.offset or OFFSETS[:args.offsets], args.tol_lambda))
-            with open(args.out, "w") as f:
-                json.dump(out, f, indent=1)
+            files.write_json(args.out, out)   # each ratio's validation kept whole before the next
         for v in out:
             print("%s model, ratio %g, a1/Delta %g, %d positions: xi, M/M_th - 1 of sliding, rolling, twist"
                   % (v["model"], v["ratio"], v["a_over_delta"], len(v["offsets"])))
@@ -462,8 +461,7 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                                args.tol_lambda))
             files.write_json(args.out, out)   # each ratio's hours kept whole before the next
     out = [add_fits(s) for s in out]
-    with open(args.out, "w") as f:
-        json.dump(out, f, indent=1)
+    files.write_json(args.out, out)   # the same file as the kept measurements: whole, never half
     plot(os.path.splitext(args.out)[0] + ".png", out)
     for s in out:
         print("ratio %g a1/Delta %g (%.0f s): xi, FDM/theory of M11 M22 M_twist, (M12 - M12_th)/sqrt(M11 M22),"
