@@ -175,13 +175,13 @@ def test_fluid_every_puts_every_snapshot_on_a_fluid_step(couette, tmp_path):
 def held_drag_runs(tmp_path_factory, env):
     """cases/couette/fluidEvery.py's phi 0.47 scene (98 spheres, 10 x 16 x 8 a1) for 0.2 strain units: the
     particles at 0.005 with the fluid at every step (the reference) and every 4th, the steps between holding
-    its force constant or extrapolated (about a minute in all)."""
+    its force constant or extrapolated (about a minute in all). One workdir: the second call takes the reference
+    from the first's kept result (a variant with the fluid at every step holds no drag), as a rerun would."""
     fluid_every = load_case_module("couette", "fluidEvery")
     work = tmp_path_factory.mktemp("heldDrag")
     common = ["--phi", "0.47", "--strain", "0.2", "--window", "0.05", "0.2", "--dump-every", "0.02",
-              "--variants", "0.005:1", "0.005:4"]
-    return {held: fluid_every.main(common + ["--held-drag", held, "--workdir", str(work / held),
-                                             "--out", str(work / (held + ".json"))])
+              "--variants", "0.005:1", "0.005:4", "--workdir", str(work)]
+    return {held: fluid_every.main(common + ["--held-drag", held, "--out", str(work / (held + ".json"))])
             for held in ("constant", "extrapolated")}
 
 
