@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from conftest import PROJECT, load_case_module
+from conftest import PROJECT, assert_refused, load_case_module
 from fdmsubgrid import case, output, packing, profiles
 
 TINY = ["--phi", "0.25", "--size", "7", "11", "7", "--a-over-delta", "3", "--dt", "0.02", "--strain", "0.4",
@@ -511,6 +511,28 @@ def test_table8_extends_a_run_whose_averaging_window_is_short():
     assert table8.extension(dict(steps_done=1500, strain_averaged=2.0), args, 0.04) is None
     # a run too short to be analysed yet counts as averaged over nothing
     assert table8.extension(dict(steps_done=25), args, 0.04) == 25 + 500
+
+
+def test_table8_runs_the_densest_rows_first_and_projects_the_whole_curve(tmp_path, capsys):
+    """--paper is the paper's seven rows; rows are launched densest (costliest) first; the summary's budget
+    is the rows' wall times run --jobs at a time in that order, each next one on the first free slot."""
+    import argparse
+    table8 = load_case_module("couette", "table8")
+    assert table8.launch_order([0.27, 0.54, 0.37]) == [0.54, 0.37, 0.27]
+    # two slots: 10 | 8, then 3 after the 8 (11), 2 after the 10 (12), 1 after the 11 (12)
+    assert table8.makespan([10.0, 8.0, 3.0, 2.0, 1.0], 2) == 12.0
+    assert table8.makespan([10.0, 8.0, 3.0, 2.0, 1.0], 1) == 24.0      # one at a time: the sum
+    assert table8.makespan([10.0, 8.0, 3.0], 7) == 10.0                 # more slots than rows: the longest
+    args = argparse.Namespace(a_over_delta=3.0, dt=None, tol_lambda=0.01, strain=25.0, seed=1, jobs=2,
+                              np_fluid=1, out=str(tmp_path / "table8.json"))
+    rows = [dict(phi_bulk_table8=phi, phi_core=phi + 0.03, eta_s=eta, eta_s_err=0.1, status="finished",
+                 window_short=False, wall_seconds=wall)
+            for phi, eta, wall in ((0.27, 3.5, 3.0), (0.37, 8.0, 2.0), (0.47, 26.0, 8.0), (0.52, 80.0, 10.0))]
+    budget = table8.summarise(rows, args)["budget"]
+    assert budget["rows"] == [0.52, 0.47, 0.37, 0.27] and budget["jobs"] == 2
+    # launched 0.52 (10) | 0.47 (8), then 0.37 after the 8 (10), then 0.27 after a 10 (13)
+    assert budget["wall_seconds_rows"] == 23.0 and budget["projected_wall_seconds"] == 13.0
+    assert_refused(table8.main, ["--paper", "--phis", "0.27"], ["--paper", "--phis"], tmp_path, capsys)
 
 
 def test_table8_fits_only_finished_rows_with_a_full_window(tmp_path):

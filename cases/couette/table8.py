@@ -7,7 +7,8 @@ run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq
                                             there: 0.04, 0.02, 0.01, and the fluid every 0.04 up to 0.42,
                                             0.02 beyond: couette.fluid_every, 1, 2 and 2 particle steps
                                             per fluid step)
-  table8.py --phis 0.27 0.32 0.37 0.42 0.47 0.52 0.54   all seven rows
+  table8.py --paper --jobs 2                all seven rows of the paper's Fig. 21 (= --phis 0.27 0.32 0.37
+                                            0.42 0.47 0.52 0.54), two at a time
   table8.py --analyse-only                  the runs as they stand (partial runs reported with the
                                             strain they reached), nothing run
   table8.py --progress-minutes 10           every 10 minutes a line per running row: the strain it
@@ -19,6 +20,11 @@ run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq
   table8.py --min-average 20                each finished run whose averaging window (after the transient
                                             its MSER rule finds) is shorter is extended (fdmRun --resume
                                             --until) until it holds 20 strain units, up to --max-strain
+
+Rows are launched densest first: the dense rows cost the most (docs/validation.md, Table 8), and the
+longest first leaves the short ones to fill the cores at the end. The summary's `budget` adds the rows'
+measured wall times and gives the wall time the call would take from nothing at --jobs rows at a time in
+that order (`makespan`): the cost of the whole curve from one command.
 
 Each run is `couette.py --table8 PHI` (the paper's box and particle count, this project's time step
 and a1/Delta), in <workdir>/table8_phi..., run with fdmRun; a call finds each folder again: a
@@ -43,6 +49,7 @@ stress differences and the contact normal stresses with their error bars) as <ou
 import argparse
 import contextlib
 import glob
+import heapq
 import json
 import math
 import os
@@ -69,6 +76,7 @@ PAPER_FIT = dict(zip(("alpha", "phi_m"), rheology.PAPER_MARON_PIERCE))   # paper
 # (0.04 at 0.27, 0.02 from 0.32 to 0.42, 0.01 at 0.47, smaller beyond; couette.py's MEASURED_DT_LIMITS,
 # docs/benchmarks.md "What limits the time step"). Until 2026-11-27 0.04 below phi_bulk 0.30 (0.45, then
 # 0.40 before that) and 0.02 above it: the rows 0.32 and 0.37 of docs/validation.md ran at 0.04, 0.47 at 0.02.
+DEFAULT_PHIS = [0.27, 0.37, 0.47]          # a curve with three points, the fit's least
 MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as started, not analysed
 
 
@@ -92,6 +100,21 @@ def default_jobs(np_fluid: int) -> int:
     """Rows run at once unless --jobs says: one per np_fluid cores this process may use (a row's fdmDEM
     rank waits for the fluid most of the time: 5-9 % of a core in the phi 0.42 and 0.47 rows)."""
     return max(1, len(os.sched_getaffinity(0)) // max(1, np_fluid))
+
+
+def launch_order(phis: List[float]) -> List[float]:
+    """The order rows are launched in: densest first (the longest runs first, the short ones fill the
+    cores at the end)."""
+    return sorted(phis, reverse=True)
+
+
+def makespan(walls: List[float], jobs: int) -> float:
+    """The wall time of running jobs of these wall times `jobs` at a time, each next one (in the given
+    order) on the first slot free: what a ThreadPoolExecutor of `jobs` workers takes for them."""
+    slots = [0.0] * max(1, jobs)
+    for wall in walls:
+        heapq.heapreplace(slots, slots[0] + wall)
+    return max(slots)
 
 
 def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int, model: str,
@@ -345,6 +368,13 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
                          # analyse_row and earlier_rows give each row its own (a row without one: every step)
                          fluid_every={"%g" % r["phi_bulk_table8"]: r.get("fluid_every", 1) for r in rows},
                          tol_lambda=args.tol_lambda, strain=args.strain, seed=args.seed)
+    timed_by_phi = {r["phi_bulk_table8"]: r for r in done if r.get("wall_seconds")}
+    timed = [timed_by_phi[phi] for phi in launch_order(list(timed_by_phi))]
+    if timed:
+        jobs = getattr(args, "jobs", None) or default_jobs(getattr(args, "np_fluid", 1))
+        summary["budget"] = dict(rows=[r["phi_bulk_table8"] for r in timed], jobs=jobs,
+                                 wall_seconds_rows=float(sum(r["wall_seconds"] for r in timed)),
+                                 projected_wall_seconds=makespan([r["wall_seconds"] for r in timed], jobs))
     fit = None
     if len(fitted) >= 3:
         fit = rheology.fit_maron_pierce([r["phi_core"] for r in fitted], [r["eta_s"] for r in fitted],
@@ -411,6 +441,11 @@ def print_table(summary: Dict) -> None:
     else:
         print("Maron-Pierce fit: needs 3 finished rows with a full window and a good step, has %d"
               % len(fitted_rows(summary["rows"])))
+    if "budget" in summary:
+        b = summary["budget"]
+        print("The rows' runs (phi_bulk %s) took %.1f h of wall time in all: from nothing, %d at a time densest "
+              "first, %.1f h" % (", ".join("%g" % x for x in b["rows"]), b["wall_seconds_rows"] / 3600, b["jobs"],
+                                 b["projected_wall_seconds"] / 3600))
     for r in summary["rows"]:
         warning = demonly.time_step_too_large(r.get("position_update"))
         if warning:
@@ -419,7 +454,11 @@ def print_table(summary: Dict) -> None:
 
 def main(argv: Optional[List[str]] = None) -> Dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--phis", type=float, nargs="+", default=[0.27, 0.37, 0.47], help="Table 8 rows (phi_bulk)")
+    p.add_argument("--phis", type=float, nargs="+", default=None,
+                   help="Table 8 rows (phi_bulk; default %s)" % " ".join("%g" % phi for phi in DEFAULT_PHIS))
+    p.add_argument("--paper", action="store_true",
+                   help="all seven rows of the paper's Table 8 and Fig. 21 (phi_bulk %s), instead of --phis"
+                        % " ".join("%g" % phi for phi in sorted(couette.TABLE8)))
     p.add_argument("--strain", type=float, default=25.0, help="strain units per run (transient + averaging)")
     p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 of every row "
                    "(default: the largest measured good at its phi_bulk, couette.largest_good_dt: %s)"
@@ -459,6 +498,9 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                    help="rows run at once, each with --np-fluid fluid ranks and one particle rank (default: "
                         "the cores this process may use divided by --np-fluid)")
     args = p.parse_args(argv)
+    if args.paper and args.phis:
+        p.error("--paper runs all seven rows: give it or --phis, not both")
+    args.phis = sorted(couette.TABLE8) if args.paper else (args.phis or DEFAULT_PHIS)
     os.makedirs(args.workdir, exist_ok=True)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)   # the figures are written first
     start = time.time()
@@ -486,7 +528,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
         if args.progress_minutes > 0:
             threading.Thread(target=report_progress, args=(stop_progress,), daemon=True).start()
         with ThreadPoolExecutor(max_workers=args.jobs or default_jobs(args.np_fluid)) as pool:
-            launched = [(phi, pool.submit(launch, phi)) for phi in args.phis]
+            launched = [(phi, pool.submit(launch, phi)) for phi in launch_order(args.phis)]
             for phi, future in launched:
                 try:
                     row = future.result()
