@@ -618,7 +618,7 @@ def test_table8_finds_the_run_of_its_fluid_every(tmp_path):
 
 
 def test_table8_runs_rows_at_once_and_names_a_stopped_one(tmp_path, monkeypatch):
-    """--jobs 2: two rows run at the same time and the third waits for one of them; a row whose run
+    """--jobs 2: the two densest rows run at the same time and the third waits for one of them; a row whose run
     fdmRun stops (run_row's SystemExit) lets the others finish, the summary is written, and table8.py
     then ends naming it. The rows' runs are replaced by a pause here: this is the scheduling alone."""
     import json
@@ -639,7 +639,8 @@ def test_table8_runs_rows_at_once_and_names_a_stopped_one(tmp_path, monkeypatch)
     with pytest.raises(SystemExit, match="row 0.32"):
         table8.main(["--phis", "0.27", "0.32", "0.37", "--jobs", "2", "--workdir", str(tmp_path), "--out", str(out)])
     assert set(spans) == {0.27, 0.32, 0.37}
-    (a0, a1), (b0, b1), (c0, _) = spans[0.27], spans[0.32], spans[0.37]
+    # launched densest first: 0.37 and 0.32 at once, 0.27 when a worker was free
+    (a0, a1), (b0, b1), (c0, _) = spans[0.37], spans[0.32], spans[0.27]
     assert b0 < a1 and a0 < b1                  # the first two at once
     assert c0 >= min(a1, b1) - 0.05             # the third when a worker was free
     assert [r["status"] for r in json.loads(out.read_text())["rows"]] == ["not started"] * 3
