@@ -532,6 +532,9 @@ def test_table8_runs_the_densest_rows_first_and_projects_the_whole_curve(tmp_pat
     assert budget["rows"] == [0.52, 0.47, 0.37, 0.27] and budget["jobs"] == 2
     # launched 0.52 (10) | 0.47 (8), then 0.37 after the 8 (10), then 0.27 after a 10 (13)
     assert budget["wall_seconds_rows"] == 23.0 and budget["projected_wall_seconds"] == 13.0
+    assert budget["unfinished"] == []
+    rows[3]["status"] = "partial"                  # a row still running counts as it stands, and is named
+    assert table8.summarise(rows, args)["budget"]["unfinished"] == [0.52]
     assert_refused(table8.main, ["--paper", "--phis", "0.27"], ["--paper", "--phis"], tmp_path, capsys)
 
 

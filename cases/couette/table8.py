@@ -374,7 +374,9 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
         jobs = getattr(args, "jobs", None) or default_jobs(getattr(args, "np_fluid", 1))
         summary["budget"] = dict(rows=[r["phi_bulk_table8"] for r in timed], jobs=jobs,
                                  wall_seconds_rows=float(sum(r["wall_seconds"] for r in timed)),
-                                 projected_wall_seconds=makespan([r["wall_seconds"] for r in timed], jobs))
+                                 projected_wall_seconds=makespan([r["wall_seconds"] for r in timed], jobs),
+                                 # a row still running counts with the wall time it has taken so far
+                                 unfinished=[r["phi_bulk_table8"] for r in timed if r.get("status") != "finished"])
     fit = None
     if len(fitted) >= 3:
         fit = rheology.fit_maron_pierce([r["phi_core"] for r in fitted], [r["eta_s"] for r in fitted],
@@ -445,7 +447,9 @@ def print_table(summary: Dict) -> None:
         b = summary["budget"]
         print("The rows' runs (phi_bulk %s) took %.1f h of wall time in all: from nothing, %d at a time densest "
               "first, %.1f h" % (", ".join("%g" % x for x in b["rows"]), b["wall_seconds_rows"] / 3600, b["jobs"],
-                                 b["projected_wall_seconds"] / 3600))
+                                 b["projected_wall_seconds"] / 3600)
+              + ("; unfinished rows counted as they stand: %s" % ", ".join("%g" % x for x in b["unfinished"])
+                 if b.get("unfinished") else ""))
     for r in summary["rows"]:
         warning = demonly.time_step_too_large(r.get("position_update"))
         if warning:
