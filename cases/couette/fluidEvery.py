@@ -136,11 +136,11 @@ def variant_records(result: Dict) -> Optional[output.ParticleRecords]:
     return output.read_particle_records(path, mmap=False) if os.path.isfile(path) else None
 
 
-def trajectory_difference(ref: Optional[output.ParticleRecords], result: Dict, strain: float) -> Optional[Dict]:
-    """A variant's particles compared with the reference's records `ref` at their last common record at or before
-    `strain`: the mean over the particles of |x - x_ref| (a1; the minimum image in the periodic directions) and of
-    |U - U_ref| over the wall speed. None where a run has no records left or none in common."""
-    other = variant_records(result)
+def trajectory_difference(ref: Optional[output.ParticleRecords], other: Optional[output.ParticleRecords],
+                          strain: float) -> Optional[Dict]:
+    """A variant's particle records `other` compared with the reference's `ref` at their last common record at or
+    before `strain`: the mean over the particles of |x - x_ref| (a1; the minimum image in the periodic directions)
+    and of |U - U_ref| over the wall speed. None where a run has no records left or none in common."""
     if ref is None or other is None:
         return None
     times, i, j = np.intersect1d(np.round(ref.times, 9), np.round(other.times, 9), return_indices=True)
@@ -171,7 +171,8 @@ def compare(results: List[Dict], window: Tuple[float, float]) -> None:
         r["stress_mean"] = float(curve.mean())
         r["error_mean"] = float(diff.mean())
         r["error_rms"] = float(np.sqrt(np.mean(diff ** 2)))
-        r["particles_difference"] = trajectory_difference(ref_records, r, hi)
+        r["particles_difference"] = trajectory_difference(
+            ref_records, ref_records if r is results[0] else variant_records(r), hi)
         r["fluid_solves_per_step"] = r["fluid_solves"] / r["steps"]
 
 

@@ -371,10 +371,9 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
     timed_by_phi = {r["phi_bulk_table8"]: r for r in done if r.get("wall_seconds")}
     timed = [timed_by_phi[phi] for phi in launch_order(list(timed_by_phi))]
     if timed:
-        jobs = getattr(args, "jobs", None) or default_jobs(getattr(args, "np_fluid", 1))
-        summary["budget"] = dict(rows=[r["phi_bulk_table8"] for r in timed], jobs=jobs,
+        summary["budget"] = dict(rows=[r["phi_bulk_table8"] for r in timed], jobs=args.jobs,
                                  wall_seconds_rows=float(sum(r["wall_seconds"] for r in timed)),
-                                 projected_wall_seconds=makespan([r["wall_seconds"] for r in timed], jobs),
+                                 projected_wall_seconds=makespan([r["wall_seconds"] for r in timed], args.jobs),
                                  # a row still running counts with the wall time it has taken so far
                                  unfinished=[r["phi_bulk_table8"] for r in timed if r.get("status") != "finished"])
     fit = None
@@ -505,6 +504,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     if args.paper and args.phis:
         p.error("--paper runs all seven rows: give it or --phis, not both")
     args.phis = sorted(couette.TABLE8) if args.paper else (args.phis or DEFAULT_PHIS)
+    args.jobs = args.jobs or default_jobs(args.np_fluid)   # the pool's size and the budget's
     os.makedirs(args.workdir, exist_ok=True)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)   # the figures are written first
     start = time.time()
@@ -531,7 +531,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
         stop_progress = threading.Event()
         if args.progress_minutes > 0:
             threading.Thread(target=report_progress, args=(stop_progress,), daemon=True).start()
-        with ThreadPoolExecutor(max_workers=args.jobs or default_jobs(args.np_fluid)) as pool:
+        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
             launched = [(phi, pool.submit(launch, phi)) for phi in launch_order(args.phis)]
             for phi, future in launched:
                 try:
