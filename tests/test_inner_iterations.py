@@ -169,3 +169,39 @@ def test_relative_linear_solves_keep_the_answer(dense_channel):
     assert relative["solves"] <= absolute["solves"] + 2, (relative["solves"], absolute["solves"])
     reference = dense_channel["reference"]
     assert _velocity_error(relative, reference) < 1.5 * max(_velocity_error(absolute, reference), 2e-3)
+
+
+@pytest.fixture(scope="module")
+def contact_pair(tmp_path_factory, env):
+    """The paper's contact pair (section 5.3, Fig. 15: a2/a1 1.4, r0 = (-3.48, 0.93) a1, h_r 5e-3 a1) at the
+    particle step 0.025, until the pair has parted (r_x ~ 1): the fluid solved at every step, and at every
+    4th step with its force held in between (fix fdm/couple fluid_every 4 held_drag extrapolated)."""
+    module = load_case_module("pairShear")
+    work = str(tmp_path_factory.mktemp("contactPair"))
+    contact = module.paper_contact()
+    runs = {}
+    for fluid_every in (1, 4):
+        t = module.run_trajectory(work, module.PAPER_CONTACT_RATIO, module.PAPER_CONTACT_R_Y0, contact, dt=0.025,
+                                  r_x0=module.PAPER_CONTACT_R_X0, max_steps=185, fluid_every=fluid_every)
+        t.update(module.summarise(t, h_r=contact[3]))
+        runs[fluid_every] = t
+    return runs
+
+
+def test_held_drag_keeps_the_contact_window_in_four_fluid_solves_per_step(contact_pair):
+    # issue 13 (b): at most 5 fluid solves per particle step with the contact window within 0.02 a1 of
+    # the run that solves the fluid at every step (measured 2026-11-28 over the whole trajectory: 3.97
+    # against 12.9 solves per step; onset 0.007 a1 and end 0.012 a1 off; r_y(r_x) within 0.005 a1;
+    # docs/benchmarks.md "The held drag extrapolated")
+    every, held = contact_pair[1], contact_pair[4]
+    assert every["unconverged_steps"] == 0 and held["unconverged_steps"] == 0
+    assert held["fluid_solves_per_step"] <= 5.0, held["fluid_solves_per_step"]
+    assert held["fluid_solves_per_step"] < 0.5 * every["fluid_solves_per_step"]
+    for end in ("contact_r_x_from", "contact_r_x_to"):
+        assert every[end] is not None and held[end] is not None, end
+        assert abs(held[end] - every[end]) < 0.02, (end, held[end], every[end])
+    # the relative trajectory r_y(r_x) over the stretch both runs cover (r_x rises monotonically)
+    rx_every, rx_held = np.array(every["r_x"]), np.array(held["r_x"])
+    common = np.linspace(max(rx_every[0], rx_held[0]), min(rx_every[-1], rx_held[-1]), 2000)
+    difference = np.abs(np.interp(common, rx_held, held["r_y"]) - np.interp(common, rx_every, every["r_y"])).max()
+    assert difference < 0.01, difference
