@@ -91,12 +91,21 @@ def test_bad_options_are_refused_by_name(tmp_path, env):
 
 def test_table8_figures_join_the_report(tmp_path, env):
     """--table8 SUMMARY puts the summary's rows and both its figures (Fig. 21, Fig. 22) into the report,
-    copied beside it; the summary here is table8.py --analyse-only over the rows of a shipped one."""
+    copied beside it, each row's η_s beside the paper's fit (Eq. 55) at its own φ_core; the summary here is
+    table8.py --analyse-only over the rows of a shipped one."""
     from conftest import load_case_module
     table8 = load_case_module("couette", "table8")
     shipped = os.path.join(PROJECT, "docs", "validation_table8_fluidEvery.json")
-    summary = table8.main(["--analyse-only", "--phis", "0.54", "--workdir", str(tmp_path / "runs"),
+    summary = table8.main(["--analyse-only", "--phis", "0.58", "--workdir", str(tmp_path / "runs"),
                            "--rows-from", shipped, "--out", str(tmp_path / "t8.json")])
+    from fdmsubgrid import rheology, validation
+    eta_rows = [row for row in validation.table8_rows(summary) if row.quantity == "η_s"]
+    finished = [r for r in summary["rows"] if "eta_s" in r]
+    assert len(eta_rows) == len(finished) >= 3
+    for row, r in zip(eta_rows, finished):
+        paper_fit = rheology.PAPER_MARON_PIERCE[0] / (1 - r["phi_core"] / rheology.PAPER_MARON_PIERCE[1]) ** 2
+        assert abs(row.reference / paper_fit - 1) < 1e-12
+        assert abs(row.error - (r["eta_s"] / paper_fit - 1)) < 1e-12   # (value - reference)/reference
     out = tmp_path / "report" / "r.md"
     out.parent.mkdir()
     report(["--only", "shearedSphere", "--report-only", "--table8", str(tmp_path / "t8.json"), "--out", str(out),

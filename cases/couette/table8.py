@@ -390,7 +390,7 @@ def summarise(rows: List[Dict], args: argparse.Namespace) -> Dict:
                                 [r["eta_s_err"] for r in done], fit=fit,
                                 phi_core_error=[r.get("phi_core_err") or 0.0 for r in done],
                                 label="this project (a1/Δ = %g, Δt = %s)" % (args.a_over_delta, ", ".join(
-                                    "%g" % d for d in dts) + ("; particle steps between fluid steps"
+                                    "%g" % d for d in dts) + (";\nparticle steps between fluid steps"
                                                               if any(k > 1 for k in summary["fluid_every"].values()) else "")),
                                 title="Fig. 21: η_s(φ_core)", reference=rheology.PAPER_MARON_PIERCE,
                                 not_fitted=[r not in fitted for r in done] if fit is not None else None)

@@ -326,7 +326,7 @@ def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error
     ax.set_xlabel(r"$\phi_{core}$")
     ax.set_ylabel(r"$\eta_s$")
     # lower right: the curve rises to the upper right, where the densest row's point is
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="upper left")   # the rows rise to the right: the upper left is empty
     if title:
         ax.set_title(title)
     fig.tight_layout()

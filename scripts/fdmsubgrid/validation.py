@@ -23,6 +23,8 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Callable, Dict, List, Optional, Sequence
 
+from . import rheology
+
 PROJECT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 
 
@@ -291,10 +293,6 @@ for _c in [
     CASES[_c.name + ("Contact" if "--contact" in _c.default_args else "")] = _c
 
 
-# The paper's Maron-Pierce fit of Fig. 21 (Eq. 55)
-PAPER_MARON_PIERCE = (0.803, 0.59)
-
-
 def table8_rows(summary: dict) -> List[Row]:
     """The rows of a cases/couette/table8.py summary (Table 8 and Fig. 21), beside the paper's."""
     rows = []
@@ -309,15 +307,18 @@ def table8_rows(summary: dict) -> List[Row]:
             paper = t.get(paper_key)
             rows.append(Row(q, config, r[key], paper, "%g (Table 8)" % paper if paper is not None else "—",
                             relative(r[key], paper), spread=r.get(key + "_err") or r.get(key.split("_over")[0] + "_err")))
-        rows.append(Row("η_s", config, r["eta_s"], spread=r["eta_s_err"], paper="Fig. 21"))
+        # Table 8 gives no η_s: the paper's fit of its Fig. 21 (Eq. 55) at this row's own φ_core
+        paper_fit = float(rheology.maron_pierce(r["phi_core"], *rheology.PAPER_MARON_PIERCE))
+        rows.append(Row("η_s", config, r["eta_s"], paper_fit, "%.4g (Fig. 21's fit at φ_core)" % paper_fit,
+                        relative(r["eta_s"], paper_fit), spread=r["eta_s_err"]))
         rows.append(Row("N̂1", config, r["N1_hat"], spread=r.get("N1_hat_err"), paper="Fig. 22"))
         rows.append(Row("N̂2", config, r["N2_hat"], spread=r.get("N2_hat_err"), paper="Fig. 22"))
         rows.append(Row("stress balance (core against walls)", config, r["stress_balance_rel_error"],
                         percent=True))
     fit = summary.get("fit")
     if fit:
-        for q, key, paper in (("Maron–Pierce α", "alpha", PAPER_MARON_PIERCE[0]),
-                              ("Maron–Pierce φ_m", "phi_m", PAPER_MARON_PIERCE[1])):
+        for q, key, paper in (("Maron–Pierce α", "alpha", rheology.PAPER_MARON_PIERCE[0]),
+                              ("Maron–Pierce φ_m", "phi_m", rheology.PAPER_MARON_PIERCE[1])):
             rows.append(Row(q, "fit of the rows above (Eq. 55)", fit[key], paper, "%g (Fig. 21)" % paper,
                             relative(fit[key], paper), spread=fit.get(key + "_error")))
     return rows
