@@ -325,8 +325,8 @@ def plot_viscosity(path: str, phi_core: ArrayLike, eta_s: ArrayLike, eta_s_error
     ax.set_ylim(0.7 * low, 3.0 * eta_data.max())
     ax.set_xlabel(r"$\phi_{core}$")
     ax.set_ylabel(r"$\eta_s$")
-    # lower right: the curve rises to the upper right, where the densest row's point is
-    ax.legend(fontsize=8, loc="upper left")   # the rows rise to the right: the upper left is empty
+    # upper left: the curve rises steeply to the upper right, and a long label at the lower right ran off the axes
+    ax.legend(fontsize=8, loc="upper left")
     if title:
         ax.set_title(title)
     fig.tight_layout()
