@@ -69,6 +69,47 @@ def test_shipped_fits_reproduce_their_measurements():
         assert fit == pytest.approx(s["fit"], rel=1e-6), label   # the json is what the table was made from
 
 
+def test_position_floor_is_the_best_any_gap_only_correction_can_do():
+    """Two positions whose solver resistances differ: no common correction s does better at the worse of
+    the two than the floor, and the floor's s makes both equally wrong; one position: no floor."""
+    r_th, r = 2.0, np.array([1.2, 1.5])
+    cal = calibration.SqueezeCalibration("pair", 3.0, 1.0, [0.1], [8.0, 12.0],
+                                         {"8": [[1 / r[0]], [1 / r[1]]], "12": [[1 / r[0]], [1 / r[1]]]})
+    cal.theory = lambda: np.array([1 / r_th])          # a synthetic theory for the one gap
+    floor = cal.position_floor()[0]
+    scan = np.linspace(0.0, 1.5, 30001)
+    worst = np.max(np.abs(r_th / (r[:, None] + scan[None, :]) - 1), axis=0)
+    assert floor == pytest.approx(worst.min(), rel=1e-4)   # the scan's step
+    assert floor > 0.5 * (r[1] - r[0]) / r_th * 0.9
+    one = calibration.SqueezeCalibration("pair", 3.0, 1.0, [0.1], [8.0, 12.0], {"8": [[0.7]], "12": [[0.7]]})
+    one.theory = lambda: np.array([0.5])
+    assert one.position_floor()[0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_position_errors_predict_the_coupled_solver(tmp_path, env):
+    """The calibrated model's error at one of the calibration's positions, predicted from the solver's own
+    measurements alone (the squeeze resistances add), against the coupled run there (a1/Delta 3,
+    a2/a1 1.4, the worst of the 4 positions at xi 0.1; box extrapolated from 8 and 12 a1 as the
+    calibration was): the same within 0.3 %. So the spread the table docs/validation.md shows over
+    positions is what the pair style does."""
+    with open(os.path.join(DATA, "squeeze_calibration.json")) as f:
+        s = next(c for c in json.load(f) if (c["kind"], c["a_over_delta"], c["ratio"]) == ("pair", 3.0, 1.4))
+    cal = calibration.SqueezeCalibration(s["kind"], s["a_over_delta"], s["ratio"], s["gaps"], s["boxes"],
+                                         s["velocities"])
+    predicted = cal.corrected_errors(s["fit"])
+    position, xis = 3, [0.1, 0.05]
+    runs = [squeeze.run_pair(str(tmp_path), 1.4, xis, True, a_over_delta=3.0, L_over_a=L, tol_lambda=1e-5,
+                             offset=calibration.OFFSETS[position]) for L in s["boxes"]]
+    r = squeeze.box_extrapolated(runs[0], runs[1], *s["boxes"])
+    assert r["converged"]
+    measured = theory.relative_errors(r["velocity"], [theory.pair_squeeze_velocity(1.0, 1.4, xi) for xi in xis])
+    for xi, e in zip(xis, measured):
+        assert e == pytest.approx(predicted[position, s["gaps"].index(xi)], abs=3e-3), xi
+    # and that position is off by more than the issue's 2 %, which the floor says no gap-only correction mends
+    assert abs(measured[0]) > 0.04
+    assert cal.position_floor()[s["gaps"].index(0.1)] > 0.04
+
+
 @pytest.mark.parametrize("ratio", [1.0, 1.4])
 def test_calibrated_pair_squeeze_against_theory(tmp_path, env, ratio):
     """pair_style fdm/subgrid model calibrated at a1/Delta = 3 (the suspension resolution): the

@@ -45,6 +45,11 @@ sliding-rolling coupling, rolling, twist) that pairtangential.py measures: `--pa
 pair_tangential_calibration.json) and a figure of each (.png).
 
     python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --tangential --pair-tangential --out dem/resistance/data/subgrid_calibration.dat
+
+What it leaves at each position in the cell (no run: the resistances add, so the model's error at every
+measured position follows from the measurement; beside it the floor no correction of the gap alone can pass):
+
+    python3 -m fdmsubgrid.calibration --position-errors dem/resistance/data/squeeze_calibration.json
 """
 from __future__ import annotations
 
@@ -109,6 +114,36 @@ class SqueezeCalibration:
 
     def theory(self) -> np.ndarray:
         return np.array([theory_velocity(self.kind, self.ratio, g) for g in self.gaps])
+
+    def resistance_by_position(self) -> np.ndarray:
+        """r_FDM = 1/V_FDM at every position (rows) and gap (columns), each box-extrapolated."""
+        L1, L2 = self.boxes[0], self.boxes[1]
+        return 1 / squeeze.extrapolate_box(np.array(self.velocities["%g" % L1]),
+                                           np.array(self.velocities["%g" % L2]), L1, L2)
+
+    def corrected_errors(self, fit: Dict[str, float]) -> np.ndarray:
+        """The calibrated model's error of the closing velocity at every measured position (rows) and
+        gap (columns): 1/(r_FDM,i + s) against the theory, s the correction the table holds (the fit's,
+        kept where positive, tapered). Exact for the squeeze (the resistances add, module docstring),
+        so it needs no further run."""
+        s = np.array([max(self.correction(g, fit), 0.0) * taper(g) for g in self.gaps])
+        return self.theory() ** -1 / (self.resistance_by_position() + s) - 1
+
+    def position_floor(self) -> np.ndarray:
+        """Per gap, the smallest worst-position error of the closing velocity that any correction
+        depending on the gap alone can reach at the calibration's own positions in the cell.
+
+        A correction of the gap alone adds the same s to the solver's resistance r_i = 1/V_FDM,i
+        (box-extrapolated) at every position i; the velocity is then 1/(r_i + s) exactly (the squeeze
+        resistances add, module docstring). The best s makes the fastest and the slowest position
+        equally wrong, r_th/(r_min + s) - 1 = 1 - r_th/(r_max + s): the floor is that common error."""
+        r = self.resistance_by_position()
+        r_th = 1 / self.theory()
+        spread = r.max(axis=0) - r.min(axis=0)
+        # A = r_min + s solves 2 A^2 + 2 A (D - r_th) - r_th D = 0 (D the spread), its positive root
+        b = 2 * (spread - r_th)
+        a_min = (-b + np.sqrt(b ** 2 + 8 * r_th * spread)) / 4
+        return r_th / a_min - 1
 
     def fit(self) -> Dict[str, float]:
         """r_FDM(xi) = r_inf + (r_0 - r_inf)/(1 + (xi/xi_1)^p) through r_FDM = 1/V_inf (least squares in
@@ -331,6 +366,34 @@ def plot(path: str, summaries: Sequence[Dict]) -> None:
     plt.close(fig)
 
 
+def position_errors(path: str) -> List[Dict]:
+    """For each calibration in the .json beside a table: per gap the calibrated model's closing-velocity
+    error averaged over the measured positions and at the worst one (`corrected_errors`), and the floor
+    (`position_floor`)."""
+    with open(path) as f:
+        summaries = json.load(f)
+    out = []
+    for s in summaries:
+        cal = SqueezeCalibration(s["kind"], s["a_over_delta"], s["ratio"], s["gaps"], s["boxes"], s["velocities"])
+        err = cal.corrected_errors(s["fit"])
+        worst = err[np.abs(err).argmax(axis=0), np.arange(len(cal.gaps))]
+        out.append(dict(kind=cal.kind, a_over_delta=cal.a_over_delta, ratio=cal.ratio, gaps=cal.gaps,
+                        positions=len(err), mean=err.mean(axis=0).tolist(), worst=worst.tolist(),
+                        floor=cal.position_floor().tolist()))
+    return out
+
+
+def print_position_errors(path: str) -> None:
+    """`position_errors` as a text table, in %."""
+    for e in position_errors(path):
+        print("%s a1/Delta %g a2/a1 %g (%d positions), error in %%" % (e["kind"], e["a_over_delta"], e["ratio"],
+                                                                      e["positions"]))
+        print("  gap            " + " ".join("%6.3g" % g for g in e["gaps"]))
+        for name in ("mean", "worst", "floor"):
+            print("  %-14s " % name + " ".join("%+6.1f" % (100 * v) if name != "floor" else "%6.1f" % (100 * v)
+                                               for v in e[name]))
+
+
 def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--a-over-delta", type=float, nargs="+", default=[3.0, 4.0, 5.0])
@@ -340,7 +403,11 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p.add_argument("--boxes", type=float, nargs=2, default=list(BOXES), help="the two box sizes L/a1")
     p.add_argument("--offsets", type=int, default=len(OFFSETS), help="positions in the cell averaged (1-4)")
     p.add_argument("--workdir", default="calibration_runs")
-    p.add_argument("--out", required=True, help="the table (text); its .json beside it holds every measurement")
+    p.add_argument("--out", help="the table (text); its .json beside it holds every measurement")
+    p.add_argument("--position-errors", metavar="JSON", help="no run: from the measurements beside a table "
+                   "(squeeze_calibration.json), per gap the calibrated model's error averaged over the measured "
+                   "positions in the cell and at the worst one, and the floor no correction of the gap alone "
+                   "can pass there")
     p.add_argument("--from-raw", metavar="RAW_JSON", nargs="+", help="analyse the measurements earlier calls "
                    "kept (<workdir>/measurements.json, or the .json beside a table) instead of running")
     p.add_argument("--tangential", action="store_true", help="also measure the tangential wall functions "
@@ -352,6 +419,11 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p.add_argument("--pair-tangential-from-raw", metavar="JSON", nargs="+", help="the tangential pair measurements "
                    "of earlier runs (pair_tangential_calibration.json beside a table, or pairtangential --out)")
     args = p.parse_args(argv)
+    if args.position_errors:
+        print_position_errors(args.position_errors)
+        return []
+    if not args.out:
+        p.error("--out is required (or --position-errors)")
     if any(r < 1 for r in args.ratios):
         p.error("--ratios: a2/a1 must be >= 1 (a pair 1/1.4 is the pair 1.4 seen from the other sphere)")
     os.makedirs(args.workdir, exist_ok=True)
