@@ -79,6 +79,13 @@ def trajectory(root):
     return dump_frames(root, ("x", "y", "z"))
 
 
+def largest_difference(root, reference):
+    """The largest position difference between the DEM dumps of two runs, over root's frames."""
+    got, order = trajectory(root)
+    ref, _ = trajectory(reference)
+    return max(float(np.max(np.abs(got[s] - ref[s]))) for s in order)
+
+
 def records_once(root):
     """The fluid's records hold each step once, in order: steps 1..STEPS, and one particle record
     per step and particle."""
@@ -158,7 +165,7 @@ def assert_same_trajectory(root, reference):
     got, order = trajectory(root)
     ref, ref_order = trajectory(reference)
     assert order == ref_order == list(range(0, STEPS + 1)), order   # every frame once, in order
-    worst = max(float(np.max(np.abs(got[s] - ref[s]))) for s in ref_order)
+    worst = largest_difference(root, reference)
     final = float(np.max(np.abs(got[STEPS] - ref[STEPS]) / np.abs(ref[STEPS])))
     print("largest position difference over the trajectory %.3g (box 8 x 6 x 6), relative at step %d %.3g"
           % (worst, STEPS, final))
@@ -462,10 +469,8 @@ def test_fluid_every_solves_the_fluid_on_its_steps(reference_every2, reference):
     assert times == pytest.approx(sorted([0.05 * s for s in range(10, STEPS + 1, 10)] + [0.05 * 45])), times
     log = open(os.path.join(reference_every2, "log.dem")).read()
     assert "fluid_every 2: the fluid solved in %d of the steps" % len(expected) in log
-    got, order = trajectory(reference_every2)
-    ref, _ = trajectory(reference)
-    assert order == list(range(0, STEPS + 1))
-    worst = max(float(np.max(np.abs(got[s] - ref[s]))) for s in order)
+    assert trajectory(reference_every2)[1] == list(range(0, STEPS + 1))
+    worst = largest_difference(reference_every2, reference)
     print("fluid_every 2 against every step: largest position difference %.3g a over %d steps" % (worst, STEPS))
     assert 0 < worst < 3e-2
 
@@ -499,10 +504,8 @@ def test_fluid_every_killed_run_resumes_to_the_same_trajectory(tmp_path, env, re
     r = fdm_run(root, env, "--resume")
     assert r.returncode == 0, r.stdout
     assert fluid_steps(root) == fluid_steps(reference_every2)
-    got, order = trajectory(root)
-    ref, ref_order = trajectory(reference_every2)
-    assert order == ref_order
-    worst = max(float(np.max(np.abs(got[s] - ref[s]))) for s in ref_order)
+    assert trajectory(root)[1] == trajectory(reference_every2)[1]
+    worst = largest_difference(root, reference_every2)
     assert worst < 1e-8 * 8, worst
 
 
@@ -511,12 +514,6 @@ def test_fluid_every_killed_run_resumes_to_the_same_trajectory(tmp_path, env, re
 # ------------------------------------------------------------------------------------------------
 
 EXTRAPOLATED = "fluid_every 2 held_drag extrapolated"
-
-
-def largest_difference(root, reference):
-    got, order = trajectory(root)
-    ref, _ = trajectory(reference)
-    return max(float(np.max(np.abs(got[s] - ref[s]))) for s in order)
 
 
 @pytest.fixture(scope="module")
