@@ -367,9 +367,9 @@ def plot(path: str, summaries: Sequence[Dict]) -> None:
 
 
 def position_errors(path: str) -> List[Dict]:
-    """For each calibration in the .json beside a table: per gap the calibrated model's closing-velocity
-    error averaged over the measured positions and at the worst one (`corrected_errors`), and the floor
-    (`position_floor`)."""
+    """For each calibration in the .json beside a table: per gap the theory's velocity (units F/(6 pi eta a1)),
+    the calibrated model's error of it averaged over the measured positions, its standard deviation and the
+    worst position's (`corrected_errors`), and the floor (`position_floor`)."""
     with open(path) as f:
         summaries = json.load(f)
     out = []
@@ -378,8 +378,8 @@ def position_errors(path: str) -> List[Dict]:
         err = cal.corrected_errors(s["fit"])
         worst = err[np.abs(err).argmax(axis=0), np.arange(len(cal.gaps))]
         out.append(dict(kind=cal.kind, a_over_delta=cal.a_over_delta, ratio=cal.ratio, gaps=cal.gaps,
-                        positions=len(err), mean=err.mean(axis=0).tolist(), worst=worst.tolist(),
-                        floor=cal.position_floor().tolist()))
+                        positions=len(err), theory=cal.theory().tolist(), mean=err.mean(axis=0).tolist(),
+                        std=err.std(axis=0).tolist(), worst=worst.tolist(), floor=cal.position_floor().tolist()))
     return out
 
 

@@ -324,6 +324,35 @@ def table8_rows(summary: dict) -> List[Row]:
     return rows
 
 
+# The squeeze calibration's measurements shipped beside its table (no run: the report reads them)
+SQUEEZE_CALIBRATION = os.path.join(PROJECT, "dem", "resistance", "data", "squeeze_calibration.json")
+
+
+def squeeze_calibration_rows(path: str = SQUEEZE_CALIBRATION) -> List[Row]:
+    """Appendix B: per calibration (pair or wall, a1/Delta, a2/a1) the calibrated model's velocity at the gap
+    where its mean over the calibration's positions in the cell is worst (± the spread over them), and at
+    the worst position and gap, beside the floor no correction of the gap alone can pass there. Exact from
+    the measurements (calibration.py: the squeeze resistances add)."""
+    from . import calibration
+    rows = []
+    for e in calibration.position_errors(path):
+        name = "ξ" if e["kind"] == "pair" else "ε"
+        config = "%s, a1/Δ %g%s" % (e["kind"], e["a_over_delta"], ", a2/a1 %g" % e["ratio"] if e["kind"] == "pair"
+                                    else "")
+        quantity = "closing velocity" if e["kind"] == "pair" else "velocity toward the wall"
+        k = max(range(len(e["gaps"])), key=lambda i: abs(e["mean"][i]))
+        rows.append(Row(quantity + " (mean of %d positions)" % e["positions"],
+                        "%s, %s %g (its worst gap)" % (config, name, e["gaps"][k]),
+                        e["theory"][k] * (1 + e["mean"][k]), e["theory"][k], "Figs. B.24–B.25 (error bars)",
+                        e["mean"][k], spread=e["theory"][k] * e["std"][k]))
+        k = max(range(len(e["gaps"])), key=lambda i: abs(e["worst"][i]))
+        rows.append(Row(quantity + " (worst position)",
+                        "%s, %s %g (its worst gap; no correction of the gap alone does better than %.1f %% there)"
+                        % (config, name, e["gaps"][k], 100 * e["floor"][k]),
+                        e["theory"][k] * (1 + e["worst"][k]), e["theory"][k], "—", e["worst"][k]))
+    return rows
+
+
 @dataclass
 class CaseResult:
     """What the report knows of one case after running (or reading) it."""
@@ -438,6 +467,14 @@ def markdown(results: List[CaseResult], table8: Optional[dict], info: dict, figu
         lines += table(r.rows)
         for fig in r.figures:
             lines += figure_lines(fig, r.key, figures_dir, out)
+    if os.path.exists(SQUEEZE_CALIBRATION):
+        lines += ["## Appendix B: the squeeze calibration at every position in the cell", "",
+                  "From the solver's own measurements behind the shipped table (%s; no run): the calibrated "
+                  "model's velocity averaged over the calibration's 4 positions in the cell, and at the worst one "
+                  "(docs/validation.md, \"At every position in the cell\"). Reference: the two-sphere theory "
+                  "(Jeffrey & Onishi), Brenner (1961) for the wall; units F/(6πηa1)."
+                  % os.path.relpath(SQUEEZE_CALIBRATION, PROJECT), ""]
+        lines += table(squeeze_calibration_rows())
     if table8 is not None:
         lines += ["## 6.1 suspensions in simple shear: Table 8, Figs. 21 and 22 (`cases/couette/table8.py`)", "",
                   "From %s (the runs as they stand; a row's strain units say how far it got)." % info["table8"], ""]
@@ -530,6 +567,8 @@ def run_report(keys: Optional[Sequence[str]] = None, full: bool = False, report_
     summary = dict(info, cases=[dict(key=r.key, section=r.case.section, status=r.status, command=r.command,
                                      provenance=r.provenance, wall_seconds=r.wall_seconds, message=r.message,
                                      rows=[asdict(row) for row in r.rows]) for r in results])
+    if os.path.exists(SQUEEZE_CALIBRATION):
+        summary["squeeze_calibration_rows"] = [asdict(row) for row in squeeze_calibration_rows()]
     if table8_summary is not None:
         summary["table8_rows"] = [asdict(row) for row in table8_rows(table8_summary)]
     with open(os.path.splitext(out)[0] + ".json", "w") as f:
