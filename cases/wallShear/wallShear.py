@@ -152,14 +152,18 @@ def check_scene(eps_values: Sequence[float], radii: Sequence[float], size: Seque
 
 
 def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool, eps_values: Sequence[float],
-              offsets: Sequence[Sequence[float]], options) -> dict:
+              offsets: Sequence[Sequence[float]], options, loads: str = "", load_name: str = "") -> dict:
     """One coupled run: the sphere of `radius` at every eps (largest first) and every offset, one step each.
-    Returns dict(per_step=[...], wall_seconds, cells)."""
+    Returns dict(per_step=[...], wall_seconds, cells). With `loads` (LIGGGHTS lines: fix addforce, fix
+    fdm/torque; `load_name` tags the run folder) both walls are at rest and the fluid starts at rest: the
+    sphere driven by the loads alone (shearStresslet.py), U_x/(gamma_dot d) and the like then in units of
+    gamma_dot = 1."""
     delta = A1 / options.a_over_delta
     lx, ly, lz = (float(v) for v in size)
-    box = case.Box((0, 0, 0), (lx, ly, lz), delta, faces=("cyclic", ((0, 0, 0), (SHEAR_RATE * ly, 0, 0)), "cyclic"))
-    tag = "%gx%gx%g_ad%g_a%g_n%d_%s" % (lx, ly, lz, options.a_over_delta, radius, len(offsets),
-                                        "subgrid" if subgrid else "nosubgrid")
+    wall_speed = 0.0 if loads else SHEAR_RATE * ly
+    box = case.Box((0, 0, 0), (lx, ly, lz), delta, faces=("cyclic", ((0, 0, 0), (wall_speed, 0, 0)), "cyclic"))
+    tag = "%gx%gx%g_ad%g_a%g_n%d_%s%s" % (lx, ly, lz, options.a_over_delta, radius, len(offsets),
+                                          "subgrid" if subgrid else "nosubgrid", "_" + load_name if loads else "")
     run_dir = os.path.join(workdir, tag)
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
@@ -174,14 +178,14 @@ def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool,
                           acceleration=options.acceleration)
     # the undisturbed flow: the far field starts converged, the inner iterations build the sphere's disturbance
     case.write_initial_velocity(fluid, box, lambda c: np.column_stack(
-        [SHEAR_RATE * c[:, 1], np.zeros(len(c)), np.zeros(len(c))]))
+        [wall_speed / ly * c[:, 1], np.zeros(len(c)), np.zeros(len(c))]))
     runs = case.held_step_runs([[p] for p in positions])
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [positions[0] + (radius,)], dt=1.0,
                          fix_options="move no stresslets yes",
                          # the walls as in the fluid case: y = 0 at rest, y = L_y at gamma_dot L_y along x
-                         pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (SHEAR_RATE * size[1], 0, 0))),
+                         pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (wall_speed, 0, 0))),
                                                             subgrid, options.model, options.cutoff, options.wall_cutoff),
-                         before_run=case.RECORD_EVERY_STEP,
+                         before_run=case.RECORD_EVERY_STEP + ("\n" + loads if loads else ""),
                          runs=runs, name="in.wallShear")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
     rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"), mmap=False)
