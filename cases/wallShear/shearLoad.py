@@ -250,23 +250,26 @@ def print_rows(rows: Sequence[dict]) -> None:
                if "Ux_norm_split_fits_rel_error" in r else ""))
 
 
-def main(argv: Sequence[str] | None = None) -> dict:
-    """Parse the options (module docstring), run every box, print the table, write --out."""
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--eps", type=float, nargs="+", default=EPS_DEFAULT, help="reduced gaps eps = d/a - 1")
-    p.add_argument("--boxes", type=float, nargs="+", default=BOXES_DEFAULT, metavar="L",
-                   help="cube sides in a1 (three: extrapolated to an infinite box; default %s)"
-                        % " ".join("%g" % b for b in BOXES_DEFAULT))
+def add_split_options(p: argparse.ArgumentParser, eps_default: Sequence[float], boxes_default: Sequence[float],
+                      boxes_help: str) -> None:
+    """The options of the scripts that split the free sphere by linearity (this one, shearStresslet.py)."""
+    p.add_argument("--eps", type=float, nargs="+", default=list(eps_default), help="reduced gaps eps = d/a - 1")
+    p.add_argument("--boxes", type=float, nargs="+", default=list(boxes_default), metavar="L",
+                   help="cube sides in a1 (%s; default %s)" % (boxes_help, " ".join("%g" % b for b in boxes_default)))
     p.add_argument("--a-over-delta", type=float, default=3.0, help="a1/Delta (default 3)")
     p.add_argument("--positions", type=int, default=2, help="offsets in the cell, as cases/wallShear (default 2)")
     p.add_argument("--n-max", type=int, default=2000, help="fdmFoam's innerIterations nMax (4x on the first step)")
-    p.add_argument("--no-corrected", action="store_true",
-                   help="skip the free sphere with the correction on (run by default beside the split)")
     case.add_run_options(p, HERE, tol_lambda=1e-4, cutoff=True)
-    args = p.parse_args(argv)
+
+
+def check_split_options(p: argparse.ArgumentParser, args: argparse.Namespace, box_counts: Sequence[int],
+                        corrected: bool = True) -> None:
+    """Refuses (p.error) a box count not in box_counts, a gap outside the exact wall table, a box too small
+    for the sphere, and with `corrected` a resolution the model has no calibration for."""
     args.wall_cutoff, args.keep = None, False
-    if len(args.boxes) not in (1, 3):
-        p.error("--boxes: one box, or three to extrapolate, got %d" % len(args.boxes))
+    if len(args.boxes) not in box_counts:
+        p.error("--boxes: one box, or %s to extrapolate, got %d"
+                % (" or ".join({2: "two", 3: "three"}[n] for n in box_counts if n > 1), len(args.boxes)))
     for eps in args.eps:
         if not 0 < eps <= 3:
             p.error("--eps %g: the exact wall table covers 0 < eps <= 3" % eps)
@@ -275,10 +278,20 @@ def main(argv: Sequence[str] | None = None) -> dict:
             wallShear.check_scene(args.eps, [1.0], (L, L, L), args.a_over_delta)
         except ValueError as e:
             p.error(str(e))
-    if not args.no_corrected:
+    if corrected:
         missing = case.uncalibrated([1.0], 1.0 / args.a_over_delta, walls=True, model=args.model, pairs=False)
         if missing:
             p.error("; ".join(missing))
+
+
+def main(argv: Sequence[str] | None = None) -> dict:
+    """Parse the options (module docstring), run every box, print the table, write --out."""
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_split_options(p, EPS_DEFAULT, BOXES_DEFAULT, "three: extrapolated to an infinite box")
+    p.add_argument("--no-corrected", action="store_true",
+                   help="skip the free sphere with the correction on (run by default beside the split)")
+    args = p.parse_args(argv)
+    check_split_options(p, args, (1, 3), corrected=not args.no_corrected)
     offsets, _ = wallShear.cell_offsets(args.positions)
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()

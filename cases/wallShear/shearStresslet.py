@@ -41,8 +41,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 sys.path.insert(0, HERE)
-from fdmsubgrid import case, files  # noqa: E402
+from fdmsubgrid import files  # noqa: E402
 import freeSphereWall  # noqa: E402
+import shearLoad  # noqa: E402
 import wallShear  # noqa: E402
 
 EPS_DEFAULT = [0.54, 0.1, 0.01, 0.0032, 0.001]
@@ -127,25 +128,9 @@ def print_rows(title: str, rows: Sequence[dict]) -> None:
 
 def main(argv: Sequence[str] | None = None) -> dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--eps", type=float, nargs="+", default=EPS_DEFAULT, help="reduced gaps eps = d/a - 1")
-    p.add_argument("--boxes", type=float, nargs="+", default=BOXES_DEFAULT, metavar="L",
-                   help="cube sides in a1 (two: extrapolated as Q_inf + c L^-3)")
-    p.add_argument("--a-over-delta", type=float, default=3.0)
-    p.add_argument("--positions", type=int, default=2, help="offsets in the cell, as cases/wallShear")
-    p.add_argument("--n-max", type=int, default=2000, help="fdmFoam's innerIterations nMax (4x on the first step)")
-    case.add_run_options(p, HERE, tol_lambda=1e-4, cutoff=True)
+    shearLoad.add_split_options(p, EPS_DEFAULT, BOXES_DEFAULT, "two: extrapolated as Q_inf + c L^-3")
     args = p.parse_args(argv)
-    args.wall_cutoff, args.keep = None, False
-    if len(args.boxes) not in (1, 2):
-        p.error("--boxes: one box, or two to extrapolate, got %d" % len(args.boxes))
-    for L in args.boxes:
-        try:
-            wallShear.check_scene(args.eps, [1.0], (L, L, L), args.a_over_delta)
-        except ValueError as e:
-            p.error(str(e))
-    missing = case.uncalibrated([1.0], 1.0 / args.a_over_delta, walls=True, model=args.model, pairs=False)
-    if missing:
-        p.error("; ".join(missing))
+    shearLoad.check_split_options(p, args, (1, 2))
     offsets, _ = wallShear.cell_offsets(args.positions)
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()
