@@ -41,7 +41,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
 sys.path.insert(0, HERE)
-from fdmsubgrid import files  # noqa: E402
+from fdmsubgrid import files, squeeze  # noqa: E402
 import freeSphereWall  # noqa: E402
 import shearLoad  # noqa: E402
 import wallShear  # noqa: E402
@@ -108,7 +108,7 @@ def infinite_box(boxes: Sequence[list[dict]], sizes: Sequence[float]) -> list[di
         for q in r1:
             if q in row or q.endswith("_std"):
                 continue
-            row[q] = r2[q] + (r2[q] - r1[q]) * L1 ** 3 / (L2 ** 3 - L1 ** 3)
+            row[q] = float(squeeze.extrapolate_box(r1[q], r2[q], L1, L2))
         out.append(row)
     return out
 

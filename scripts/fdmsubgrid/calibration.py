@@ -99,13 +99,16 @@ class SqueezeCalibration:
     velocities: Dict[str, List[List[float]]] = field(default_factory=dict)   # "L" -> [offset][gap]
     wall_seconds: float = 0.0
 
-    def mean_velocity(self, L: float) -> np.ndarray:
-        return np.mean(np.array(self.velocities["%g" % L]), axis=0)
+    def velocity_by_position(self) -> np.ndarray:
+        """V_hat_FDM at every position (rows) and gap (columns), each box-extrapolated."""
+        L1, L2 = self.boxes[0], self.boxes[1]
+        return squeeze.extrapolate_box(np.array(self.velocities["%g" % L1]), np.array(self.velocities["%g" % L2]),
+                                       L1, L2)
 
     def velocity_inf(self) -> np.ndarray:
-        """Box-extrapolated, offset-averaged V_hat_FDM."""
-        L1, L2 = self.boxes[0], self.boxes[1]
-        return squeeze.extrapolate_box(self.mean_velocity(L1), self.mean_velocity(L2), L1, L2)
+        """Box-extrapolated, offset-averaged V_hat_FDM (the extrapolation is linear: the mean of each
+        position's equals the extrapolation of the means)."""
+        return self.velocity_by_position().mean(axis=0)
 
     def spread(self) -> np.ndarray:
         """Relative spread (max - min over the offsets, over the mean) at the largest box."""
@@ -115,19 +118,13 @@ class SqueezeCalibration:
     def theory(self) -> np.ndarray:
         return np.array([theory_velocity(self.kind, self.ratio, g) for g in self.gaps])
 
-    def resistance_by_position(self) -> np.ndarray:
-        """r_FDM = 1/V_FDM at every position (rows) and gap (columns), each box-extrapolated."""
-        L1, L2 = self.boxes[0], self.boxes[1]
-        return 1 / squeeze.extrapolate_box(np.array(self.velocities["%g" % L1]),
-                                           np.array(self.velocities["%g" % L2]), L1, L2)
-
     def corrected_errors(self, fit: Dict[str, float]) -> np.ndarray:
         """The calibrated model's error of the closing velocity at every measured position (rows) and
         gap (columns): 1/(r_FDM,i + s) against the theory, s the correction the table holds (the fit's,
         kept where positive, tapered). Exact for the squeeze (the resistances add, module docstring),
         so it needs no further run."""
         s = np.array([max(self.correction(g, fit), 0.0) * taper(g) for g in self.gaps])
-        return self.theory() ** -1 / (self.resistance_by_position() + s) - 1
+        return self.theory() ** -1 / (1 / self.velocity_by_position() + s) - 1
 
     def position_floor(self) -> np.ndarray:
         """Per gap, the smallest worst-position error of the closing velocity that any correction
@@ -137,7 +134,7 @@ class SqueezeCalibration:
         (box-extrapolated) at every position i; the velocity is then 1/(r_i + s) exactly (the squeeze
         resistances add, module docstring). The best s makes the fastest and the slowest position
         equally wrong, r_th/(r_min + s) - 1 = 1 - r_th/(r_max + s): the floor is that common error."""
-        r = self.resistance_by_position()
+        r = 1 / self.velocity_by_position()          # the solver's resistance at each position
         r_th = 1 / self.theory()
         spread = r.max(axis=0) - r.min(axis=0)
         # A = r_min + s solves 2 A^2 + 2 A (D - r_th) - r_th D = 0 (D the spread), its positive root
