@@ -66,7 +66,13 @@ def test_shipped_fits_reproduce_their_measurements():
         label = "%s a/Delta %g ratio %g" % (s["kind"], s["a_over_delta"], s["ratio"])
         assert fit["rms_rel"] < 0.03, label
         assert fit["max_rel"] < 0.07, label
-        assert fit == pytest.approx(s["fit"], rel=1e-6), label   # the json is what the table was made from
+        # the json is what the table was made from: the same curve (not the same digits of each parameter,
+        # which are only as sharp as the optimizer's stopping rule and a machine's rounding)
+        xi = np.geomspace(1e-4, 1, 41)
+        names = ("r_0", "r_inf", "xi_1", "p")
+        curve, shipped = (calibration.fitted_resistance(xi, *(f[n] for n in names)) for f in (fit, s["fit"]))
+        assert np.max(np.abs(curve / shipped - 1)) < 1e-5, label
+        assert fit["rms_rel"] == pytest.approx(s["fit"]["rms_rel"], abs=1e-7), label
 
 
 def test_position_floor_is_the_best_any_gap_only_correction_can_do():

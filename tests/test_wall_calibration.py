@@ -96,9 +96,16 @@ def test_shipped_calibration_covers_the_suspension_resolutions(shipped):
     for s in shipped:
         assert len(s["boxes"]) == 3 and len(s["offsets"]) >= 2
         # the table was made from these fits: analysing the kept measurements again gives them
+        # (the same curve: a fit's parameters are only as sharp as the optimizer's stopping rule, and p moves
+        # by 2e-6 between machines' rounding while the curve stays put)
         again = wc.summary(wc.from_summary(s))
+        eps = np.geomspace(1e-3, 1, 61)
         for name in wc.FUNCTIONS:
-            assert again["fits"][name] == pytest.approx(s["fits"][name], rel=1e-6), (s["a_over_delta"], name)
+            scale = (np.sqrt(wc.theory_at("YA", eps) * wc.theory_at("YC", eps)) if name == "YB"
+                     else np.abs(wc.theory_at(name, eps)))
+            moved = (wc.fdm_fit(name, eps, again["fits"][name]) - wc.fdm_fit(name, eps, s["fits"][name])) / scale
+            assert np.max(np.abs(moved)) < 1e-5, (s["a_over_delta"], name)
+            assert again["fits"][name]["rms"] == pytest.approx(s["fits"][name]["rms"], abs=1e-7)
 
 
 def test_shipped_fits_reproduce_their_measurements(shipped):
