@@ -69,9 +69,8 @@ def test_shipped_fits_reproduce_their_measurements():
         # the json is what the table was made from: the same curve (not the same digits of each parameter,
         # which are only as sharp as the optimizer's stopping rule and a machine's rounding)
         xi = np.geomspace(1e-4, 1, 41)
-        names = ("r_0", "r_inf", "xi_1", "p")
-        curve, shipped = (calibration.fitted_resistance(xi, *(f[n] for n in names)) for f in (fit, s["fit"]))
-        assert np.max(np.abs(curve / shipped - 1)) < 1e-5, label
+        shipped_curve = calibration.fitted_curve(xi, s["fit"])
+        assert np.max(np.abs(calibration.fitted_curve(xi, fit) / shipped_curve - 1)) < 1e-5, label
         assert fit["rms_rel"] == pytest.approx(s["fit"]["rms_rel"], abs=1e-7), label
 
 

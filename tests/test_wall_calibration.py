@@ -101,9 +101,8 @@ def test_shipped_calibration_covers_the_suspension_resolutions(shipped):
         again = wc.summary(wc.from_summary(s))
         eps = np.geomspace(1e-3, 1, 61)
         for name in wc.FUNCTIONS:
-            scale = (np.sqrt(wc.theory_at("YA", eps) * wc.theory_at("YC", eps)) if name == "YB"
-                     else np.abs(wc.theory_at(name, eps)))
-            moved = (wc.fdm_fit(name, eps, again["fits"][name]) - wc.fdm_fit(name, eps, s["fits"][name])) / scale
+            moved = ((wc.fdm_fit(name, eps, again["fits"][name]) - wc.fdm_fit(name, eps, s["fits"][name]))
+                     / wc.residual_scale(name, eps))
             assert np.max(np.abs(moved)) < 1e-5, (s["a_over_delta"], name)
             assert again["fits"][name]["rms"] == pytest.approx(s["fits"][name]["rms"], abs=1e-7)
 

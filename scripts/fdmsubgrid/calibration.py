@@ -162,7 +162,7 @@ class SqueezeCalibration:
     def correction(self, gap: float, fit: Dict[str, float]) -> float:
         """s_hat(xi) = r_th(xi) - r_FDM,fit(xi) (units 6 pi eta a1), not clipped."""
         r_th = 1 / theory_velocity(self.kind, self.ratio, round_gap(gap))
-        return r_th - float(fitted_resistance(np.array(gap), fit["r_0"], fit["r_inf"], fit["xi_1"], fit["p"]))
+        return r_th - float(fitted_curve(np.array(gap), fit))
 
     def table(self, fit: Dict[str, float]) -> List[tuple]:
         """(xi, xi * s_hat * taper) from TABLE_MIN_GAP to the first sign change of s_hat or TAPER_END
@@ -195,6 +195,11 @@ def taper(xi: float) -> float:
 def fitted_resistance(xi: np.ndarray, r_0: float, r_inf: float, xi_1: float, p: float) -> np.ndarray:
     """The fit of the solver's squeeze resistance (units 6 pi eta a1)."""
     return r_inf + (r_0 - r_inf) / (1 + (xi / xi_1) ** p)
+
+
+def fitted_curve(xi: np.ndarray, fit: Dict[str, float]) -> np.ndarray:
+    """fitted_resistance with the parameters of a fit (SqueezeCalibration.fit's dict)."""
+    return fitted_resistance(xi, fit["r_0"], fit["r_inf"], fit["xi_1"], fit["p"])
 
 
 def round_gap(g: float) -> float:
@@ -352,7 +357,7 @@ def plot(path: str, summaries: Sequence[Dict]) -> None:
                         fmt="x", ms=4, label="FDM, L = %g a1" % L)
         ax.loglog(gaps, 1 / np.array(s["velocity_inf"]), "^", label="FDM, L → ∞")
         f = s["fit"]
-        ax.loglog(fine, fitted_resistance(fine, f["r_0"], f["r_inf"], f["xi_1"], f["p"]), "-", color="C3", label="fit")
+        ax.loglog(fine, fitted_curve(fine, f), "-", color="C3", label="fit")
         ax.set_xlabel(r"$\xi$" if s["kind"] == "pair" else r"$\varepsilon$")
         ax.set_ylabel(r"squeeze resistance / $6\pi\eta a_1$")
         ax.set_title("%s, a1/Δ = %g%s" % (s["kind"], s["a_over_delta"],

@@ -238,6 +238,13 @@ def fdm_fit(name: str, eps, fit: Dict[str, float]):
     return f
 
 
+def residual_scale(name: str, eps) -> np.ndarray:
+    """The scale a fit's residuals of function `name` are measured on: sqrt(Y^A Y^C) of the theory for
+    Y^B (which crosses zero), |f_th| for the others."""
+    return (np.sqrt(theory_at("YA", eps) * theory_at("YC", eps)) if name == "YB"
+            else np.abs(theory_at(name, eps)))
+
+
 def fit_function(name: str, gaps: Sequence[float], fdm: np.ndarray) -> Dict[str, float]:
     """(eps_c, p) of f_FDM = f_th(seen_gap(eps)), and for Y^B the bump (amplitude `bump`, centre eps_b,
     width in ln eps), through the measured FDM function `name` (least squares with the residuals over
@@ -245,8 +252,7 @@ def fit_function(name: str, gaps: Sequence[float], fdm: np.ndarray) -> Dict[str,
     f_0 = f_th(eps_c)."""
     from scipy.optimize import least_squares
     gaps = np.asarray(gaps, dtype=float)
-    scale = (np.sqrt(theory_at("YA", gaps) * theory_at("YC", gaps)) if name == "YB"
-             else np.abs(theory_at(name, gaps)))
+    scale = residual_scale(name, gaps)
     with_bump = name == "YB"
 
     def as_fit(q: np.ndarray) -> Dict[str, float]:
