@@ -23,7 +23,7 @@ sudo=""
 if [ "$(id -u)" -ne 0 ]; then command -v sudo >/dev/null && sudo=sudo || die "run as root or install sudo"; fi
 
 # ---- 1. Debian packages --------------------------------------------------------------------------
-debianPackages="openfoam libopenfoam liggghts libliggghts-dev libeigen3-dev libsuitesparse-dev libopenblas0-serial libopenmpi-dev openmpi-bin
+debianPackages="openfoam libopenfoam liggghts libliggghts-dev libeigen3-dev libfftw3-dev libfftw3-mpi-dev libsuitesparse-dev libopenblas0-serial libopenmpi-dev openmpi-bin
  g++ make cmake bzip2 libgtest-dev dpkg-dev python3 python3-pip"
 missing=""
 for p in $debianPackages; do

@@ -52,6 +52,21 @@ class Box:
         return [f == "cyclic" for f in self.faces]
 
 
+# The fvSolution lines of each linear-solver choice, (p, U): FFTBox solves the box meshes every case
+# writes directly (fluid/boxSolvers) and hands any other mesh to its fallback
+LINEAR_SOLVERS = {
+    "FFTBox": ("""        solver          FFTBox;
+        fallback        { solver GAMG; smoother GaussSeidel; }""",
+               """        solver          FFTBox;
+        fallback        { solver smoothSolver; smoother symGaussSeidel; }"""),
+    "GAMG": ("""        solver          GAMG;
+        smoother        GaussSeidel;""",
+             """        solver          smoothSolver;
+        smoother        symGaussSeidel;"""),
+}
+DEFAULT_LINEAR_SOLVER = "GAMG"
+
+
 def write_control_dict(case_dir, application="fdmFoam", write_interval=100000, end_time=None, delta_t=None):
     """system/controlDict. For fdmFoam (the default) time is driven by fdmDEM: the run starts from
     the latest time and endTime and deltaT are placeholders. For another solver (e.g. icoFoam in a
@@ -85,7 +100,7 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
                      pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
                      n_correctors=2, extra_fdm="", acceleration="anderson", tol_velocity=0.0,
                      mean_flow_correction=True, mean_flow_damping=None, u_rel_tol=0.0, p_rel_tol=0.01,
-                     p_final_rel_tol=0.0):
+                     p_final_rel_tol=0.0, linear_solver=None):
     """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/). u_rel_tol, p_rel_tol,
     p_final_rel_tol: the relTol of the momentum predictor, of the first pressure corrector and of
     the last (pFinal) in every inner iteration (0: solved to tol_u, tol_p each time; the suspension
@@ -94,7 +109,13 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
     iteration's, "anderson" (default) or "none" (the plain iteration of paper 4.3); tol_velocity: the
     innerIterations tolVelocity (0 = not checked, the first step included); mean_flow_correction: the
     exact plane-averaged profile of a channel at every inner iteration (a no-op in other boxes);
-    mean_flow_damping: its meanFlowDamping (None: fdmFoam's default, 10), docs/fluid.md."""
+    mean_flow_damping: its meanFlowDamping (None: fdmFoam's default, 10), docs/fluid.md.
+    linear_solver: the solver of p and U, "FFTBox" (the direct solver for box meshes, GAMG and
+    symGaussSeidel as its fallbacks) or "GAMG" (GAMG for p, symGaussSeidel for U); None:
+    DEFAULT_LINEAR_SOLVER (docs/fluid.md, "Direct solver for box meshes")."""
+    linear_solver = DEFAULT_LINEAR_SOLVER if linear_solver is None else linear_solver
+    if linear_solver not in LINEAR_SOLVERS:
+        raise ValueError("write_fluid_case: linear_solver %r is not one of %s" % (linear_solver, ", ".join(LINEAR_SOLVERS)))
     x0, y0, z0 = box.lo
     x1, y1, z1 = box.hi
     names = ("x", "y", "z")
@@ -156,8 +177,7 @@ solvers
 {
     p
     {
-        solver          GAMG;
-        smoother        GaussSeidel;
+%(p_solver)s
         tolerance       %(tol_p)g;     // tol_p of the paper (4.4.5)
         relTol          %(p_rel_tol)g;
     }
@@ -168,8 +188,7 @@ solvers
     }
     U
     {
-        solver          smoothSolver;
-        smoother        symGaussSeidel;
+%(u_solver)s
         tolerance       %(tol_u)g;     // tol_u of the paper (4.4.5)
         relTol          %(u_rel_tol)g;
     }
@@ -183,7 +202,7 @@ PISO
     pRefValue       0;
 }
 """ % dict(tol_p=tol_p, tol_u=tol_u, u_rel_tol=u_rel_tol, p_rel_tol=p_rel_tol, p_final_rel_tol=p_final_rel_tol,
-           ncorr=n_correctors))
+           ncorr=n_correctors, p_solver=LINEAR_SOLVERS[linear_solver][0], u_solver=LINEAR_SOLVERS[linear_solver][1]))
 
     # no system/decomposeParDict: fdmRun -f N writes the split for N ranks (fdmsubgrid.decomposition)
 
