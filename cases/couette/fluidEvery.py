@@ -243,7 +243,8 @@ def main(argv=None) -> Dict:
                  r["inner_iterations_mean"], r["fluid_solves_per_step"], pu.get("limited_per_particle_step") or 0.0,
                  100 * r["error_mean"], 100 * r["error_rms"], moved.get("position", np.nan),
                  moved.get("velocity", np.nan)))
-    files.write_json(args.out, files.relative_paths(summary), indent=1)   # run folders relative to here
+    summary = files.relative_paths(summary)   # run folders relative to here: a summary may be shipped (docs/data)
+    files.write_json(args.out, summary, indent=1)
     plot(results, os.path.splitext(args.out)[0] + ".png")
     print("wrote", args.out)
     return summary

@@ -548,7 +548,8 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     rows = sorted(rows + earlier_rows(args.rows_from, args.phis), key=lambda r: r["phi_bulk_table8"])
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    files.write_json(args.out, files.relative_paths(summary))   # run folders relative to here
+    summary = files.relative_paths(summary)   # run folders relative to here: a summary may be shipped (docs/data)
+    files.write_json(args.out, summary)
     print_table(summary)
     print("wrote %s" % args.out)
     if stopped:
