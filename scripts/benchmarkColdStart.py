@@ -12,6 +12,7 @@ import json
 import os
 import shutil
 import sys
+import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
@@ -61,8 +62,8 @@ def main(argv=None):
     p.add_argument("--cells", type=int, default=48, help="cells per side of the cubic box")
     p.add_argument("--a-over-delta", type=float, default=4.0)
     p.add_argument("--n-max", type=int, default=3000)
-    p.add_argument("--workdir", default="/tmp/fdmColdStart")
-    p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "benchmarks_coldStart.json"))
+    p.add_argument("--workdir", default=os.path.join(tempfile.gettempdir(), "fdmColdStart"))
+    p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "data", "benchmarks_coldStart.json"))
     args = p.parse_args(argv)
     results = [run_one(args.workdir, *r, cells=args.cells, a_over_delta=args.a_over_delta, n_max=args.n_max)
                for r in RUNS]

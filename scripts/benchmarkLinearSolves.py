@@ -26,7 +26,7 @@ Two measurements, one per part:
 
   python3 scripts/benchmarkLinearSolves.py [--part accuracy cost] [--seeds 1 2 3] [--steps 8]
                                            [--repeats 2] [--workdir DIR] [--out FILE]
-Writes docs/benchmarks_linearSolves.json unless --out says otherwise.
+Writes docs/data/benchmarks_linearSolves.json unless --out says otherwise.
 """
 import argparse
 import dataclasses
@@ -35,6 +35,7 @@ import os
 import re
 import shutil
 import sys
+import tempfile
 import time
 from typing import Dict, List, Optional
 
@@ -195,8 +196,8 @@ def main(argv=None) -> int:
     p.add_argument("--tol-lambdas", type=float, nargs="+", default=[1e-2, 3e-3])
     p.add_argument("--steps", type=int, default=8, help="steps of the Table 8 scene per cost run")
     p.add_argument("--repeats", type=int, default=2)
-    p.add_argument("--workdir", default="/tmp/fdmLinearSolves")
-    p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "benchmarks_linearSolves.json"))
+    p.add_argument("--workdir", default=os.path.join(tempfile.gettempdir(), "fdmLinearSolves"))
+    p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "data", "benchmarks_linearSolves.json"))
     args = p.parse_args(argv)
     result = dict(settings=[dataclasses.asdict(s) for s in SETTINGS])
     if "accuracy" in args.part:

@@ -14,7 +14,7 @@ depends on the path of the iteration, and two converged runs may differ at a con
 
   python3 scripts/benchmarkMeanFlowDamping.py [--phi 0.37] [--seeds 1 2 3] [--friction]
                                               [--workdir DIR] [--out FILE]
-Writes docs/benchmarks_meanFlowDamping.json unless --out says otherwise.
+Writes docs/data/benchmarks_meanFlowDamping.json unless --out says otherwise.
 """
 import argparse
 import dataclasses
@@ -22,6 +22,7 @@ import json
 import os
 import shutil
 import sys
+import tempfile
 
 import numpy as np
 
@@ -104,8 +105,8 @@ def main(argv=None):
     p.add_argument("--phi", type=float, default=0.37)
     p.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
     p.add_argument("--friction", action="store_true", help="keep Coulomb friction (mu_s 0.5)")
-    p.add_argument("--workdir", default="/tmp/fdmMeanFlowDamping")
-    p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "benchmarks_meanFlowDamping.json"))
+    p.add_argument("--workdir", default=os.path.join(tempfile.gettempdir(), "fdmMeanFlowDamping"))
+    p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "data", "benchmarks_meanFlowDamping.json"))
     args = p.parse_args(argv)
     runs = [run_scene(args.workdir, *r, phi=args.phi, seed=s, friction=args.friction,
                       tol_solve=1e-10 if r[0] == "reference" else None)

@@ -35,7 +35,7 @@ step of fdmFoam's inner iteration; both start from rest (u = 0, the walls moving
   python3 scripts/benchmarkOverhead.py --only step --scene-steps 10   # keeps `iteration` from the JSON
 
 Needs the project's environment (. etc/bashrc: fdmFoam, fdmDEM, blockMesh) and /usr/bin/icoFoam.
-Writes docs/benchmarks_overhead.json; run folders go to --workdir.
+Writes docs/data/benchmarks_overhead.json; run folders go to --workdir.
 """
 import argparse
 import json
@@ -43,6 +43,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -330,8 +331,8 @@ def main(argv=None):
     ap.add_argument("--n-max", type=int, default=100, help="nMax of the `step` runs")
     ap.add_argument("--tol-u", type=float, default=1e-5, help="U solver tolerance (paper section 6)")
     ap.add_argument("--tol-p", type=float, default=1e-3, help="p solver tolerance (paper section 6)")
-    ap.add_argument("--workdir", default="/tmp/fdmOverhead")
-    ap.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_overhead.json"))
+    ap.add_argument("--workdir", default=os.path.join(tempfile.gettempdir(), "fdmOverhead"))
+    ap.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "benchmarks_overhead.json"))
     args = ap.parse_args(argv)
     parts = args.only or ["iteration", "step"]
     if not os.path.isfile(ICO):

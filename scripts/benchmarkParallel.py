@@ -14,7 +14,7 @@ of each run's median over its steps of
   scripts/benchmarkParallel.py                     # 100^3, ranks 1 2, 3 repeats (15 min here with --busy-poll)
   scripts/benchmarkParallel.py --cells 40 --repeats 1
 
-Writes --out (default docs/benchmarks_parallel.json) and prints the table of docs/benchmarks.md
+Writes --out (default docs/data/benchmarks_parallel.json) and prints the table of docs/benchmarks.md
 ("Parallel runs"); run folders go to --workdir (default .cache/runs/benchmarkParallel).
 """
 import argparse
@@ -78,7 +78,7 @@ def main():
                         help="also run every rank count > 1 with Open MPI busy-polling (mpi_yield_when_idle 0), "
                              "which fdmRun switches off when the ranks outnumber the cores")
     parser.add_argument("--workdir", default=os.path.join(PROJECT, ".cache", "runs", "benchmarkParallel"))
-    parser.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_parallel.json"))
+    parser.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "benchmarks_parallel.json"))
     args = parser.parse_args()
 
     shutil.rmtree(args.workdir, ignore_errors=True)

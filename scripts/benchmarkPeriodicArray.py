@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Run time against error for the periodic array of spheres (paper 5.1): K error against
 Hasimoto versus wall time, for a/Delta in {3, 4, 5, 6} and several lambda tolerances.
-Writes docs/benchmarks_periodicArray.json, docs/benchmarks_periodicArray.png and prints a
+Writes docs/data/benchmarks_periodicArray.json, docs/data/benchmarks_periodicArray.png and prints a
 Markdown table for docs/benchmarks.md. Runs `--jobs` configurations side by side.
 
   scripts/benchmarkPeriodicArray.py [--a-over-delta 3 4 5 6] [--tol-lambda 1e-3 1e-4]
@@ -27,7 +27,7 @@ def main():
     p.add_argument("--L-over-a", type=float, default=8.0)
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--workdir", default=os.path.join(PROJECT, "cases", "periodicArray", "runs", "benchmark"))
-    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_periodicArray"))
+    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "benchmarks_periodicArray"))
     args = p.parse_args()
     os.makedirs(args.workdir, exist_ok=True)
     configs = [(ad, tol) for ad in args.a_over_delta for tol in args.tol_lambda]

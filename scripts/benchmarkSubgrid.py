@@ -41,7 +41,7 @@
   scripts/benchmarkSubgrid.py --skip-coupled       # DEM only (a few minutes)
   scripts/benchmarkSubgrid.py --only coupled --coupled-steps 3
   scripts/benchmarkSubgrid.py --only scaling coupled-shear    # re-run parts; the others are kept from the JSON
-Writes docs/benchmarks_subgrid.json and docs/benchmarks_subgrid.md (the tables of docs/benchmarks.md);
+Writes docs/data/benchmarks_subgrid.json and docs/data/benchmarks_subgrid.md (the tables of docs/benchmarks.md);
 run folders go to --workdir (default .cache/runs/benchmarkSubgrid).
 """
 import argparse
@@ -441,7 +441,7 @@ def main(argv=None):
     ap.add_argument("--scaling-repeats", type=int, default=2)
     ap.add_argument("--keep", action="store_true", help="keep the coupled runs' mesh and fields")
     ap.add_argument("--workdir", default=os.path.join(PROJECT, ".cache", "runs", "benchmarkSubgrid"))
-    ap.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_subgrid"))
+    ap.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "benchmarks_subgrid"))
     args = ap.parse_args(argv)
     parts = args.only or (["stability", "timing", "scaling"] +
                           ([] if args.skip_coupled else ["coupled", "coupled-shear"]))

@@ -690,12 +690,12 @@ def test_table8_progress_lines_read_the_runs_own_log(tiny_run, tmp_path):
 
 
 def test_table8_summary_draws_fig21_and_fig22_from_earlier_rows(tmp_path):
-    """table8.py --analyse-only with the rows of a shipped summary (docs/validation_table8_fluidEvery.json:
+    """table8.py --analyse-only with the rows of a shipped summary (docs/data/validation_table8_fluidEvery.json:
     all seven of the paper's) and one row not run (0.58, outside the shipped ones: a listed row replaces the
     shipped row of its phi) writes the summary with both figures, Fig. 21 and Fig. 22 (normal stresses), and
     refits the same Maron-Pierce parameters from the same rows; --out may name a folder not made yet."""
     table8 = load_case_module("couette", "table8")
-    shipped = os.path.join(PROJECT, "docs", "validation_table8_fluidEvery.json")
+    shipped = os.path.join(PROJECT, "docs", "data", "validation_table8_fluidEvery.json")
     out = tmp_path / "report" / "t8.json"
     summary = table8.main(["--analyse-only", "--phis", "0.58", "--workdir", str(tmp_path / "runs"),
                            "--rows-from", shipped, "--out", str(out)])

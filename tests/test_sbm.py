@@ -92,7 +92,7 @@ def test_velocity_against_quadrature_and_the_plug():
 def test_fit_from_couette_results():
     """The material functions from the shipped Table 8 phi_bulk 0.27 results: one row fits alpha (phi_m
     held at the paper's 0.592) and K (n held at 2); the fit reproduces the row."""
-    path = os.path.join(PROJECT, "docs", "validation_table8_phi0.27.json")
+    path = os.path.join(PROJECT, "docs", "data", "validation_table8_phi0.27.json")
     material = sbm.from_couette_results([path])
     import json
     row = json.load(open(path))["mser_window"]
@@ -123,4 +123,4 @@ def test_bad_input_is_refused_with_the_value():
     with pytest.raises(sbm.SBMError, match=r"singular"):
         sbm.solve(flat, 0.4)
     with pytest.raises(sbm.SBMError, match=r"not a Couette results file"):
-        sbm.from_couette_results([os.path.join(PROJECT, "docs", "benchmarks_coldStart.json")])
+        sbm.from_couette_results([os.path.join(PROJECT, "docs", "data", "benchmarks_coldStart.json")])

@@ -10,7 +10,7 @@ A run whose results file exists is not run again, so the study can be stopped an
                                       tolLambda 1e-2 and 3e-3 (the case's 1e-3) at dt 0.02, a1/Delta 3
   convergence.py --strain 4 --quick   two runs only (dt 0.04 and 0.02 at a1/Delta = 3)
 
-Writes <workdir>/<run>.json per run and --out (default docs/benchmarks_couetteConvergence.json) with
+Writes <workdir>/<run>.json per run and --out (default docs/data/benchmarks_couetteConvergence.json) with
 a figure beside it (eta_s, N2_hat and the stress balance against dt, core-seconds per strain unit).
 """
 import argparse
@@ -87,7 +87,7 @@ def main(argv=None) -> Dict:
                    help="run only these of the grid (e.g. 3:0.02 4:0.02 3:0.02:0.01), so that two processes can "
                    "share the grid; the summary holds every run of the grid whose results exist")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs", "convergence"))
-    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_couetteConvergence.json"))
+    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "benchmarks_couetteConvergence.json"))
     args = p.parse_args(argv)
     os.makedirs(args.workdir, exist_ok=True)
     grid: List[Tuple[int, float, float]] = [(3, 0.04, TOL_LAMBDA), (3, 0.02, TOL_LAMBDA)]

@@ -223,7 +223,7 @@ def main(argv=None) -> Dict:
     p.add_argument("--out", default=None, help="default docs/benchmarks_fluidEvery_phi<PHI>.json")
     args = p.parse_args(argv)
     if args.out is None:
-        args.out = os.path.join(PROJECT, "docs", "benchmarks_fluidEvery_phi%g.json" % args.phi)
+        args.out = os.path.join(PROJECT, "docs", "data", "benchmarks_fluidEvery_phi%g.json" % args.phi)
     os.makedirs(args.workdir, exist_ok=True)
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         results = list(pool.map(lambda v: run_variant(v[0], v[1], v[2], args), args.variants))
@@ -243,6 +243,7 @@ def main(argv=None) -> Dict:
                  r["inner_iterations_mean"], r["fluid_solves_per_step"], pu.get("limited_per_particle_step") or 0.0,
                  100 * r["error_mean"], 100 * r["error_rms"], moved.get("position", np.nan),
                  moved.get("velocity", np.nan)))
+    summary = files.relative_paths(summary)   # run folders relative to here: a summary may be shipped (docs/data)
     files.write_json(args.out, summary, indent=1)
     plot(results, os.path.splitext(args.out)[0] + ".png")
     print("wrote", args.out)

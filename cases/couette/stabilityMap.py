@@ -10,7 +10,7 @@ Every run's particle records are checked for non-finite values (there must be no
   stabilityMap.py                      phi 0.27 and 0.47 x dt 0.02, 0.05, 0.1 x stiffness 1, 10
   stabilityMap.py --quick              phi 0.47, dt 0.05 and 0.1, stiffness 1
 
-Writes --out (default docs/benchmarks_stabilityMap.json) and a figure beside it.
+Writes --out (default docs/data/benchmarks_stabilityMap.json) and a figure beside it.
 """
 import argparse
 import glob
@@ -127,7 +127,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--quick", action="store_true")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs", "stabilityMap"))
-    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "benchmarks_stabilityMap.json"))
+    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "benchmarks_stabilityMap.json"))
     args = p.parse_args(argv)
     if args.quick:
         args.phis, args.dts, args.stiffness = [0.47], [0.05, 0.1], [1.0]

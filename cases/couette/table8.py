@@ -39,7 +39,7 @@ written. Killing this script (or the session ending) loses at most one checkpoin
 phi_bulk not run here; a row whose particle step exceeds couette.largest_good_dt at its phi_bulk (one run
 before that limit was measured) is listed and plotted, not fitted.
 
-Writes --out (default docs/table8.json): per phi_bulk the paper's row, this project's phi_core,
+Writes --out (default docs/data/table8.json): per phi_bulk the paper's row, this project's phi_core,
 gamma_core/gamma_0, eta_s, N1_hat, N2_hat, Sigma_c_hat with error bars, the stress balance, the strain
 reached and the cost; the Maron-Pierce fit with its uncertainty against the paper's alpha = 0.803,
 phi_m = 0.59 (over 3 or more finished rows whose window is full: partial and short rows are plotted
@@ -487,11 +487,11 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--max-strain", type=float, default=60.0,
                    help="the strain a run is extended to at most (a row still short there is reported as short)")
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
-    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "table8.json"))
+    p.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "table8.json"))
     p.add_argument("--analyse-only", action="store_true", help="report the runs as they stand; run nothing")
     p.add_argument("--rows-from", nargs="+", default=[], metavar="JSON",
                    help="add the rows of earlier table8.py summaries (runs made elsewhere, or whose folders are "
-                   "gone) for the phi_bulk not in --phis, e.g. docs/validation_table8_calibrated.json; fitted by the "
+                   "gone) for the phi_bulk not in --phis, e.g. docs/data/validation_table8_calibrated.json; fitted by the "
                    "same rules (a row beyond the largest good time step at its phi_bulk is listed, not fitted)")
     p.add_argument("--progress-minutes", type=float, default=10.0,
                    help="minutes between progress lines (each running row's strain and ETA; 0: none)")
@@ -548,6 +548,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     rows = sorted(rows + earlier_rows(args.rows_from, args.phis), key=lambda r: r["phi_bulk_table8"])
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    summary = files.relative_paths(summary)   # run folders relative to here: a summary may be shipped (docs/data)
     files.write_json(args.out, summary)
     print_table(summary)
     print("wrote %s" % args.out)

@@ -36,3 +36,17 @@ def write_results(path: str, results: dict, started: float) -> dict:
     results["date"] = time.strftime("%Y-%m-%d")
     write_json(path, results)
     return results
+
+
+def relative_paths(obj, start: str | None = None):
+    """A copy of `obj` (dicts, lists, strings) with every absolute path in it written relative to `start`
+    (default: the working directory, from which the command recorded beside it was given). Summaries that
+    may be shipped (docs/data/) name no folder of the machine they were made on (tests/test_docs.py)."""
+    start = os.getcwd() if start is None else start
+    if isinstance(obj, dict):
+        return {k: relative_paths(v, start) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [relative_paths(v, start) for v in obj]
+    if isinstance(obj, str) and os.path.isabs(obj) and not any(c.isspace() for c in obj):
+        return os.path.relpath(obj, start)
+    return obj

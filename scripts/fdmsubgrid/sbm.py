@@ -51,7 +51,7 @@ PAPER_PHI_M = 0.592
 # The contact normal stress Sigma_hat^c_22 = -K phi_r^n: n = 2 and K = 0.8 give Morris & Boulay's (1999)
 # normal-to-shear viscosity ratio lambda_2 = 0.8 at phi_m with their phi_r^2 growth, and -0.218 at
 # phi_core 0.309, where this project's Table 8 phi_bulk 0.27 run measured -0.216 +- 0.006
-# (docs/validation_table8_phi0.27.json)
+# (docs/data/validation_table8_phi0.27.json)
 DEFAULT_CONTACT_K = 0.8
 DEFAULT_CONTACT_N = 2.0
 LAYER_OVER_A1 = 2.5          # the layering region left out of the model (paper section 6.2)

@@ -3,7 +3,7 @@ markdown report of its tables, each row with the paper's value beside this proje
 the error and the wall time, from the cases' results files.
 
     from fdmsubgrid import validation
-    report = validation.run_report(full=False)          # runs the cases, writes docs/validation_report.md
+    report = validation.run_report(full=False)          # runs the cases, writes docs/data/validation_report.md
     rows = validation.CASES["periodicArray"].summarise(json.load(open("runs/validation/periodicArray/results.json")))
 
 The command is scripts/validationReport (`--help`). Each case is its own script, cases/NAME/NAME.py,
@@ -368,6 +368,18 @@ class CaseResult:
     provenance: str = ""                # read: when, at which commit and where the results were made
 
 
+def shown_path(path: str) -> str:
+    """A path as the report writes it: relative to the project (a report names no folder of the machine
+    it was made on; tests/test_docs.py checks the tracked files for absolute paths)."""
+    return os.path.relpath(path, PROJECT) if os.path.isabs(path) else path
+
+
+def shown_command(command: str) -> str:
+    """A command line as the report writes it: every absolute path in it relative to the project (also
+    the commands of run records written before the report wrote them so)."""
+    return " ".join(shown_path(token) if token.startswith(os.sep) else token for token in command.split(" "))
+
+
 def case_command(case: Case, full: bool, folder: str) -> List[str]:
     return [sys.executable, case.script_path()] + list(case.full_args if full else case.default_args) + \
         ["--workdir", os.path.join(folder, "runs"), "--out", os.path.join(folder, "results.json")]
@@ -379,14 +391,14 @@ def collect(key: str, case: Case, folder: str, status: str, command: str, wall: 
     path = os.path.join(folder, "results.json")
     if not os.path.exists(path):
         return CaseResult(key, case, "missing" if status == "read" else "failed", command, wall, [], log,
-                          "no results file %s" % path)
+                          "no results file %s" % shown_path(path))
     try:
         with open(path) as f:
             results = json.load(f)
         rows = case.summarise(results)
     except (ValueError, KeyError, TypeError) as exc:
         return CaseResult(key, case, "failed", command, wall, [], log,
-                          "%s: cannot read it (%s: %s)" % (path, type(exc).__name__, exc))
+                          "%s: cannot read it (%s: %s)" % (shown_path(path), type(exc).__name__, exc))
     if wall is None:
         wall = results.get("wall_seconds")
     figures = sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".png"))
@@ -404,7 +416,7 @@ def run_case(key: str, case: Case, full: bool, folder: str) -> CaseResult:
         shutil.rmtree(folder)   # never report a previous run's numbers or figures as this one's
     os.makedirs(folder)
     command = case_command(case, full, folder)
-    shown = " ".join(os.path.relpath(c, PROJECT) if c.startswith(PROJECT) else c for c in command[1:])
+    shown = " ".join(shown_path(c) for c in command[1:])
     log = os.path.join(folder, "log")
     started = time.strftime("%Y-%m-%d %H:%M")
     t0 = time.time()
@@ -415,7 +427,8 @@ def run_case(key: str, case: Case, full: bool, folder: str) -> CaseResult:
         json.dump(dict(command=shown, commit=git_commit(), date=started, wall_seconds=wall,
                        exit_code=done.returncode), f, indent=1)
     if done.returncode != 0:
-        return CaseResult(key, case, "failed", shown, wall, [], log, "exit code %d (log %s)" % (done.returncode, log))
+        return CaseResult(key, case, "failed", shown, wall, [], log,
+                          "exit code %d (log %s)" % (done.returncode, shown_path(log)))
     return collect(key, case, folder, "ran", shown, wall, log)
 
 
@@ -424,11 +437,12 @@ def read_case(key: str, case: Case, folder: str) -> CaseResult:
     time from folder/RUN_RECORD where run_case wrote one, else the results file's path."""
     record_path = os.path.join(folder, RUN_RECORD)
     if not os.path.exists(record_path):
-        return collect(key, case, folder, "read", "(read: %s)" % os.path.join(folder, "results.json"), None, None)
+        return collect(key, case, folder, "read", "(read: %s)" % shown_path(os.path.join(folder, "results.json")),
+                       None, None)
     with open(record_path) as f:
         record = json.load(f)
-    read = collect(key, case, folder, "read", record["command"], record.get("wall_seconds"), None)
-    read.provenance = "run on %s at commit %s, read from %s" % (record["date"], record["commit"], folder)
+    read = collect(key, case, folder, "read", shown_command(record["command"]), record.get("wall_seconds"), None)
+    read.provenance = "run on %s at commit %s, read from %s" % (record["date"], record["commit"], shown_path(folder))
     return read
 
 
@@ -523,7 +537,7 @@ DEFAULT_WORKDIR = os.path.join(PROJECT, "runs", "validation")
 
 
 def run_report(keys: Optional[Sequence[str]] = None, full: bool = False, report_only: bool = False,
-               out: str = os.path.join(PROJECT, "docs", "validation_report.md"),
+               out: str = os.path.join(PROJECT, "docs", "data", "validation_report.md"),
                table8: Optional[str] = None, workdir: str = DEFAULT_WORKDIR, command: str = "validationReport") -> dict:
     """Run (or, report_only, read) the cases and write the report: out (markdown), its .json and a folder of
     figures beside it. Each case runs in workdir/<key>/ (its results.json, figures, log and run folders)."""
@@ -558,7 +572,8 @@ def run_report(keys: Optional[Sequence[str]] = None, full: bool = False, report_
             results.append(run_case(key, case, full, os.path.join(workdir, key)))
             print("      %s in %.0f s%s" % (results[-1].status, results[-1].wall_seconds or 0,
                                            (": " + results[-1].message) if results[-1].message else ""), flush=True)
-    info = dict(command=command, date=time.strftime("%Y-%m-%d %H:%M"), commit=git_commit(), workdir=workdir,
+    info = dict(command=shown_command(command), date=time.strftime("%Y-%m-%d %H:%M"), commit=git_commit(),
+                workdir=shown_path(workdir),
                 size="--full sizes" if full else "default sizes", wall_seconds=time.time() - t0,
                 cases_wall_seconds=sum(r.wall_seconds or 0.0 for r in results),
                 table8=os.path.relpath(table8, PROJECT) if table8 else None)
