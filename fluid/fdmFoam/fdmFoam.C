@@ -39,6 +39,7 @@ Usage
 #include "innerConvergence.H"
 #include "fluidCheckpoint.H"
 #include "meanFlowCorrection.H"
+#include "runProfile.H"
 #include <chrono>
 
 namespace
@@ -115,6 +116,8 @@ int main(int argc, char *argv[])
     scalarList radii;
 
     scalar fluidTime = 0, particleTime = 0, outputTime = 0, checkpointTime = 0;
+    // the inner iteration's parts, printed at the end of the run
+    fdm::runProfile profile;
     label nStepsDone = 0, nInnerTotal = 0;
     // steps of the run before this session (a resumed run continues its count)
     const label stepsBefore = label(resumed.stepsDone);
@@ -201,11 +204,14 @@ int main(int argc, char *argv[])
         {
             ++innerIteration;
             double t0 = wallClock();
+            profile.start();
             if (accelerate)
             {
-                state = anderson.pack(U, lambda, p);
+                anderson.pack(U, lambda, p, state);
+                profile.lap("Anderson mixing");
             }
             convergence.startIteration(U);
+            profile.lap("convergence test");
 
             // Step 3: fluid sub-problem
             {
@@ -218,18 +224,22 @@ int main(int argc, char *argv[])
             // The slowest modes, the plane-averaged channel profile, solved
             // exactly (meanFlowCorrection.H)
             meanFlow.correct(U, lambda, gradP0.value()/rho.value());
+            profile.lap("mean-flow correction");
             double t1 = wallClock();
             stepFluidTime += t1 - t0;
 
             // Step 4: particle velocities from the DEM side (Eq. 31)
             integrals = forcing.integrals(U, lambda);
+            profile.lap("particle integrals");
             stepParticleTime += wallClock() - t1;
             coupling.sendIntegrals(innerIteration, integrals);
             velocities = coupling.receiveVelocities(innerIteration);
+            profile.lap("exchange + DEM");
 
             // Steps 5-6: correct lambda and u (Eq. 38)
             t0 = wallClock();
             residual = forcing.correct(U, lambda, velocities);
+            profile.lap("lambda and u correction");
             stepParticleTime += wallClock() - t0;
 
             const string divergence =
@@ -243,6 +253,7 @@ int main(int argc, char *argv[])
                 );
             }
             convergence.endIteration(U, velocities, radii, residual);
+            profile.lap("convergence test");
             if (reportIterations)
             {
                 Info<< "    inner " << innerIteration << " residual lambda "
@@ -265,7 +276,9 @@ int main(int argc, char *argv[])
             if (accelerate)
             {
                 t0 = wallClock();
+                profile.start();
                 anderson.accelerate(state, U, lambda, p);
+                profile.lap("Anderson mixing");
                 stepFluidTime += wallClock() - t0;
             }
         }
@@ -381,7 +394,9 @@ int main(int argc, char *argv[])
             << pct(checkpointTime) << " %; every "
             << coupling.checkpointEvery() << " steps and at the end)" << nl;
     }
-    Info<< endl;
+    Info<< "fdmFoam inner iterations by part (" << nInnerTotal << " inner iterations, "
+        << profile.total() << " s):" << nl
+        << profile.report(profile.total(), nInnerTotal, "iteration").c_str() << endl;
 
     Info<< "End\n" << endl;
     return 0;

@@ -37,11 +37,12 @@ Foam::andersonAcceleration::andersonAcceleration
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
 
-Foam::tmp<Foam::scalarField> Foam::andersonAcceleration::pack
+void Foam::andersonAcceleration::pack
 (
     const volVectorField& U,
     const volVectorField& lambda,
-    const volScalarField& p
+    const volScalarField& p,
+    scalarField& x
 ) const
 {
     const vectorField& u = U.primitiveField();
@@ -49,8 +50,7 @@ Foam::tmp<Foam::scalarField> Foam::andersonAcceleration::pack
     const scalarField& pk = p.primitiveField();
     const label n = u.size();
 
-    tmp<scalarField> tx(new scalarField(7*n));
-    scalarField& x = tx.ref();
+    x.setSize(7*n);
     for (label i = 0; i < n; ++i)
     {
         for (direction d = 0; d < 3; ++d)
@@ -60,7 +60,6 @@ Foam::tmp<Foam::scalarField> Foam::andersonAcceleration::pack
         }
         x[6*n + i] = pressureScale_*pk[i];
     }
-    return tx;
 }
 
 
@@ -72,7 +71,8 @@ void Foam::andersonAcceleration::accelerate
     volScalarField& p
 )
 {
-    scalarField next(pack(U, lambda, p));
+    scalarField& next = next_;
+    pack(U, lambda, p, next);
     if (!mixing_.mix(x.cdata(), next.data(), next.size()))
     {
         return;     // no history yet: the fields already hold G(x_k)
