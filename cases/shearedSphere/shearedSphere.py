@@ -28,13 +28,12 @@ import json
 import math
 import os
 import shutil
-import sys
 
 import numpy as np
 
+from fdmsubgrid import case, output, profiles, rheology
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output, profiles, rheology  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0

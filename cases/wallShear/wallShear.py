@@ -67,17 +67,15 @@ import argparse
 import math
 import os
 import shutil
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 
+from fdmsubgrid import case, files, output
+import freeSphereWall
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-sys.path.insert(0, HERE)
-from fdmsubgrid import case, files, output  # noqa: E402
-import freeSphereWall  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0
