@@ -1,10 +1,13 @@
 """The Python package fdmsubgrid (scripts/fdmsubgrid) as a user meets it: importable from any folder
 after ./Allwmake (a notebook), declared by scripts/pyproject.toml, finding the project's programs
 through the environment rather than through the file's location."""
+import importlib.metadata
 import os
 import shutil
+import site
 import subprocess
 import sys
+import sysconfig
 import tomllib
 
 import pytest
@@ -31,6 +34,27 @@ def test_importable_from_any_folder_after_Allwmake():
     proc = subprocess.run([sys.executable, "-c", code], cwd="/", env=clean_environment(), text=True,
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     assert proc.returncode == 0, "import fdmsubgrid failed (./Allwmake installs it):\n" + proc.stdout
+
+
+def test_installed_by_pip_with_its_command():
+    # etc/install-python-package.sh (./Allwmake): pip knows the package, editable from this checkout, and
+    # installed the command of pyproject.toml; its offline fallback (a .pth file) is said in docs/install.md
+    show = subprocess.run([sys.executable, "-m", "pip", "show", "fdmsubgrid"], env=clean_environment(), text=True,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    if show.returncode != 0:
+        code = "import site, sysconfig, os; print(any(os.path.isfile(os.path.join(d, 'fdmsubgrid.pth')) for d in " \
+               "(sysconfig.get_paths()['purelib'], site.getusersitepackages())))"
+        fallback = subprocess.run([sys.executable, "-c", code], text=True, stdout=subprocess.PIPE).stdout.strip()
+        if fallback == "True":
+            pytest.skip("fdmsubgrid made importable by the .pth fallback (no wheel package offline: docs/install.md)")
+        pytest.fail("pip does not know fdmsubgrid: run etc/install-python-package.sh (./Allwmake)\n" + show.stdout)
+    fields = dict(line.split(": ", 1) for line in show.stdout.splitlines() if ": " in line)
+    assert os.path.samefile(fields["Editable project location"], os.path.join(PROJECT, "scripts")), show.stdout
+    # the command pip wrote beside the interpreter (or in the user's bin folder for a user install)
+    commands = [e for e in importlib.metadata.entry_points(group="console_scripts") if e.name == "fdmProfiles"]
+    assert commands and commands[0].value == "fdmsubgrid.shear:main"
+    folders = (sysconfig.get_paths()["scripts"], os.path.join(site.getuserbase(), "bin"))
+    assert any(os.access(os.path.join(d, "fdmProfiles"), os.X_OK) for d in folders), folders
 
 
 def test_pyproject_declares_the_package_and_its_command():
