@@ -41,6 +41,8 @@ if pipInstall --no-build-isolation -e "$root/scripts" || pipInstall -e "$root/sc
     while read -r d; do rm -f "$d/fdmsubgrid.pth"; done < <(sitePackages)
     where=$("$python" -m pip show fdmsubgrid 2>/dev/null | sed -n 's/^Editable project location: //p')
     echo "[build] fdmsubgrid installed by pip (editable, from ${where:-$root/scripts})"
+    # pyenv finds a new command through a shim, made by a rehash
+    if command -v pyenv >/dev/null; then pyenv rehash 2>/dev/null || true; fi
     scripts=$("$python" -c 'import sysconfig; print(sysconfig.get_paths()["scripts"])')
     command -v fdmProfiles >/dev/null \
         || echo "[build] note: fdmProfiles was installed in $scripts or your user's bin folder, which is not on the PATH (. etc/bashrc puts scripts/fdmProfiles there)"
