@@ -42,7 +42,7 @@ fi
 # ---- 2. Python packages --------------------------------------------------------------------------
 python=${FDM_PYTHON:-python3}
 pyMissing=""
-for m in numpy scipy matplotlib pytest; do
+for m in numpy scipy matplotlib pytest wheel; do   # wheel: pip install -e scripts without the network
     "$python" -c "import $m" 2>/dev/null || pyMissing="$pyMissing $m"
 done
 if [ -n "$pyMissing" ]; then

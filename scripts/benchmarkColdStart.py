@@ -14,9 +14,9 @@ import shutil
 import sys
 import tempfile
 
+from fdmsubgrid import case, output
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-from fdmsubgrid import case, output  # noqa: E402
 
 # (label, acceleration, mean-flow correction, tolLambda, tolVelocity, tol_u = tol_p)
 RUNS = [

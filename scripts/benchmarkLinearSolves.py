@@ -41,11 +41,9 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
+from fdmsubgrid import case, couettescene, output, packing
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-sys.path.insert(0, os.path.join(HERE, "..", "cases", "couette"))
-from fdmsubgrid import case, output, packing  # noqa: E402
-import couette  # noqa: E402
 
 TIGHT = 1e-7
 
@@ -104,10 +102,10 @@ def accuracy_run(workdir: str, label: str, setting: Setting, tol_lambda: float, 
     run_dir = os.path.join(workdir, "accuracy", "seed%d" % seed, re.sub(r"[^A-Za-z0-9.]+", "_", label))
     shutil.rmtree(run_dir, ignore_errors=True)
     size, a_over_delta, dt = (10.0, 12.0, 8.0), 3.0, 0.04
-    pack = packing.channel_packing(size, phi=phi, seed=seed, min_gap=2 * couette.ROUGHNESS,
-                                   wall_gap=2 * couette.ROUGHNESS)
-    springs = dataclasses.replace(couette.choose_springs(pack.phi, dt, couette.A1 / a_over_delta), mu_s=0.0)
-    scene = couette.write_case(run_dir, pack, springs, a_over_delta, dt, 2 * dt, 1, tol_lambda, "anderson", n_max,
+    pack = packing.channel_packing(size, phi=phi, seed=seed, min_gap=2 * couettescene.ROUGHNESS,
+                                   wall_gap=2 * couettescene.ROUGHNESS)
+    springs = dataclasses.replace(couettescene.choose_springs(pack.phi, dt, couettescene.A1 / a_over_delta), mu_s=0.0)
+    scene = couettescene.write_case(run_dir, pack, springs, a_over_delta, dt, 2 * dt, 1, tol_lambda, "anderson", n_max,
                                fluid_options=dict(first_step=(TIGHT, 3000)))
     set_linear_solves(os.path.join(run_dir, "fluid"), setting, tight=1e-10 if tight else None)
     wall = case.run(run_dir)
@@ -152,9 +150,11 @@ def accuracy(args) -> List[Dict]:
 
 def cost_run(workdir: str, setting: Setting, repeat: int, steps: int) -> Dict:
     dt = 0.04
-    written = couette.main(["--table8", "0.37", "--dt", str(dt), "--tol-lambda", "0.01", "--strain", str(steps * dt),
-                            "--workdir", os.path.join(workdir, "cost", "r%d_%s" % (
-                                repeat, re.sub(r"[^A-Za-z0-9.]+", "_", setting.label))), "--overwrite"])
+    # couette.py --table8 0.37 --dt 0.04 --tol-lambda 0.01 --strain STEPS*dt --overwrite: the row's box and count
+    _, _, size, n_particles, _ = couettescene.TABLE8[0.37]
+    written = couettescene.write_run(os.path.join(workdir, "cost", "r%d_%s" % (
+        repeat, re.sub(r"[^A-Za-z0-9.]+", "_", setting.label))), list(size), dt, steps * dt, phi=0.37,
+        n_particles=n_particles, tol_lambda=0.01, table8=True, overwrite=True)
     run_dir = written["run_dir"]
     set_linear_solves(os.path.join(run_dir, "fluid"), setting)
     t0 = time.time()

@@ -26,11 +26,9 @@ import tempfile
 
 import numpy as np
 
+from fdmsubgrid import case, couettescene, output, packing
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-sys.path.insert(0, os.path.join(HERE, "..", "cases", "couette"))
-from fdmsubgrid import case, output, packing  # noqa: E402
-import couette  # noqa: E402
 
 TIGHT = 1e-7
 # (label, acceleration, meanFlowDamping, tolLambda, nMax); the reference's linear solves to 1e-10 as
@@ -59,9 +57,9 @@ def run_scene(workdir: str, label: str, acceleration: str, damping: float, tol_l
     run_dir = os.path.join(workdir, "seed%d" % seed, label.replace(", ", "_").replace(" ", ""))
     shutil.rmtree(run_dir, ignore_errors=True)
     size, a_over_delta, dt = (10.0, 12.0, 8.0), 3.0, 0.04
-    pack = packing.channel_packing(size, phi=phi, seed=seed, min_gap=2 * couette.ROUGHNESS,
-                                   wall_gap=2 * couette.ROUGHNESS)
-    springs = couette.choose_springs(pack.phi, dt, couette.A1 / a_over_delta)
+    pack = packing.channel_packing(size, phi=phi, seed=seed, min_gap=2 * couettescene.ROUGHNESS,
+                                   wall_gap=2 * couettescene.ROUGHNESS)
+    springs = couettescene.choose_springs(pack.phi, dt, couettescene.A1 / a_over_delta)
     if not friction:
         springs = dataclasses.replace(springs, mu_s=0.0)
     # the first step (from rest) converged tightly in every run, the second with the run's criterion
@@ -71,7 +69,7 @@ def run_scene(workdir: str, label: str, acceleration: str, damping: float, tol_l
         rel_tol = (0.0, 0.0, 0.0)
     if rel_tol is not None:
         fluid.update(zip(("u_rel_tol", "p_rel_tol", "p_final_rel_tol"), rel_tol))
-    scene = couette.write_case(run_dir, pack, springs, a_over_delta, dt, 2 * dt, 1, tol_lambda, acceleration,
+    scene = couettescene.write_case(run_dir, pack, springs, a_over_delta, dt, 2 * dt, 1, tol_lambda, acceleration,
                                n_max, fluid_options=fluid)
     try:
         wall = case.run(run_dir)

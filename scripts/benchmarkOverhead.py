@@ -48,10 +48,10 @@ import time
 
 import numpy as np
 
+from fdmsubgrid import case, output, packing
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-from fdmsubgrid import case, output, packing  # noqa: E402
 
 A1, NU, U_WALL = 1.0, 1.0, 1.0
 # frictional contact as in the suspension cases (kn, kt, mu_s, h_r), docs/contact.md

@@ -23,14 +23,12 @@ import os
 import shutil
 import statistics
 import subprocess
-import sys
 import time
+
+from fdmsubgrid import case, decomposition, output
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-
-from fdmsubgrid import case, decomposition, output  # noqa: E402
 
 DELTA = 0.2
 RADIUS = 1.0   # a/Delta = 5, the paper's resolution

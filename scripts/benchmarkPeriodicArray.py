@@ -11,12 +11,11 @@ import argparse
 import concurrent.futures
 import json
 import os
-import sys
+
+from fdmsubgrid import periodicarray as periodic_array
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-from fdmsubgrid import periodicarray as periodic_array  # noqa: E402
 
 
 def main():

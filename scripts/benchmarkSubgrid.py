@@ -55,10 +55,10 @@ import time
 
 import numpy as np
 
+from fdmsubgrid import case, demonly, output, packing
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(HERE)
-sys.path.insert(0, HERE)
-from fdmsubgrid import case, demonly, output, packing  # noqa: E402
 
 SOLVERS = [("cg", 1e-10), ("cg", 1e-6), ("ldlt", None)]
 ASSEMBLY = ("cg", 0.9)            # warm-started CG stops at once: what remains is the assembly

@@ -10,15 +10,20 @@ import pytest
 
 TESTS = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(TESTS)
+# the package of this checkout, whichever one is installed
 sys.path.insert(0, os.path.join(PROJECT, "scripts"))
 
 FULL = os.environ.get("FDM_FULL") == "1"
 
 
 def load_case_module(name, script=None):
-    """cases/<name>/<script>.py (default <name>.py) as a module."""
+    """cases/<name>/<script>.py (default <name>.py) as a module. Its folder goes on the import path, as
+    when the script runs (Python puts a script's folder first): the scripts of one case import each other."""
     script = script or name
-    path = os.path.join(PROJECT, "cases", name, script + ".py")
+    folder = os.path.join(PROJECT, "cases", name)
+    if folder not in sys.path:
+        sys.path.insert(0, folder)
+    path = os.path.join(folder, script + ".py")
     spec = importlib.util.spec_from_file_location(script, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

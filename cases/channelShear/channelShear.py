@@ -49,15 +49,14 @@ import argparse
 import math
 import os
 import shutil
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 
+from fdmsubgrid import case, channelscenes, files, output, theory
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, files, output, theory  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0
@@ -140,18 +139,11 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
     nx = wall_cells(size[0], a, a_over_delta)
     nz = wall_cells(size[1], a, a_over_delta)
     Lx, H, Lz = nx * delta, ny * delta, nz * delta
-    U = SHEAR_RATE * H / 2                                   # gamma_dot = 2U/H
     name = "a%g_H%gcells_L%gx%g_ad%g_%s" % (a, ny, nx, nz, a_over_delta, "subgrid" if subgrid else "nosubgrid")
     run_dir = os.path.join(workdir, name)
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
-    box = case.Box((0, 0, 0), (Lx, H, Lz), delta, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
-    fluid = os.path.join(run_dir, "fluid")
-    case.write_fluid_case(fluid, box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
-                          first_step=(tol_lambda, 3000), n_particles=1, tol_u=1e-8, tol_p=1e-7)
-    # the first step starts from the undisturbed flow u = gamma_dot (y - H/2) e_x
-    case.write_initial_velocity(fluid, box, lambda c: np.column_stack(
-        [SHEAR_RATE * (c[:, 1] - H / 2), np.zeros(len(c)), np.zeros(len(c))]))
+    channel = channelscenes.ShearedChannel(Lx, H, Lz, delta, SHEAR_RATE)
     # offsets from the vertex nearest the box centre in x and z; y on the mid-plane (a vertex plane
     # when ny is even, a cell-centre plane when odd)
     x0, z0 = (nx // 2) * delta, (nz // 2) * delta
@@ -161,13 +153,10 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
 
     runs = [case.RECORD_EVERY_STEP]
     runs += case.held_step_runs([[centre(o)] for o in offsets])
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [centre(offsets[0]) + (a,)], dt=0.01,
-                         fix_options="move no stresslets yes", runs=runs,
-                         # both no-slip walls at the fluid case's velocities (the pair style checks they agree
-                         # with 0/U; docs/dem.md)
-                         pair_style=case.subgrid_pair_style((("ylo", (-U, 0, 0)), ("yhi", (U, 0, 0))), subgrid,
-                                                            model=model),
-                         name="in.channelShear")
+    # both no-slip walls at the fluid case's velocities (the pair style checks they agree with 0/U; docs/dem.md)
+    channelscenes.write_sheared_channel(run_dir, channel, [centre(offsets[0]) + (a,)], runs, "in.channelShear",
+                                        tol_lambda, ETA, case.subgrid_pair_style(channel.walls, subgrid, model=model))
+    fluid = os.path.join(run_dir, "fluid")
     wall = case.run(run_dir, np_fluid=np_fluid)
     rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"))
     steps = output.steps(fluid)
@@ -176,7 +165,7 @@ def run_gap(workdir: str, radius: float, H_over_a: float, size: Sequence[float],
     # stresslets (T, N, 6) in the order xx xy xz yy yz zz (docs/profiles.md): column 1 is S_xy
     s_fluid = np.array(rec["S_fluid"][:, 0, 1], dtype=float)
     s_subgrid = np.array(rec["S_subgrid"][:, 0, 1], dtype=float)
-    stokes_s = 10.0 / 3.0 * math.pi * ETA * a ** 3 * SHEAR_RATE       # S_xy of a free sphere in unbounded shear
+    stokes_s = channelscenes.unbounded_shear_stresslet(a, ETA, SHEAR_RATE)
     omega = np.array(rec["omega"][:, 0], dtype=float)
     velocity = np.array(rec["U"][:, 0], dtype=float)
     if not keep:

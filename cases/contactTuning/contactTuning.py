@@ -35,17 +35,16 @@ import math
 import os
 import re
 import shutil
-import sys
 import threading
 import time
 
 import numpy as np
 
+from fdmsubgrid import theory
+from fdmsubgrid.demonly import fdmdem, run_in
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(PROJECT, "scripts"))
-from fdmsubgrid import theory  # noqa: E402
-from fdmsubgrid.demonly import fdmdem, run_in  # noqa: E402
 
 PI = math.pi
 # the scene: every length in units of a = 1 m, eta = 1 Pa s (the velocity scale F/(6 pi eta a))

@@ -22,9 +22,9 @@ import sys
 
 import numpy as np
 
+from fdmsubgrid import demonly, packing
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import demonly, packing  # noqa: E402
 
 KN_RULE_047 = 3.128e5     # the case's k_n at phi 0.47 (couette.py's recipe, printed by the coupled runs)
 KT_SOFT_047 = 485.1       # the case's former rule k_t = 0.5 zeta_t/dt at dt = 0.02 (before docs/contact.md 2c)

@@ -37,13 +37,11 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
+from fdmsubgrid import case, contacts, demonly, files, output, profiles, rheology, suspension
+import couette
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(PROJECT, "scripts"))
-sys.path.insert(0, HERE)
-
-from fdmsubgrid import case, contacts, demonly, files, output, profiles, rheology, suspension  # noqa: E402
-import couette  # noqa: E402
 
 DEFAULT_VARIANTS = ["0.005:1", "0.02:1", "0.01:1", "0.01:2", "0.005:4", "0.01:4", "0.02:2", "0.0025:8"]
 

@@ -23,14 +23,10 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
+from fdmsubgrid import couettescene, files, output
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(PROJECT, "scripts"))
-
-from fdmsubgrid import files, output  # noqa: E402
-
-sys.path.insert(0, HERE)
-import couette  # noqa: E402
 
 
 def last_error(run_dir: str) -> Optional[str]:
@@ -72,7 +68,7 @@ def run_one(phi: float, dt: float, stiffness: float, args: argparse.Namespace) -
            "--workdir", workdir, "--out", os.path.join(args.workdir, name + ".results.json"), "--overwrite"]
     if stiffness != 1:
         # the recipe's springs (at the nominal phi) times the factor
-        rule = couette.choose_springs(phi, dt, couette.A1 / 3.0)
+        rule = couettescene.choose_springs(phi, dt, couettescene.A1 / 3.0)
         cmd += ["--kn", repr(rule.kn * stiffness), "--kt", repr(rule.kt * stiffness)]
     print("running:", " ".join(cmd), flush=True)
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")

@@ -5,7 +5,7 @@ run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq
   table8.py                                 phi_bulk 0.27, 0.37, 0.47 (25 strain units, tolLambda 1e-2,
                                             each row's particles at the largest time step measured good
                                             there: 0.04, 0.02, 0.01, and the fluid every 0.04 up to 0.42,
-                                            0.02 beyond: couette.fluid_every, 1, 2 and 2 particle steps
+                                            0.02 beyond: couettescene.fluid_every, 1, 2 and 2 particle steps
                                             per fluid step)
   table8.py --paper --jobs 2                all seven rows of the paper's Fig. 21 (= --phis 0.27 0.32 0.37
                                             0.42 0.47 0.52 0.54), two at a time
@@ -36,7 +36,7 @@ time; a row whose run stops is named at the end, after the other rows have run a
 written. Killing this script (or the session ending) loses at most one checkpoint interval.
 
 --rows-from JSON... adds the rows of earlier summaries (their run folders elsewhere or gone) for the
-phi_bulk not run here; a row whose particle step exceeds couette.largest_good_dt at its phi_bulk (one run
+phi_bulk not run here; a row whose particle step exceeds couettescene.largest_good_dt at its phi_bulk (one run
 before that limit was measured) is listed and plotted, not fitted.
 
 Writes --out (default docs/data/table8.json): per phi_bulk the paper's row, this project's phi_core,
@@ -61,19 +61,15 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from typing import Dict, Iterator, List, Optional, Tuple
 
+from fdmsubgrid import checkpoint, couettescene, demonly, files, output, rheology  # couettescene: a row's time step
+from fdmsubgrid.shear import steps_planned
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(PROJECT, "scripts"))
-
-from fdmsubgrid import checkpoint, demonly, files, output, rheology  # noqa: E402
-from fdmsubgrid.shear import steps_planned  # noqa: E402
-
-sys.path.insert(0, HERE)
-import couette  # noqa: E402  (the scene's own rules: the time step of a row)
 
 PAPER_FIT = dict(zip(("alpha", "phi_m"), rheology.PAPER_MARON_PIERCE))   # paper section 6.1, Eq. (55)
-# The time step of a row unless --dt says one: couette.largest_good_dt(phi_bulk), the largest measured good
-# (0.04 at 0.27, 0.02 from 0.32 to 0.42, 0.01 at 0.47, smaller beyond; couette.py's MEASURED_DT_LIMITS,
+# The time step of a row unless --dt says one: couettescene.largest_good_dt(phi_bulk), the largest measured good
+# (0.04 at 0.27, 0.02 from 0.32 to 0.42, 0.01 at 0.47, smaller beyond; couettescene.MEASURED_DT_LIMITS,
 # docs/benchmarks.md "What limits the time step"). Until 2026-11-27 0.04 below phi_bulk 0.30 (0.45, then
 # 0.40 before that) and 0.02 above it: the rows 0.32 and 0.37 of docs/validation.md ran at 0.04, 0.47 at 0.02.
 DEFAULT_PHIS = [0.27, 0.37, 0.47]          # a curve with three points, the fit's least
@@ -81,19 +77,19 @@ MIN_STRAIN_TO_REPORT = 2.0                  # below this a run is listed as star
 
 
 def row_dt(phi: float, args: argparse.Namespace) -> float:
-    """The (particle) time step of the row phi_bulk: --dt if given, else couette.largest_good_dt(phi)."""
+    """The (particle) time step of the row phi_bulk: --dt if given, else couettescene.largest_good_dt(phi)."""
     if args.dt is not None:
         return args.dt
-    return couette.largest_good_dt(phi)
+    return couettescene.largest_good_dt(phi)
 
 
 def row_fluid_every(phi: float, args: argparse.Namespace) -> int:
     """Particle steps per fluid step of the row phi_bulk: --fluid-every if given, else
-    couette.fluid_every(phi, dt) (the fluid every couette.fluid_dt(phi) or so; 1 where the particle step is
+    couettescene.fluid_every(phi, dt) (the fluid every couettescene.fluid_dt(phi) or so; 1 where the particle step is
     that large already)."""
     if getattr(args, "fluid_every", None) is not None:
         return args.fluid_every
-    return couette.fluid_every(phi, row_dt(phi, args))
+    return couettescene.fluid_every(phi, row_dt(phi, args))
 
 
 def default_jobs(np_fluid: int) -> int:
@@ -323,10 +319,10 @@ def step_too_large(row: Dict) -> bool:
 
 
 def beyond_good_step(row: Dict) -> bool:
-    """The row's (particle) time step exceeds couette.largest_good_dt at its phi_bulk (a row run before that
+    """The row's (particle) time step exceeds couettescene.largest_good_dt at its phi_bulk (a row run before that
     limit was measured, e.g. phi_bulk 0.32 or 0.37 at 0.04: 7 and 12-15 % low, docs/benchmarks.md)."""
     dt = row.get("dt")
-    return dt is not None and dt > couette.largest_good_dt(row["phi_bulk_table8"]) * (1 + 1e-9)
+    return dt is not None and dt > couettescene.largest_good_dt(row["phi_bulk_table8"]) * (1 + 1e-9)
 
 
 def fitted_rows(rows: List[Dict]) -> List[Dict]:
@@ -461,15 +457,15 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                    help="Table 8 rows (phi_bulk; default %s)" % " ".join("%g" % phi for phi in DEFAULT_PHIS))
     p.add_argument("--paper", action="store_true",
                    help="all seven rows of the paper's Table 8 and Fig. 21 (phi_bulk %s), instead of --phis"
-                        % " ".join("%g" % phi for phi in sorted(couette.TABLE8)))
+                        % " ".join("%g" % phi for phi in sorted(couettescene.TABLE8)))
     p.add_argument("--strain", type=float, default=25.0, help="strain units per run (transient + averaging)")
     p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 of every row "
-                   "(default: the largest measured good at its phi_bulk, couette.largest_good_dt: %s)"
-                   % ", ".join("%g at %g" % (couette.largest_good_dt(phi), phi) for phi in sorted(couette.TABLE8)))
+                   "(default: the largest measured good at its phi_bulk, couettescene.largest_good_dt: %s)"
+                   % ", ".join("%g at %g" % (couettescene.largest_good_dt(phi), phi) for phi in sorted(couettescene.TABLE8)))
     p.add_argument("--fluid-every", type=int, default=None, metavar="K",
-                   help="particle steps per fluid step of every row (default couette.fluid_every: the fluid every "
-                   "couette.fluid_dt(phi), %s)" % ", ".join(
-                       "%d at %g" % (couette.fluid_every(phi), phi) for phi in sorted(couette.TABLE8)))
+                   help="particle steps per fluid step of every row (default couettescene.fluid_every: the fluid every "
+                   "couettescene.fluid_dt(phi), %s)" % ", ".join(
+                       "%d at %g" % (couettescene.fluid_every(phi), phi) for phi in sorted(couettescene.TABLE8)))
     p.add_argument("--a-over-delta", type=float, default=3.0)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",
@@ -503,7 +499,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     args = p.parse_args(argv)
     if args.paper and args.phis:
         p.error("--paper runs all seven rows: give it or --phis, not both")
-    args.phis = sorted(couette.TABLE8) if args.paper else (args.phis or DEFAULT_PHIS)
+    args.phis = sorted(couettescene.TABLE8) if args.paper else (args.phis or DEFAULT_PHIS)
     args.jobs = args.jobs or default_jobs(args.np_fluid)   # the pool's size and the budget's
     os.makedirs(args.workdir, exist_ok=True)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)   # the figures are written first

@@ -33,13 +33,11 @@ import time
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, demonly, output, profiles, timeseries  # noqa: E402
-from fdmsubgrid.environment import program, run_environment  # noqa: E402
+from fdmsubgrid import case, demonly, output, profiles, timeseries
+from fdmsubgrid.environment import program, run_environment
+import couette  # --phi: the scene is couette.py's, written and not run
 
-sys.path.insert(0, HERE)
-import couette  # noqa: E402  (--phi: the scene is couette.py's, written and not run)
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 ETA, SHEAR_RATE = 1.0, 1.0   # the Couette scenes' units (couette.py)
 

@@ -69,15 +69,15 @@ import argparse
 import math
 import os
 import shutil
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 
+from fdmsubgrid import case, channelscenes, files
+from fdmsubgrid import convergence as convergence_study
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, files  # noqa: E402
 
 ETA = 1.0                         # Pa s
 U_C = 1.0                         # m/s, centre-line velocity of Eq. (47)
@@ -122,46 +122,13 @@ def rho_of_xi(xi: float, d2_over_a: float = D2_OVER_A, H_over_a: float = H_OVER_
     return math.sqrt(r2) / H_over_a
 
 
-class Scene:
-    """The channel H = 4a on its mesh: Delta the nearest to a/a_over_delta that makes H whole cells,
-    L_x, L_z (size, in units of a) rounded to whole cells."""
+class Scene(channelscenes.PoiseuilleChannel):
+    """The channel H = 4a on its mesh (channelscenes.PoiseuilleChannel): Delta the nearest to a/a_over_delta
+    that makes H whole cells, L_x, L_z (size, in units of a) rounded to whole cells."""
 
     def __init__(self, a_over_delta: float, size: Sequence[float], d2_over_a: float = D2_OVER_A) -> None:
-        self.H = H_OVER_A * A
+        super().__init__(A, H_OVER_A * A, a_over_delta, size, eta=ETA, centre_velocity=U_C, a1=A)
         self.d2_over_a = float(d2_over_a)
-        self.ny = max(1, int(round(self.H * a_over_delta / A)))
-        self.delta = self.H / self.ny
-        self.nx = max(1, int(round(size[0] * A / self.delta)))
-        self.nz = max(1, int(round(size[1] * A / self.delta)))
-        self.Lx, self.Lz = self.nx * self.delta, self.nz * self.delta
-        self.box = case.Box((0, 0, 0), (self.Lx, self.H, self.Lz), self.delta,
-                            faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
-
-    @property
-    def a_over_delta(self) -> float:
-        return A / self.delta
-
-    @property
-    def size_over_a(self) -> list[float]:
-        return [self.Lx / A, self.H / A, self.Lz / A]
-
-    @property
-    def cells(self) -> int:
-        return self.nx * self.ny * self.nz
-
-    @property
-    def grad_p0(self) -> float:
-        """dP0/dx of Eq. (48)."""
-        return -8.0 * ETA * U_C / self.H ** 2
-
-    @property
-    def discrete_offset(self) -> float:
-        """(Delta/H)^2: the solver's undisturbed flow is Eq. (47) plus U_c times this (module docstring)."""
-        return (self.delta / self.H) ** 2
-
-    def discrete_profile(self, y: np.ndarray) -> np.ndarray:
-        """fdmFoam's steady undisturbed u_x at heights y: the parabola plus U_c (Delta/H)^2."""
-        return U_C * (1.0 - (2.0 * (y - self.H / 2) / self.H) ** 2 + self.discrete_offset)
 
     def pair(self, rho_over_H: float, offset: Sequence[float], mirror: bool = False) -> np.ndarray:
         """Centres (2, 3) of spheres 1 and 2: sphere 2 at x1 + rho12 (downstream), sphere 1 at the vertex
@@ -209,17 +176,9 @@ def check_scene(scene: Scene, rho_list: Sequence[float]) -> None:
 
 def cell_offsets(n_positions: int) -> tuple[list[tuple[float, float]], int]:
     """Offsets (o_x, o_z) in cells standing for n_positions positions of the pair in a cell (module
-    docstring): m^2 (m even) lattice points, the half with o_z < 1/2 computed; otherwise Halton points in
-    [0, 1) x [0, 1/2); 1: (0.25, 0.25). Returns (offsets to compute, positions they stand for)."""
-    if n_positions < 1:
-        raise ValueError("pairPoiseuille: --positions must be at least 1, got %d" % n_positions)
-    if n_positions == 1:
-        return [(0.25, 0.25)], 1
-    m = int(round(math.sqrt(n_positions)))
-    if m * m == n_positions and m % 2 == 0:
-        g = [(i + 0.5) / m for i in range(m)]
-        return [(x, z) for z in g[: m // 2] for x in g], n_positions
-    return [(float(x), 0.5 * float(z)) for x, z in case.halton_points(n_positions, 2)], n_positions
+    docstring: [0, 1) x [0, 1/2), the z mirror only; case.symmetric_cell_offsets). Returns (offsets to
+    compute, positions they stand for)."""
+    return case.symmetric_cell_offsets(n_positions, "pairPoiseuille", mirror_x=False, x_fastest=True)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -237,21 +196,10 @@ def run_configurations(run_dir: str, scene: Scene, configurations: Sequence[np.n
     """One coupled run: each configuration (n, 3) in turn, one step each, all spheres held (move no), the
     fluid started from the solver's undisturbed profile. Returns the per-step velocities (steps, n, 3),
     angular velocities, sub-grid forces, inner iterations, convergence flags and the wall time."""
-    n = len(configurations[0])
-    fluid = os.path.join(run_dir, "fluid")
-    case.write_fluid_case(fluid, scene.box, nu=ETA, rho=1.0, grad_p0=(scene.grad_p0, 0.0, 0.0),
-                          tol_lambda=options.tol_lambda, n_max=options.n_max,
-                          first_step=(options.tol_lambda / 10, 4 * options.n_max), n_particles=n,
-                          acceleration=options.acceleration)
-    case.write_initial_velocity(fluid, scene.box, lambda c: np.column_stack(
-        [scene.discrete_profile(c[:, 1]), np.zeros(len(c)), np.zeros(len(c))]))
-    runs = case.held_step_runs(configurations)
-    spheres = [tuple(map(float, p)) + (A,) for p in configurations[0]]
-    case.write_dem_input(os.path.join(run_dir, "dem"), scene.box, spheres, dt=1.0, fix_options="move no",
-                         pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid,
-                                                            options.model, options.cutoff, options.wall_cutoff),
-                         before_run=case.RECORD_EVERY_STEP,
-                         runs=runs, name="in.pairPoiseuille")
+    channelscenes.write_poiseuille_channel(
+        run_dir, scene, configurations, [A] * len(configurations[0]), "in.pairPoiseuille",
+        case.subgrid_pair_style(scene.walls, subgrid, options.model, options.cutoff, options.wall_cutoff),
+        options.tol_lambda, options.n_max, options.acceleration)
     wall = case.run(run_dir, np_fluid=options.np_fluid)
     m = len(configurations)
     rec, steps = case.read_held_steps(run_dir, m, "pairPoiseuille")
@@ -471,9 +419,7 @@ def plot(scenes: Sequence[dict], path: str) -> None:
 def convergence(options, offsets, represented: int) -> tuple[list[dict], list[dict]]:
     """a/Delta 3 -> 4 (first box) and box CONVERGENCE_BOXES[0] -> [1] (a/Delta 3) at options.rho, with the
     correction (options.subgrid). Returns (scenes, the changes from the base per rho and quantity)."""
-    combos = [("base", CONVERGENCE_A_OVER_DELTA[0], CONVERGENCE_BOXES[0]),
-              ("mesh", CONVERGENCE_A_OVER_DELTA[1], CONVERGENCE_BOXES[0]),
-              ("box", CONVERGENCE_A_OVER_DELTA[0], CONVERGENCE_BOXES[1])]
+    combos = convergence_study.variants(CONVERGENCE_A_OVER_DELTA, CONVERGENCE_BOXES)
     scenes = []
     for study, ad, box in combos:
         opts = argparse.Namespace(**vars(options))
@@ -489,10 +435,9 @@ def convergence(options, offsets, represented: int) -> tuple[list[dict], list[di
     base = scenes[0]
     for other in scenes[1:]:
         for rb, ro in zip(base["rows"], other["rows"]):
-            e = dict(change=other["study"], rho_over_H=rb["rho_over_H"], from_a_over_delta=base["a_over_delta"],
-                     to_a_over_delta=other["a_over_delta"], from_box=base["box"], to_box=other["box"])
-            for q in ("Ux1", "Ux_shifted1", "Uy1", "Wz1", "Ux2", "Ux_shifted2", "Uy2", "Wz2", "Un"):
-                e[q + "_from"], e[q + "_to"], e[q + "_change"] = rb[q], ro[q], ro[q] - rb[q]
+            e = convergence_study.change_entry(dict(change=other["study"], rho_over_H=rb["rho_over_H"]), base, other,
+                                               rb, ro, ("Ux1", "Ux_shifted1", "Uy1", "Wz1", "Ux2", "Ux_shifted2", "Uy2",
+                                                        "Wz2", "Un"))
             for s in SPHERES:
                 if base["single"] and other["single"]:
                     e["single_Ux%d_change" % s] = other["single"]["Ux%d" % s] - base["single"]["Ux%d" % s]

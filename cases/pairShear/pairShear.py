@@ -25,14 +25,13 @@ import json
 import math
 import os
 import shutil
-import sys
 import time
 
 import numpy as np
 
+from fdmsubgrid import case, files, output, suspension
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, files, output, suspension  # noqa: E402
 
 
 # The paper's contact case (section 5.3, Figs. 14-15): a2/a1 = 1.4, r^0 = (-3.48, 0.93) a1

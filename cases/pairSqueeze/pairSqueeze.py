@@ -16,14 +16,13 @@ Writes results.json and results_pairSqueeze.png here (docs/cases.md).
 """
 import argparse
 import os
-import sys
 import time
 
+from fdmsubgrid import case, files, theory
+from fdmsubgrid import squeeze
+from fdmsubgrid.squeeze import box_extrapolated, run_pair
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, files, theory  # noqa: E402
-from fdmsubgrid import squeeze  # noqa: E402
-from fdmsubgrid.squeeze import box_extrapolated, run_pair  # noqa: E402
 
 XI_DEFAULT = [1.0, 0.3, 0.1, 0.03, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4]
 

@@ -21,11 +21,11 @@ import os
 import sys
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case  # noqa: E402
+from fdmsubgrid import case
 # the computation lives in the package (tests and scripts/benchmarkPeriodicArray.py use it too)
-from fdmsubgrid.periodicarray import hasimoto_K, positions_in_cell, run_configuration  # noqa: E402,F401
+from fdmsubgrid.periodicarray import hasimoto_K, positions_in_cell, run_configuration  # noqa: F401
+
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def plot(results, path):

@@ -24,13 +24,12 @@ L_y = 40 a1 (docs/validation.md, "Pressure-driven flow").
 import argparse
 import os
 import shutil
-import sys
 
 import numpy as np
 
+from fdmsubgrid import case, packing, poiseuille, sbm, suspension
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, packing, poiseuille, sbm, suspension  # noqa: E402
 
 PAPER_SIZE = (40.0, 40.0, 20.0)       # (L_x, L_y, L_z)/a1, section 6.2
 PAPER_DT = 1e-3                       # L_y/(2 U_c)

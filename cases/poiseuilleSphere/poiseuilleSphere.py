@@ -74,15 +74,15 @@ import csv
 import math
 import os
 import shutil
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 
+from fdmsubgrid import case, channelscenes, files
+from fdmsubgrid import convergence as convergence_study
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, files  # noqa: E402
 
 ETA = 1.0                         # Pa s
 U_C = 1.0                         # m/s, centre-line velocity of the undisturbed flow (Eq. 47)
@@ -226,50 +226,20 @@ def d_values(two_a_over_H: float, words: Sequence[str]) -> tuple[list[float], li
     return sorted(kept, reverse=True), skipped
 
 
-class Scene:
-    """The channel of one (radius a, 2a/H) on its mesh: H = 2a/(2a/H), Delta the nearest to
-    a1/a1_over_delta giving H a whole number of cells, L_x and L_z (size, in units of a) rounded to
-    whole cells; the sphere's centre at the mesh vertex nearest to (L_x/2, L_z/2) plus the offset."""
+class Scene(channelscenes.PoiseuilleChannel):
+    """The channel of one (radius a, 2a/H) on its mesh (channelscenes.PoiseuilleChannel): H = 2a/(2a/H), Delta
+    the nearest to a1/a1_over_delta giving H a whole number of cells, L_x and L_z (size, in units of a)
+    rounded to whole cells; the sphere's centre at the mesh vertex nearest to (L_x/2, L_z/2) plus the offset."""
 
     def __init__(self, radius: float, two_a_over_H: float, a1_over_delta: float, size: Sequence[float]) -> None:
-        self.radius, self.two_a_over_H = float(radius), float(two_a_over_H)
-        self.H = 2.0 * self.radius / self.two_a_over_H
-        self.ny = max(1, int(round(self.H * a1_over_delta / A1)))
-        self.delta = self.H / self.ny
-        self.nx = max(1, int(round(size[0] * self.radius / self.delta)))
-        self.nz = max(1, int(round(size[1] * self.radius / self.delta)))
-        self.Lx, self.Lz = self.nx * self.delta, self.nz * self.delta
-        self.box = case.Box((0, 0, 0), (self.Lx, self.H, self.Lz), self.delta,
-                            faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
-
-    @property
-    def a_over_delta(self) -> float:
-        return self.radius / self.delta
-
-    @property
-    def size_over_a(self) -> list[float]:
-        return [self.Lx / self.radius, self.H / self.radius, self.Lz / self.radius]
-
-    @property
-    def cells(self) -> int:
-        return self.nx * self.ny * self.nz
-
-    @property
-    def grad_p0(self) -> float:
-        """dP0/dx of Eq. (48)."""
-        return -8.0 * ETA * U_C / self.H ** 2
+        self.two_a_over_H = float(two_a_over_H)
+        super().__init__(radius, 2.0 * float(radius) / self.two_a_over_H, a1_over_delta, size, eta=ETA,
+                         centre_velocity=U_C, a1=A1)
 
     def centre(self, d_over_a: float, offset: Sequence[float]) -> tuple[float, float, float]:
         """The sphere's centre at d = d_over_a a from the lower wall, offset (o_x, o_z) cells from a vertex."""
         return ((self.nx // 2 + offset[0]) * self.delta, d_over_a * self.radius,
                 (self.nz // 2 + offset[1]) * self.delta)
-
-    def discrete_profile(self, y: np.ndarray) -> np.ndarray:
-        """The solver's own undisturbed flow at the cell centres: the finite-volume Laplacian is exact for
-        the parabola inside, and the wall flux (u_1 - 0)/(Delta/2) of the first cell is short of du0/dy
-        by 2 U_c Delta/H^2: the discrete steady profile is the parabola plus the constant U_c (Delta/H)^2
-        (docs/fluid.md's mean-flow correction solves the same stencil)."""
-        return U_C * (1.0 - (2.0 * (y - self.H / 2) / self.H) ** 2 + (self.delta / self.H) ** 2)
 
     def describe(self) -> str:
         return ("a = %g, 2a/H = %g: H = %g a1 (%d cells), a/Delta = %.4g, box %g x %g x %g a (%d cells)"
@@ -312,19 +282,8 @@ def check_scene(scene: Scene, d_list: Sequence[float]) -> None:
 def cell_offsets(n_positions: int) -> tuple[list[tuple[float, float]], int]:
     """Offsets (o_x, o_z) of the centre from a mesh vertex, in cells, standing for n_positions positions
     in the plane section of one cell at fixed d (module docstring, symmetry iii: [0, 1/2)^2 holds every
-    position once). n_positions = m^2 with m even (4, 16: the paper's 4 x 4): the lattice points
-    (i + 1/2)/m in [0, 1/2)^2, (m/2)^2 of them; 1: (1/4, 1/4); otherwise n_positions Halton points
-    (bases 2, 3) in [0, 1/2)^2. Returns (offsets to compute, positions they stand for)."""
-    if n_positions < 1:
-        raise ValueError("poiseuilleSphere: --positions must be at least 1, got %d" % n_positions)
-    if n_positions == 1:
-        return [(0.25, 0.25)], 1
-    m = int(round(math.sqrt(n_positions)))
-    if m * m == n_positions and m % 2 == 0:
-        g = [(i + 0.5) / m for i in range(m // 2)]
-        return [(x, z) for z in g for x in g], n_positions
-
-    return [(0.5 * float(x), 0.5 * float(z)) for x, z in case.halton_points(n_positions, 2)], n_positions
+    position once; case.symmetric_cell_offsets). Returns (offsets to compute, positions they stand for)."""
+    return case.symmetric_cell_offsets(n_positions, "poiseuilleSphere", mirror_x=True, x_fastest=True)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -342,22 +301,11 @@ def run_channel(workdir: str, scene: Scene, d_list: Sequence[float], offsets: Se
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
     configurations = [(d, tuple(o)) for d in d_list for o in offsets]
-    fluid = os.path.join(run_dir, "fluid")
-    case.write_fluid_case(fluid, scene.box, nu=ETA, rho=1.0, grad_p0=(scene.grad_p0, 0.0, 0.0),
-                          tol_lambda=options.tol_lambda, n_max=options.n_max,
-                          first_step=(options.tol_lambda / 10, 4 * options.n_max), n_particles=1,
-                          acceleration=options.acceleration)
     # the far field starts converged: the solver's own undisturbed profile (Scene.discrete_profile)
-    case.write_initial_velocity(fluid, scene.box, lambda c: np.column_stack(
-        [scene.discrete_profile(c[:, 1]), np.zeros(len(c)), np.zeros(len(c))]))
-    runs = case.held_step_runs([[scene.centre(d, o)] for d, o in configurations])
-    first = scene.centre(*configurations[0])
-    case.write_dem_input(os.path.join(run_dir, "dem"), scene.box, [first + (scene.radius,)], dt=1.0,
-                         fix_options="move no stresslets yes",
-                         pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), options.subgrid,
-                                                            options.model, options.cutoff, options.wall_cutoff),
-                         before_run=case.RECORD_EVERY_STEP,
-                         runs=runs, name="in.poiseuilleSphere")
+    channelscenes.write_poiseuille_channel(
+        run_dir, scene, [[scene.centre(d, o)] for d, o in configurations], [scene.radius], "in.poiseuilleSphere",
+        case.subgrid_pair_style(scene.walls, options.subgrid, options.model, options.cutoff, options.wall_cutoff),
+        options.tol_lambda, options.n_max, options.acceleration, fix_options="move no stresslets yes")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
     n = len(configurations)
     rec, steps = case.read_held_steps(run_dir, n, "poiseuilleSphere")
@@ -520,9 +468,7 @@ def convergence(options, offsets, represented: int, staben: list[dict]) -> tuple
     CONVERGENCE_BOXES with both a1/Delta of CONVERGENCE_A_OVER_DELTA, and the first a1/Delta in the
     second box. Returns (rows, the changes from the base (first mesh, first box) per configuration)."""
     rows = []
-    combos = [("base", CONVERGENCE_A_OVER_DELTA[0], CONVERGENCE_BOXES[0]),
-              ("mesh", CONVERGENCE_A_OVER_DELTA[1], CONVERGENCE_BOXES[0]),
-              ("box", CONVERGENCE_A_OVER_DELTA[0], CONVERGENCE_BOXES[1])]
+    combos = convergence_study.variants(CONVERGENCE_A_OVER_DELTA, CONVERGENCE_BOXES)
     for t, words in CONVERGENCE_CONFIGS:
         kept, _ = d_values(t, parse_d_over_a(words))
         for study, ad, box in combos:
@@ -541,12 +487,9 @@ def convergence(options, offsets, represented: int, staben: list[dict]) -> tuple
             if other["study"] == "base" or other["two_a_over_H"] != base["two_a_over_H"] or \
                     abs(other["d_over_a"] - base["d_over_a"]) > 1e-9:
                 continue
-            entry = dict(two_a_over_H=base["two_a_over_H"], d_over_a=base["d_over_a"], change=other["study"],
-                         from_a_over_delta=base["a_over_delta"], to_a_over_delta=other["a_over_delta"],
-                         from_box=base["box"], to_box=other["box"])
-            for q in ("Ux_norm", "Ux_norm_shifted", "Wz_norm", "S_star"):
-                entry[q + "_from"], entry[q + "_to"] = base[q], other[q]
-                entry[q + "_change"] = other[q] - base[q]
+            entry = convergence_study.change_entry(
+                dict(two_a_over_H=base["two_a_over_H"], d_over_a=base["d_over_a"], change=other["study"]),
+                base, other, base, other, ("Ux_norm", "Ux_norm_shifted", "Wz_norm", "S_star"))
             changes.append(entry)
             print("  2a/H %g, d/a %.4g, %s (a/Delta %.3g -> %.3g, box %g x %g -> %g x %g a): Ux/Uc %+.4f (less the "
                   "offset %+.4f), Omega_z a/Uc %+.4f, S* %+.4f" % (

@@ -25,16 +25,14 @@ Writes results.json here (docs/cases.md).
 """
 import argparse
 import json
-import math
 import os
 import shutil
-import sys
 
 import numpy as np
 
+from fdmsubgrid import case, channelscenes, output, profiles, rheology
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-from fdmsubgrid import case, output, profiles, rheology  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0
@@ -51,23 +49,17 @@ def run(workdir: str, size=(12.0, 20.0, 12.0), a_over_delta: float = 3.0, offset
             raise ValueError("shearedSphere: %s = %g a is not a whole number of cells of a/%g" % (name, v, a_over_delta))
         if v < 2 * A + 2 * delta:
             raise ValueError("shearedSphere: %s = %g a leaves no room for the sphere (2 a plus two cells)" % (name, v))
-    U = SHEAR_RATE * H / 2
     name = "L%gx%gx%g_ad%g_off%g_%g_%g" % (L, H, Lz, a_over_delta, *offset)
     run_dir = os.path.join(workdir, name)
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
-    box = case.Box((0, 0, 0), (L, H, Lz), delta, faces=("cyclic", ((-U, 0, 0), (U, 0, 0)), "cyclic"))
-    fluid = os.path.join(run_dir, "fluid")
-    case.write_fluid_case(fluid, box, nu=ETA, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
-                          first_step=(tol_lambda, 3000), n_particles=1, tol_u=1e-8, tol_p=1e-7)
-    # start from the undisturbed flow u = gamma_dot (y - H/2) e_x
-    case.write_initial_velocity(fluid, box, lambda c: np.column_stack(
-        [SHEAR_RATE * (c[:, 1] - H / 2), np.zeros(len(c)), np.zeros(len(c))]))
+    channel = channelscenes.ShearedChannel(L, H, Lz, delta, SHEAR_RATE)
+    box = channel.box
     centre = tuple(0.5 * s + o * delta for s, o in zip((L, H, Lz), offset))
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [centre + (A,)], dt=0.01,
-                         fix_options="move no stresslets yes",
-                         runs=[case.RECORD_EVERY_STEP, "run 1"],
-                         name="in.shearedSphere")
+    # no pair style: the sphere far from both walls, no sub-grid correction
+    channelscenes.write_sheared_channel(run_dir, channel, [centre + (A,)], [case.RECORD_EVERY_STEP, "run 1"],
+                                        "in.shearedSphere", tol_lambda, ETA)
+    fluid = os.path.join(run_dir, "fluid")
     wall = case.run(run_dir, np_fluid=np_fluid)
     rec = output.read_particle_records(os.path.join(run_dir, "dem", "particles.records"))
     s_xy = float(rec["S_fluid"][-1, 0, 1] + rec["S_subgrid"][-1, 0, 1])
@@ -81,7 +73,7 @@ def run(workdir: str, size=(12.0, 20.0, 12.0), a_over_delta: float = 3.0, offset
     if not keep:
         case.delete_fields(run_dir)
     return dict(size=[L, H, Lz], a_over_delta=a_over_delta, offset=list(offset), cells=int(np.prod(box.n)),
-                S_xy=s_xy, S_star=s_xy / (10.0 / 3.0 * math.pi * ETA * A ** 3 * SHEAR_RATE),
+                S_xy=s_xy, S_star=s_xy / channelscenes.unbounded_shear_stresslet(A, ETA, SHEAR_RATE),
                 omega_z_over_minus_half_gamma=float(omega[2] / (-0.5 * SHEAR_RATE)),
                 velocity=[float(v) for v in velocity],
                 wall_stress_lo=float(tau[0]), wall_stress_hi=float(tau[1]),

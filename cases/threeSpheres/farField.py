@@ -50,7 +50,6 @@ from __future__ import annotations
 import functools
 import math
 import os
-import sys
 
 import numpy as np
 
@@ -142,7 +141,6 @@ def reflection_velocities(positions: np.ndarray, forces: np.ndarray, reflections
 def _pair_functions(xi: float) -> dict:
     """The full-range X^A, Y^A, Y^B, X^C, Y^C of two equal spheres at reduced gap xi (dimensional /
     eta, a = 1), from the project's resistance library."""
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
     from fdmsubgrid import theory
     return theory.pair_full_range(1.0, 1.0, xi)
 

@@ -57,18 +57,16 @@ import argparse
 import math
 import os
 import shutil
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 
+from fdmsubgrid import case, files
+import channelImages
+import farField
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-sys.path.insert(0, HERE)
-from fdmsubgrid import case, files  # noqa: E402
-import channelImages  # noqa: E402
-import farField  # noqa: E402
 
 RADIUS = 1.0
 ETA = 1.0

@@ -42,19 +42,17 @@ import argparse
 import json
 import math
 import os
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from fdmsubgrid import case, files, squeeze, wallcalibration
+import freeSphereWall
+import wallShear
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-sys.path.insert(0, HERE)
-from fdmsubgrid import case, files, squeeze, wallcalibration  # noqa: E402
-import freeSphereWall  # noqa: E402
-import wallShear  # noqa: E402
 
 EPS_DEFAULT = [0.54, 0.128, 0.1, 0.045, 0.01, 0.0032, 0.001]
 # the tangential wall calibration the library's table was written from (fdmsubgrid.wallcalibration)

@@ -32,19 +32,17 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 
+from fdmsubgrid import files, squeeze
+import freeSphereWall
+import shearLoad
+import wallShear
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-sys.path.insert(0, HERE)
-from fdmsubgrid import files, squeeze  # noqa: E402
-import freeSphereWall  # noqa: E402
-import shearLoad  # noqa: E402
-import wallShear  # noqa: E402
 
 EPS_DEFAULT = [0.54, 0.1, 0.01, 0.0032, 0.001]
 BOXES_DEFAULT = [12.0, 16.0]

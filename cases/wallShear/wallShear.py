@@ -67,17 +67,15 @@ import argparse
 import math
 import os
 import shutil
-import sys
 import time
 from typing import Sequence
 
 import numpy as np
 
+from fdmsubgrid import case, files, output
+import freeSphereWall
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "scripts"))
-sys.path.insert(0, HERE)
-from fdmsubgrid import case, files, output  # noqa: E402
-import freeSphereWall  # noqa: E402
 
 ETA = 1.0
 SHEAR_RATE = 1.0
@@ -96,18 +94,9 @@ SYMMETRY = ("Uy_norm", "Uz_norm", "Wx_norm", "Wy_norm")
 
 def cell_offsets(n_positions: int) -> tuple[list[tuple[float, float]], int]:
     """(x, z) offsets of the centre in one mesh cell, in cells, standing for n_positions offsets over
-    the cell (module docstring: the quarter [0, 1/2)^2 holds every offset once). Returns (offsets to
-    compute, offsets they stand for)."""
-    if n_positions < 1:
-        raise ValueError("wallShear: --positions must be at least 1, got %d" % n_positions)
-    m = int(round(math.sqrt(n_positions)))
-    if m * m == n_positions and m % 2 == 0:
-        g = [(i + 0.5) / m for i in range(m // 2)]
-        return [(x, z) for x in g for z in g], n_positions
-    if n_positions == 1:
-        return [(0.25, 0.25)], 1
-
-    return [(0.5 * float(x), 0.5 * float(z)) for x, z in case.halton_points(n_positions, 2)], n_positions
+    the cell (module docstring: the quarter [0, 1/2)^2 holds every offset once; the lattice listed x by x).
+    Returns (offsets to compute, offsets they stand for)."""
+    return case.symmetric_cell_offsets(n_positions, "wallShear", mirror_x=True, x_fastest=False)
 
 
 def check_scene(eps_values: Sequence[float], radii: Sequence[float], size: Sequence[float], a_over_delta: float) -> None:

@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 from . import packing as packing_module
-from .case import records_line
+from .deminput import records_line
 from .environment import program, run_environment
 
 THERMO = ("step iterations solveTotal pairBlocks wallBlocks contacts maxSpeed maxSpin").split()

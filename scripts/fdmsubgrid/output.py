@@ -120,7 +120,7 @@ def _header_lines(path: str, count: int) -> list:
 
 
 def _patch_face(patch: str) -> str:
-    """fdmFoam's patch name of a box face (fdmsubgrid.case: xLow, yHigh, ...) as LIGGGHTS's (xlo, yhi)."""
+    """fdmFoam's patch name of a box face (fdmsubgrid.foamcase: xLow, yHigh, ...) as LIGGGHTS's (xlo, yhi)."""
     if len(patch) > 1 and patch[0] in _AXES and patch[1:] in ("Low", "High"):
         return patch[0] + ("lo" if patch[1:] == "Low" else "hi")
     return patch
@@ -130,7 +130,7 @@ def read_wall_loads(run_dir: str, dem_file: str | None = "walls.dat") -> WallLoa
     """The wall loads of a coupled run (run_dir with fluid/ and dem/): fdmFoam's
     fluid/postProcessing/fdm/walls.dat and, unless dem_file is None, the particle side
     dem/<dem_file> of `fix fdm/couple ... walls FILE`; joined on their common steps. The fluid
-    patches are matched to the particle code's faces by name (fdmsubgrid.case names the patch of the
+    patches are matched to the particle code's faces by name (fdmsubgrid.foamcase names the patch of the
     face ylo yLow). A last, incomplete line (a killed run) is dropped with a warning."""
     fluid_path = os.path.join(run_dir, "fluid", "postProcessing", "fdm", "walls.dat")
     if not os.path.isfile(fluid_path):

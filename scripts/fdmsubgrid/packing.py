@@ -79,7 +79,7 @@ class Packing:
         return float(np.sum(4.0 / 3.0 * math.pi * self.radii ** 3) / np.prod(self.box))
 
     def spheres(self):
-        """[(x, y, z, a), ...] as fdmsubgrid.case.write_dem_input takes them."""
+        """[(x, y, z, a), ...] as fdmsubgrid.deminput.write_dem_input takes them."""
         return [(float(x[0]), float(x[1]), float(x[2]), float(a)) for x, a in zip(self.positions, self.radii)]
 
     def gaps(self, cutoff):

@@ -42,7 +42,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import case, files, squeeze, theory
+from . import deminput, files, foamcase, runner, squeeze, theory
 from .squeeze import pair_centres
 from .wallcalibration import seen_gap
 
@@ -97,9 +97,9 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
     squeeze._fresh_run_dir(workdir, os.path.basename(run_dir))
     delta = 1.0 / a_over_delta
     L = L_over_a
-    box = case.Box((0, 0, 0), (L, L, L), delta)
+    box = foamcase.Box((0, 0, 0), (L, L, L), delta)
     centre = [L / 2 + o * delta for o in offset]
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+    foamcase.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
                           n_particles=2)
     runs: List[str] = []
     for k, xi in enumerate(xis):
@@ -110,14 +110,14 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
         runs += _load_lines(separation(ratio, xi))
         runs.append("run             1")
     if stresslets:
-        runs = [case.RECORD_EVERY_STEP] + runs
+        runs = [deminput.RECORD_EVERY_STEP] + runs
     p1, p2 = pair_centres(ratio, xis[0], centre)
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
+    deminput.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (1.0,), p2 + (ratio,)], dt=1.0,
                          fix_options="move no stresslets yes" if stresslets else "move no",
                          pair_style="fdm/subgrid " + ("lubrication no" if model is None else "model " + model),
                          before_run="group           one id 1\ngroup           two id 2", runs=runs,
                          name="in.pairTangential")
-    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    wall, parts, steps = runner.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     out: Dict[str, object] = {}
     for tag, k in ((1, "1"), (2, "2")):
         sel = parts["tag"] == tag
@@ -127,7 +127,7 @@ def run_loaded_pair(workdir: str, ratio: float, xis: Sequence[float], a_over_del
                converged=bool(steps["converged"].all()), gaps=[float(x) for x in xis], tol_lambda=tol_lambda)
     if stresslets:
         n = len(xis)
-        records, _ = case.read_held_steps(run_dir, n, "pairtangential.run_loaded_pair")
+        records, _ = runner.read_held_steps(run_dir, n, "pairtangential.run_loaded_pair")
         total = np.asarray(records["S_fluid"][-n:], dtype=float) + np.asarray(records["S_subgrid"][-n:], dtype=float)
         out.update(S1=total[:, 0].tolist(), S2=total[:, 1].tolist())
     squeeze.keep_result(run_dir, out)

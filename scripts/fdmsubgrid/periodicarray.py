@@ -7,7 +7,7 @@ import math
 import os
 import shutil
 
-from . import case, output
+from . import foamcase, output, runner
 
 
 def hasimoto_K(phi: float) -> float:
@@ -82,11 +82,11 @@ def run_configuration(workdir: str, L_over_a: float, a_over_delta: float, n_posi
     run_dir = os.path.join(workdir, name)
     if os.path.isdir(run_dir):
         shutil.rmtree(run_dir)
-    box = case.Box((0, 0, 0), (L, L, L), delta)
+    box = foamcase.Box((0, 0, 0), (L, L, L), delta)
     # the cell whose lower corner is the node nearest the centre of the box
     corner = [round(L / 2 / delta) * delta] * 3
     pts = list(points) if points else positions_in_cell(n_positions, corner, delta)[0]
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=nu, rho=rho, grad_p0=tuple(gradient),
+    foamcase.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=nu, rho=rho, grad_p0=tuple(gradient),
                           indicator=(b, c), tol_lambda=tol_lambda, n_max=n_max,
                           first_step=(tol_first if tol_first else tol_lambda / 10, n_max * 4),
                           tol_u=tol_u, tol_p=tol_p, n_particles=1, pseudo_time_factor=pseudo_time_factor,
@@ -101,7 +101,7 @@ def run_configuration(workdir: str, L_over_a: float, a_over_delta: float, n_posi
         f.write(DEM_INPUT.format(n=len(pts), L=L, x0=pts[0][0], y0=pts[0][1], z0=pts[0][2], d=2 * a,
                                  skin=0.1 * a, dt=1.0, fext=" ".join(repr(g * V0) for g in gradient), positions="\n".join(lines)))
 
-    wall = case.run(run_dir, np_fluid=np_fluid)
+    wall = runner.run(run_dir, np_fluid=np_fluid)
 
     steps = output.steps(os.path.join(run_dir, "fluid"))
     parts = output.particles(os.path.join(run_dir, "fluid"))

@@ -20,7 +20,7 @@ from typing import Sequence
 
 import numpy as np
 
-from . import case, files
+from . import deminput, files, foamcase, runner
 
 # Where the scene sits inside its first mesh cell (fractions of Delta along x, y, z): off the mesh's
 # symmetry planes, as the squeeze cases have always used.
@@ -113,28 +113,28 @@ def run_pair(workdir: str, ratio: float, xis: Sequence[float], subgrid: bool, a_
     F = 6 * math.pi * eta * a1
     run_dir = _fresh_run_dir(workdir, "lambda%g_ad%g_L%g_%s%s" % (ratio, a_over_delta, L_over_a, _tag(subgrid, offset),
                                                                   "_stresslets" if stresslets else ""))
-    box = case.Box((0, 0, 0), (L, L, L), delta)
+    box = foamcase.Box((0, 0, 0), (L, L, L), delta)
     centre = [L / 2 + o * delta for o in offset]
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+    foamcase.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=eta, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
                           n_particles=2)
-    runs = case.held_step_runs([pair_centres(ratio, xi, centre) for xi in xis])
+    runs = deminput.held_step_runs([pair_centres(ratio, xi, centre) for xi in xis])
     if stresslets:
-        runs = [case.RECORD_EVERY_STEP] + runs
+        runs = [deminput.RECORD_EVERY_STEP] + runs
     p1, p2 = pair_centres(ratio, xis[0], centre)
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0,
+    deminput.write_dem_input(os.path.join(run_dir, "dem"), box, [p1 + (a1,), p2 + (a2,)], dt=1.0,
                          fix_options="move no stresslets yes" if stresslets else "move no",
                          pair_style=_pair_style(subgrid, cutoff, pair_options),
                          before_run="group           one id 1\ngroup           two id 2\n"
                                     "fix             push1 one addforce %r 0 0\n"
                                     "fix             push2 two addforce %r 0 0" % (F, -F),
                          runs=runs, name="in.pairSqueeze")
-    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    wall, parts, steps = runner.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     U1 = parts["Ux"][parts["tag"] == 1]
     U2 = parts["Ux"][parts["tag"] == 2]
     result = _result((U1 - U2) / (F / (6 * math.pi * eta * a1)), wall, box, steps)
     if stresslets:
         n = len(xis)
-        records, _ = case.read_held_steps(run_dir, n, "squeeze.run_pair")
+        records, _ = runner.read_held_steps(run_dir, n, "squeeze.run_pair")
         U = np.array(records["U"][-n:, :, 0], dtype=float)
         fluid = np.array(records["S_fluid"][-n:], dtype=float)
         subgrid_part = np.array(records["S_subgrid"][-n:], dtype=float)
@@ -150,22 +150,22 @@ def run_wall_scene(run_dir: str, epss: Sequence[float], a_over_delta: float, L_o
     (walls at rest at y = 0 and H, periodic x and z), its centre at x, z = L/2 + offset_xz Delta, held at
     each gap eps = h/a - 1 of `epss` for one coupled step (largest first), driven by the LIGGGHTS lines
     `loads` (fix addforce, fix fdm/torque), in run_dir (emptied first). Returns (wall seconds, particles,
-    steps) of case.run_and_read and the box."""
+    steps) of runner.run_and_read and the box."""
     a = 1.0
     delta = a / a_over_delta
     L, H = L_over_a * a, H_over_a * a
     _fresh_run_dir(os.path.dirname(run_dir), os.path.basename(run_dir))
-    box = case.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
+    box = foamcase.Box((0, 0, 0), (L, H, L), delta, faces=("cyclic", ((0, 0, 0), (0, 0, 0)), "cyclic"))
     x, z = L / 2 + offset_xz[0] * delta, L / 2 + offset_xz[1] * delta
 
     def position(eps: float):
         return (x, a * (1 + eps), z)
 
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
+    foamcase.write_fluid_case(os.path.join(run_dir, "fluid"), box, nu=1.0, rho=1.0, tol_lambda=tol_lambda, n_max=3000,
                           n_particles=1)
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair_style,
-                         before_run=loads, runs=case.held_step_runs([[position(eps)] for eps in epss]), name=name)
-    wall, parts, steps = case.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
+    deminput.write_dem_input(os.path.join(run_dir, "dem"), box, [position(epss[0]) + (a,)], dt=1.0, pair_style=pair_style,
+                         before_run=loads, runs=deminput.held_step_runs([[position(eps)] for eps in epss]), name=name)
+    wall, parts, steps = runner.run_and_read(run_dir, np_fluid=np_fluid, keep=keep)
     return wall, parts, steps, box
 
 

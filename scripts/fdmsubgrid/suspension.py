@@ -27,7 +27,7 @@ import math
 import os
 from dataclasses import dataclass
 
-from . import case, output, packing, rheology, theory
+from . import deminput, foamcase, output, packing, rheology, theory
 
 A1 = 1.0
 A2 = packing.A2_OVER_A1 * A1
@@ -102,7 +102,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     fdm/output), and written for ParaView with the fluid fields every write_every steps
     (dem/vtk/particles.pvd, fluid/fluid.foam); text_dump: also the LIGGGHTS text dump
     dem/particles.dump of the same steps (for comparisons). fluid_options: more (or other) arguments
-    of case.write_fluid_case, e.g. first_step or mean_flow_damping. fluid_every: the fluid is solved every
+    of foamcase.write_fluid_case, e.g. first_step or mean_flow_damping. fluid_every: the fluid is solved every
     fluid_every-th particle step (fix fdm/couple ... fluid_every K, docs/dem.md "Particle steps between
     fluid steps"); dump_every and write_every (unless beyond the run's steps) must then be multiples of it,
     so that every snapshot is of a step the fluid solved. held_drag: how the steps between fluid steps hold
@@ -119,12 +119,12 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     delta = A1 / a_over_delta
     Lx, Ly, Lz = (float(v) for v in pack.box)
     u_lo, u_hi = (float(u) for u in wall_velocities)
-    box = case.Box((0, 0, 0), (Lx, Ly, Lz), delta, faces=("cyclic", ((u_lo, 0, 0), (u_hi, 0, 0)), "cyclic"))
+    box = foamcase.Box((0, 0, 0), (Lx, Ly, Lz), delta, faces=("cyclic", ((u_lo, 0, 0), (u_hi, 0, 0)), "cyclic"))
     fluid = dict(nu=ETA, rho=1.0, grad_p0=tuple(grad_p0), tol_lambda=tol_lambda, n_max=n_max,
                  first_step=(tol_lambda / 10, 3000), n_particles=pack.n, tol_u=1e-5, tol_p=1e-3,
                  acceleration=acceleration, write_interval=write_every, **LINEAR_SOLVE_REL_TOL)
     fluid.update(fluid_options or {})
-    case.write_fluid_case(os.path.join(run_dir, "fluid"), box, **fluid)
+    foamcase.write_fluid_case(os.path.join(run_dir, "fluid"), box, **fluid)
     pair = ("fdm/subgrid model %s contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
             % (model, springs.kn, springs.kt, springs.mu_s, springs.h_r, u_lo, u_hi))
     spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]
@@ -135,7 +135,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                "thermo          %d" % dump_every,
                "run             %d upto" % steps])   # upto: a resumed run ends at the same step
     # a checkpoint every 10 snapshots and at the end: fdmRun --resume continues a killed run (docs/coupling.md)
-    case.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
+    deminput.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
                          fix_options="stresslets yes checkpoint %d walls walls.dat%s"
                          % (10 * dump_every, " fluid_every %d held_drag %s" % (fluid_every, held_drag)
                             if fluid_every > 1 else ""), runs=runs,

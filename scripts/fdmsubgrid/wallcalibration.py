@@ -80,7 +80,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import case, squeeze, theory
+from . import deminput, squeeze, theory
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
 # (x, z) of the sphere's centre inside its mesh cell, fractions of Delta
@@ -106,7 +106,7 @@ def run_loaded_sphere(workdir: str, epss: Sequence[float], a_over_delta: float, 
     kept = squeeze.kept_result(run_dir, epss, tol_lambda)
     if kept is not None:
         return kept
-    pair = case.subgrid_pair_style(walls=(("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid=False)
+    pair = deminput.subgrid_pair_style(walls=(("ylo", (0, 0, 0)), ("yhi", (0, 0, 0))), subgrid=False)
     wall, parts, steps, box = squeeze.run_wall_scene(
         run_dir, epss, a_over_delta, L_over_a, H_over_a, offset, tol_lambda, pair,
         "fix             push all addforce %r 0 0\n"

@@ -1,0 +1,119 @@
+"""The particle side of a coupled case: fdmDEM's LIGGGHTS input (the spheres' data file, the pair style
+fdm/subgrid, fix fdm/couple connected to ../fluid, the held-configuration runs, the records), and whether
+the shipped sub-grid calibration covers a scene before it is launched (docs/dem.md)."""
+from __future__ import annotations
+
+import os
+from typing import Iterable
+
+def subgrid_pair_style(walls=(), subgrid=True, model=None, cutoff=None, wall_cutoff=None) -> str:
+    """The pair_style line of fdm/subgrid (docs/dem.md): the sub-grid model, its cut-offs in mesh cells
+    (pairs, walls; None: the pair style's defaults), `lubrication no` without the correction, and the
+    walls as (face, (ux, uy, uz)) pairs, e.g. (("ylo", (0, 0, 0)), ("yhi", (U, 0, 0)))."""
+    words = ["fdm/subgrid"]
+    if model is not None:
+        words.append("model %s" % model)
+    if cutoff is not None:
+        words.append("cutoff %g" % cutoff)
+    if wall_cutoff is not None:
+        words.append("wall_cutoff %g" % wall_cutoff)
+    if not subgrid:
+        words.append("lubrication no")
+    for face, velocity in walls:
+        words.append("wall %s %s" % (face, " ".join("%r" % float(v) for v in velocity)))
+    return " ".join(words)
+
+
+def held_step_runs(configurations) -> list:
+    """The LIGGGHTS lines that hold the particles at each configuration in turn for one coupled step
+    (`fix fdm/couple ... move no`): configurations[k] lists each particle's centre (x, y, z) in tag
+    order; the first is the data file's, so only the later ones are set. One `run 1` per configuration,
+    each warm-started by the solver from the previous one."""
+    runs = []
+    for k, centres in enumerate(configurations):
+        if k > 0:
+            runs += ["set             atom %d x %r y %r z %r" % (i + 1, *map(float, c)) for i, c in enumerate(centres)]
+        runs.append("run             1")
+    return runs
+
+
+def records_line(every: int) -> str:
+    """The LIGGGHTS line that records every particle every `every` steps in particles.records (fix
+    fdm/output, docs/dem.md)."""
+    return "fix             output all fdm/output records %d particles.records" % every
+
+
+# every step: the file read_held_steps and the one-step validation cases read
+RECORD_EVERY_STEP = records_line(1)
+
+
+def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, model: str = "calibrated",
+                 pairs: bool = True) -> list[str]:
+    """What the shipped calibration table lacks for a scene of these radii at mesh size delta (with
+    walls: also each radius against a wall), in pair_style fdm/subgrid's default model (calibrated):
+    empty when the run can start, else one line per missing radius pair or wall, to refuse the scene
+    before it is launched (the pair style refuses it anyway at its start; `fdmResistance coverage`
+    makes the same test). radii: every particle's (a radius held by one particle has no pair with
+    itself, as in the pair style); pairs=False: the spheres are never in one scene together (one per
+    run), so only each radius against the walls counts; model cutoff needs nothing."""
+    from collections import Counter
+    from .theory import resistance
+    if model != "calibrated":
+        return []
+    counts = Counter(float(r) for r in radii)
+    sizes = sorted(counts)
+    missing = []
+    for i, a in enumerate(sizes):
+        for b in sizes[i:]:
+            r = resistance("coverage", "--a1", a, "--a2", b, "--delta", delta, *(["--wall"] if walls and b == a else []))
+            if pairs and not r["pair"] and (b != a or counts[a] > 1):
+                missing.append("no calibration for the pair of radii %g and %g at a1/Delta %g (a2/a1 %g)"
+                               % (a, b, a / delta, b / a))
+            if walls and b == a and not r["wall"]:
+                missing.append("no wall calibration for radius %g at a/Delta %g" % (a, a / delta))
+    if missing:
+        missing.append("the table (%s) has %s; use --model cutoff for this scene" % (r["table"], r["coverage"]))
+    return missing
+
+
+
+def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",
+                    before_run="", runs=("run 1",), name="in.dem", data_file="spheres.data", pair_style="none"):
+    """LIGGGHTS input for fdmDEM: spheres [(x, y, z, radius), ...] or [(x, y, z, radius, type), ...]
+    (type: the LIGGGHTS atom type, 1 if not given; e.g. 1 for a1 and 2 for a2 in a bidisperse
+    suspension) from a data file, fix fdm/couple connected to ../fluid; pair_style e.g.
+    "fdm/subgrid contact ..." (docs/dem.md), default none. Returns the input path."""
+    os.makedirs(dem_dir, exist_ok=True)
+    types = [int(s[4]) if len(s) > 4 else 1 for s in spheres]
+    if any(t < 1 for t in types):
+        raise ValueError("write_dem_input: atom types must be 1 or more, got %s" % sorted(set(types)))
+    with open(os.path.join(dem_dir, data_file), "w") as f:
+        f.write("spheres for fdmDEM\n\n%d atoms\n%d atom types\n\n" % (len(spheres), max(types, default=1)))
+        for d, axis in enumerate("xyz"):
+            f.write("%.17g %.17g %slo %shi\n" % (box.lo[d], box.hi[d], axis, axis))
+        f.write("\nAtoms\n\n")
+        for i, (sphere, kind) in enumerate(zip(spheres, types)):
+            x, y, z, a = sphere[:4]
+            # atom_style sphere: id type diameter density x y z
+            f.write("%d %d %.17g %.17g %.17g %.17g %.17g\n" % (i + 1, kind, 2 * a, density, x, y, z))
+    boundary = " ".join("p" if p else "f" for p in box.periodic())
+    path = os.path.join(dem_dir, name)
+    with open(path, "w") as f:
+        f.write("""atom_style      sphere
+atom_modify     map array sort 0 0.0
+boundary        %(boundary)s
+newton          off
+communicate     single vel yes
+units           si
+read_data       %(data)s
+pair_style      %(pair)s
+%(coeff)sneighbor        %(skin).17g bin
+neigh_modify    delay 0 every 1 check yes
+timestep        %(dt).17g
+%(before)s
+fix             couple all fdm/couple portfile ../fluid/coupling.port %(fix)s
+%(runs)s
+""" % dict(boundary=boundary, data=data_file, pair=pair_style,
+           coeff="" if pair_style == "none" else "pair_coeff      * *\n", skin=0.1 * min(s[3] for s in spheres) if spheres else 0.1,
+           dt=dt, before=before_run, fix=fix_options, runs="\n".join(runs)))
+    return path
