@@ -177,6 +177,7 @@ int main(int argc, char *argv[])
         // Step 2
         forcing.truncateLambda(lambda);
         forcing.pseudoTimeCoefficient(rDTau, rDTauInside, rDTauOutside);
+        rAUCurrent = false;     // UEqn.H recomputes 1/A with this rDTau
         meanFlow.setForcedCells(forcing.covered());
         stepParticleTime += wallClock() - stepStart;
 

@@ -66,6 +66,8 @@ LINEAR_SOLVERS = {
         smoother        symGaussSeidel;"""),
 }
 DEFAULT_LINEAR_SOLVER = "GAMG"
+# PISO's momentum predictor with each choice
+MOMENTUM_PREDICTOR = {"FFTBox": True, "GAMG": True}
 
 
 def write_control_dict(case_dir, application="fdmFoam", write_interval=100000, end_time=None, delta_t=None):
@@ -101,7 +103,7 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
                      pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
                      n_correctors=2, extra_fdm="", acceleration="anderson", tol_velocity=0.0,
                      mean_flow_correction=True, mean_flow_damping=None, u_rel_tol=0.0, p_rel_tol=0.01,
-                     p_final_rel_tol=0.0, linear_solver=None):
+                     p_final_rel_tol=0.0, linear_solver=None, momentum_predictor=None):
     """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/). u_rel_tol, p_rel_tol,
     p_final_rel_tol: the relTol of the momentum predictor, of the first pressure corrector and of
     the last (pFinal) in every inner iteration (0: solved to tol_u, tol_p each time; the suspension
@@ -113,7 +115,8 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
     mean_flow_damping: its meanFlowDamping (None: fdmFoam's default, 10), docs/fluid.md.
     linear_solver: the solver of p and U, "FFTBox" (the direct solver for box meshes, GAMG and
     symGaussSeidel as its fallbacks) or "GAMG" (GAMG for p, symGaussSeidel for U); None:
-    DEFAULT_LINEAR_SOLVER (docs/fluid.md, "Direct solver for box meshes")."""
+    DEFAULT_LINEAR_SOLVER (docs/fluid.md, "Direct solver for box meshes"). momentum_predictor: PISO's
+    momentumPredictor (None: MOMENTUM_PREDICTOR of the linear solver)."""
     linear_solver = DEFAULT_LINEAR_SOLVER if linear_solver is None else linear_solver
     if linear_solver not in LINEAR_SOLVERS:
         raise ValueError("write_fluid_case: linear_solver %r is not one of %s" % (linear_solver, ", ".join(LINEAR_SOLVERS)))
@@ -196,14 +199,16 @@ solvers
 }
 PISO
 {
-    momentumPredictor yes;
+    momentumPredictor %(predictor)s;
     nCorrectors     %(ncorr)d;
     nNonOrthogonalCorrectors 0;
     pRefCell        0;
     pRefValue       0;
 }
 """ % dict(tol_p=tol_p, tol_u=tol_u, u_rel_tol=u_rel_tol, p_rel_tol=p_rel_tol, p_final_rel_tol=p_final_rel_tol,
-           ncorr=n_correctors, p_solver=LINEAR_SOLVERS[linear_solver][0], u_solver=LINEAR_SOLVERS[linear_solver][1]))
+           ncorr=n_correctors, p_solver=LINEAR_SOLVERS[linear_solver][0], u_solver=LINEAR_SOLVERS[linear_solver][1],
+           predictor="yes" if (MOMENTUM_PREDICTOR[linear_solver] if momentum_predictor is None else momentum_predictor)
+           else "no"))
 
     # no system/decomposeParDict: fdmRun -f N writes the split for N ranks (fdmsubgrid.decomposition)
 
