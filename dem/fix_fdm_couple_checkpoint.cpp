@@ -19,8 +19,10 @@
 #include "atom.h"
 #include "comm.h"
 #include "domain.h"
+#include "dump.h"
 #include "error.h"
 #include "fix_property_atom.h"
+#include "output.h"
 #include "update.h"
 
 #include <sys/stat.h>
@@ -56,8 +58,8 @@ std::vector<std::vector<double> > gatherByTag(const std::vector<double> &local, 
 
 bool FixFdmCouple::checkpointDue() const
 {
-  return checkpointEvery_ > 0 && update->ntimestep > 0 &&
-         (update->ntimestep % checkpointEvery_ == 0 || update->ntimestep == update->laststep);
+  const long long every = options_.checkpointEvery;
+  return every > 0 && update->ntimestep > 0 && (update->ntimestep % every == 0 || update->ntimestep == update->laststep);
 }
 
 void FixFdmCouple::writeCheckpoint()
@@ -118,22 +120,25 @@ void FixFdmCouple::writeCheckpoint()
       if (wallWidth) wallValues.insert(wallValues.end(), wallsByTag[t].begin(), wallsByTag[t].end());
     }
     // the position update's history (U_n, U_{n-1}, x_n, the planned rates) and the last outputs
-    c.arrays["state"] = {havePlan_ ? 1.0 : 0.0, haveVelocities_ ? 1.0 : 0.0, double(lastIterations_), lastResidual_,
-                         adamsBashforth_ ? 1.0 : 0.0, gapUpdate_ ? 1.0 : 0.0, double(wallWidth)};
-    c.arrays["currentVelocity"] = currentVelocity_;
-    c.arrays["previousVelocity"] = previousVelocity_;
-    c.arrays["moveRate"] = havePlan_ ? moveRate_ : std::vector<double>();
-    c.arrays["planPositions"] = havePlan_ ? planPositions_ : std::vector<double>();
-    c.arrays["solution"] = solution_;
-    c.arrays["hydro"] = hydro_;
-    c.arrays["subgrid"] = subgrid_;
-    c.arrays["fluidStress"] = fluidStress_;
-    c.arrays["stress"] = stress_;
+    const fdm::CoupledVelocitySolve::Results &r = solve_.results();
+    c.arrays["state"] = {plan_.planned ? 1.0 : 0.0, plan_.haveVelocities ? 1.0 : 0.0, double(solve_.lastIterations),
+                         solve_.lastResidual, options_.adamsBashforth ? 1.0 : 0.0, options_.gapUpdate ? 1.0 : 0.0,
+                         double(wallWidth)};
+    c.arrays["currentVelocity"] = plan_.current;
+    c.arrays["previousVelocity"] = plan_.previous;
+    c.arrays["moveRate"] = plan_.planned ? plan_.rates : std::vector<double>();
+    c.arrays["planPositions"] = plan_.planned ? plan_.positions : std::vector<double>();
+    c.arrays["solution"] = r.solution;
+    c.arrays["hydro"] = r.hydro;
+    c.arrays["subgrid"] = r.subgrid;
+    c.arrays["fluidStress"] = r.fluidStress;
+    c.arrays["stress"] = r.stress;
     // held_drag: the mode (a resume must hold the drag as the run did) and, extrapolated, the last two
     // fluid steps' drag targets (a resumed run extrapolates as the one it continues)
-    c.arrays["heldDrag"] = {heldExtrapolated_ ? 1.0 : 0.0, double(heldDragStep_), double(heldDragStepBefore_)};
-    c.arrays["heldDragLast"] = heldDrag_;
-    c.arrays["heldDragBefore"] = heldDragBefore_;
+    const fdm::HeldDrag::State &held = heldDrag_.state();
+    c.arrays["heldDrag"] = {heldDrag_.extrapolated() ? 1.0 : 0.0, double(held.lastStep), double(held.beforeStep)};
+    c.arrays["heldDragLast"] = held.last;
+    c.arrays["heldDragBefore"] = held.before;
     const std::string file = std::string(directory) + "/" + prefix + std::to_string((long long) c.step);
     try {
       ::mkdir(directory, 0755);
@@ -209,9 +214,9 @@ void FixFdmCouple::readResumeCheckpoint()
     // written before held_drag existed: the drag was held constant
     const auto held = c.arrays.find("heldDrag");
     const bool extrapolated = held != c.arrays.end() && !held->second.empty() && held->second[0] != 0;
-    if (extrapolated != heldExtrapolated_)
+    if (extrapolated != heldDrag_.extrapolated())
       problem = resumeFile_ + " was written with held_drag " + (extrapolated ? "extrapolated" : "constant") +
-                " but the input has held_drag " + (heldExtrapolated_ ? "extrapolated" : "constant") +
+                " but the input has held_drag " + (heldDrag_.extrapolated() ? "extrapolated" : "constant") +
                 ": a resumed run must hold the fluid's force between fluid steps as the run it continues";
   }
   if (!problem.empty()) error->all(FLERR, ("fdm/couple: cannot resume: " + problem).c_str());
@@ -223,6 +228,36 @@ void FixFdmCouple::readResumeCheckpoint()
   if (comm->me == 0 && screen)
     fprintf(screen, "fdm/couple: resuming from %s (step %lld of a run to step %lld)\n", resumeFile_.c_str(),
             resume_->step, resume_->lastStep);
+}
+
+void FixFdmCouple::continueDumps()
+{
+  // a resumed run continues the dumps of the interrupted one (fdmRun --resume cut them at the checkpoint)
+  for (int i = 0; i < output->ndump; i++) {
+    char append[] = "append", yes[] = "yes";
+    char *args[] = {append, yes};
+    output->dump[i]->modify_params(2, args);
+  }
+}
+
+void FixFdmCouple::checkResumedRunLength()
+{
+  // `run N` instead of `run L upto` would run N steps more: the last step is checked against the
+  // checkpoint's, or against -until's where the run was extended on purpose
+  const long long until = session_.resumeUntil();
+  if (resume_ && until > 0 && update->laststep != until)
+    allAgree(comm->me != 0 ? std::string() :
+             "resuming at step " + std::to_string(resume_->step) + " from " + resumeFile_ + " to step " +
+             std::to_string(until) + " (-until) but this run command ends at step " +
+             std::to_string((long long) update->laststep) + ": write it 'run " + std::to_string(until) +
+             " upto' (fdmRun --resume --until does; docs/coupling.md)");
+  if (resume_ && until == 0 && update->laststep != resume_->lastStep)
+    allAgree(comm->me != 0 ? std::string() :
+             "resuming at step " + std::to_string(resume_->step) + " from " + resumeFile_ + ": the run it belongs "
+             "to ends at step " + std::to_string(resume_->lastStep) + " but this run command ends at step " +
+             std::to_string((long long) update->laststep) + ": write it 'run " + std::to_string(resume_->lastStep) +
+             " upto' (a resumed input runs to the same last step; fdmRun --resume --until L extends it to L; "
+             "docs/coupling.md)");
 }
 
 void FixFdmCouple::setup_pre_exchange()
@@ -259,25 +294,28 @@ void FixFdmCouple::restoreCheckpoint()
     for (int k = 0; k < wallWidth; k++) wallHistory->array_atom[i][k] = c.arrays.at("wallHistory")[size_t(wallWidth) * t + k];
   }
   // a checkpoint's step is always one the fluid solved (fluidStepDue): the next fluid step spans from it
-  lastFluidStep_ = c.step;
-  havePlan_ = state[0] != 0;
-  haveVelocities_ = state[1] != 0;
-  lastIterations_ = int(state[2]);
-  lastResidual_ = state[3];
-  currentVelocity_ = c.arrays.at("currentVelocity");
-  previousVelocity_ = c.arrays.at("previousVelocity");
-  moveRate_ = c.arrays.at("moveRate");
-  planPositions_ = c.arrays.at("planPositions");
-  solution_ = c.arrays.at("solution");
-  hydro_ = c.arrays.at("hydro");
-  subgrid_ = c.arrays.at("subgrid");
-  fluidStress_ = c.arrays.at("fluidStress");
-  stress_ = c.arrays.at("stress");
+  schedule_.solved(c.step);
+  plan_.planned = state[0] != 0;
+  plan_.haveVelocities = state[1] != 0;
+  solve_.lastIterations = int(state[2]);
+  solve_.lastResidual = state[3];
+  plan_.current = c.arrays.at("currentVelocity");
+  plan_.previous = c.arrays.at("previousVelocity");
+  plan_.rates = c.arrays.at("moveRate");
+  plan_.positions = c.arrays.at("planPositions");
+  fdm::CoupledVelocitySolve::Results &r = solve_.results();
+  r.solution = c.arrays.at("solution");
+  r.hydro = c.arrays.at("hydro");
+  r.subgrid = c.arrays.at("subgrid");
+  r.fluidStress = c.arrays.at("fluidStress");
+  r.stress = c.arrays.at("stress");
   const auto held = c.arrays.find("heldDrag");
   if (held != c.arrays.end() && held->second.size() == 3) {
-    heldDragStep_ = bigint(held->second[1]);
-    heldDragStepBefore_ = bigint(held->second[2]);
-    heldDrag_ = c.arrays.at("heldDragLast");
-    heldDragBefore_ = c.arrays.at("heldDragBefore");
+    fdm::HeldDrag::State state;
+    state.lastStep = (long long) held->second[1];
+    state.beforeStep = (long long) held->second[2];
+    state.last = c.arrays.at("heldDragLast");
+    state.before = c.arrays.at("heldDragBefore");
+    heldDrag_.restore(state);
   }
 }

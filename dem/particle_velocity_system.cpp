@@ -2,7 +2,7 @@
 #include "contact_springs.h"
 #include "message_text.h"
 #include "particle_velocity_system.h"
-#include "andersonMixing.H"
+#include "fdm/anderson_mixing.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>

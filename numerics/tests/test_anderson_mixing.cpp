@@ -1,9 +1,9 @@
-// fdm::AndersonMixing (fluid/fdmFoam/andersonAcceleration/andersonMixing.H) on fixed-point
+// fdm::AndersonMixing (numerics/include/fdm/anderson_mixing.h) on fixed-point
 // iterations whose answers are known: it must reach the same fixed point as the plain
 // iteration, much sooner on a slowly contracting linear map (where it is GMRES in disguise),
 // give the same iterates whatever the split of the vector over "ranks", and survive
 // linearly dependent differences.
-#include "andersonMixing.H"
+#include "fdm/anderson_mixing.h"
 
 #include <gtest/gtest.h>
 

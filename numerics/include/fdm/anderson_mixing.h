@@ -1,5 +1,5 @@
 /*---------------------------------------------------------------------------*\
-    fdmFoam: fictitious-domain Stokes solver with sub-grid corrections
+    fdm numerics: plain C++ shared by the fluid solver and the particle side
 
 Class
     fdm::AndersonMixing
@@ -8,8 +8,10 @@ Description
     The arithmetic of Anderson acceleration (Anderson, J. ACM 12, 1965;
     Walker & Ni, SIAM J. Numer. Anal. 49, 2011) for a fixed-point iteration
     x -> G(x) on a vector distributed over MPI ranks, in plain C++11 so that
-    it is unit-tested without OpenFOAM (fluid/tests). The OpenFOAM side
-    (andersonAcceleration.H) packs the fields into the vector.
+    it is unit-tested without OpenFOAM (numerics/tests). Its users: fdmFoam's
+    inner iteration (fluid/fdmFoam/andersonAcceleration packs the fields into
+    the vector) and the Coulomb rounds of Eq. (31) on the particle side
+    (dem/particle_velocity_system.cpp).
 
     It keeps the last m differences dG_j = G_{j+1} - G_j and
     df_j = f_{j+1} - f_j of the residual f = G(x) - x, and replaces G(x_k) by
