@@ -429,6 +429,7 @@ def plot(rows: List[Dict], png: str) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     fig, (ax, axr) = plt.subplots(2, 1, figsize=(5.5, 6), sharex=True, gridspec_kw=dict(height_ratios=(2, 1)))
     styles = {"walls": "-", "periodic": "--"}
     colours = {"GAMG": "C0", "FFTBox": "C3"}
@@ -458,7 +459,11 @@ def plot(rows: List[Dict], png: str) -> None:
     ax.set_title("p solve to 1e-7, icoFoam on an n$^3$ box\n(filled: every solve; open: steps 2 on)", fontsize=9)
     ax.legend(fontsize=6, ncol=2)
     axr.set_ylabel("GAMG / FFTBox")
-    axr.set_xlabel("cells")
+    axr.set_xlabel("cells (n$^3$)")
+    # ticks at the sizes measured
+    axr.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    axr.set_xticks(list(c))
+    axr.set_xticklabels(["%d$^3$" % round(x ** (1 / 3)) for x in c])
     axr.set_ylim(bottom=0)
     axr.legend(fontsize=7)
     fig.tight_layout()

@@ -482,6 +482,23 @@ def fluid_time_breakdown(text):
                 particle_forcing=float(g[4]), exchange_dem=float(g[5]), output=float(g[6]))
 
 
+def fluid_inner_profile(text):
+    """fdmFoam's "inner iterations by part" at the end of log.fluid (fluid/fdmFoam/runProfile) as a dict:
+    inner_iterations, total seconds, and parts {name: seconds} (momentum assembly, pressure solve,
+    Anderson mixing, ...). None if absent (a run of a build before it)."""
+    import re
+    m = re.search(r"fdmFoam inner iterations by part \((\d+) inner iterations, ([0-9.eE+-]+) s\):\n((?:    .*\n)+)",
+                  text)
+    if not m:
+        return None
+    parts = {}
+    for line in m.group(3).splitlines():
+        row = re.match(r"\s+(.+?)\s+([0-9.eE+-]+) s\s", line)
+        if row:
+            parts[row.group(1)] = float(row.group(2))
+    return dict(inner_iterations=int(m.group(1)), total=float(m.group(2)), parts=parts)
+
+
 def dem_time_breakdown(text):
     """fdmDEM's side of a coupled run from log.dem: the last "fdm/couple timing of this run" line
     (particle_solve: the Eq. (31) assembly, solves and position update; exchange_fluid: waiting for

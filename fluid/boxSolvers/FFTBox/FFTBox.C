@@ -234,14 +234,23 @@ struct boxOperator
     }
 };
 
-boxOperator& operatorFor(const lduMesh& mesh, const word& key, const boxLattice& lattice)
+boxOperator& operatorFor
+(
+    const lduMesh& mesh,
+    const word& key,
+    const boxLattice& lattice,
+    const bool measurePlans
+)
 {
     static std::map<std::pair<const lduMesh*, std::string>, std::unique_ptr<boxOperator>> operators;
     auto& op = operators[std::make_pair(&mesh, std::string(key))];
     if (!op)
     {
         op.reset(new boxOperator);
-        op->solver.reset(new fdm::separableBoxSolver(lattice.n(), lattice.wallAxis()));
+        op->solver.reset
+        (
+            new fdm::separableBoxSolver(lattice.n(), lattice.wallAxis(), measurePlans)
+        );
         const List<std::array<long, 3>>& ijk = lattice.ijk();
         op->index.resize(ijk.size());
         forAll(ijk, celli)
@@ -284,8 +293,20 @@ Foam::FFTBox::FFTBox
         interfaces,
         solverControls
     ),
-    maxDeparture_(controlDict_.lookupOrDefault<scalar>("maxDeparture", 0.5))
-{}
+    maxDeparture_(controlDict_.lookupOrDefault<scalar>("maxDeparture", 0.5)),
+    measurePlans_
+    (
+        controlDict_.lookupOrDefault<word>("fftwPlanning", "estimate") == "measure"
+    )
+{
+    const word planning(controlDict_.lookupOrDefault<word>("fftwPlanning", "estimate"));
+    if (planning != "estimate" && planning != "measure")
+    {
+        FatalIOErrorInFunction(controlDict_)
+            << "FFTBox for " << fieldName << ": fftwPlanning " << planning
+            << " is not estimate or measure" << exit(FatalIOError);
+    }
+}
 
 
 // * * * * * * * * * * * * * * * Member Functions  * * * * * * * * * * * * * //
@@ -342,7 +363,7 @@ Foam::solverPerformance Foam::FFTBox::solve
         return fallback(psi, source, cmpt, lattice->reason());
     }
 
-    boxOperator& op = operatorFor(matrix_.mesh(), fieldName_, *lattice);
+    boxOperator& op = operatorFor(matrix_.mesh(), fieldName_, *lattice, measurePlans_);
     if (!op.sameMatrix(matrix_, interfaceBouCoeffs_, interfaces_))
     {
         op.keep

@@ -34,7 +34,8 @@ namespace
 fdm::separableBoxSolver::separableBoxSolver
 (
     const std::array<long, 3>& n,
-    int wallAxis
+    int wallAxis,
+    bool measurePlans
 )
 :
     n_(n),
@@ -106,7 +107,7 @@ fdm::separableBoxSolver::separableBoxSolver
 
     // FFTW_MEASURE times a few algorithms once (it overwrites the buffers,
     // which hold nothing yet); every solve then reuses the plans
-    const unsigned flags = FFTW_MEASURE;
+    const unsigned flags = measurePlans ? FFTW_MEASURE : FFTW_ESTIMATE;
     if (wall_ >= 0)
     {
         // one 2-D transform per plane across the walls

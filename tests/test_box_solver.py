@@ -1,0 +1,102 @@
+"""The direct solver for box meshes (FFTBox, fluid/boxSolvers) inside fdmFoam: on every kind of box the
+cases write it solves the real OpenFOAM matrices to round-off in one iteration (the residual is
+OpenFOAM's own, of the matrix it was given), the coupled answer is the iterative solvers' one, and
+where it cannot solve (walls on two pairs of faces, a decomposed mesh) it says why and the fallback
+gives the same answer. The separable solve itself is tested without OpenFOAM in
+fluid/tests/test_separable_box_solver.cpp."""
+import os
+import re
+
+import numpy as np
+import pytest
+
+from fdmsubgrid import case, output
+
+# A free sphere off-centre in a small box, a mean pressure gradient and the walls driving the flow: every
+# matrix of fdmFoam is assembled and solved (the momentum predictor on, to solve U too)
+U_WALL = 0.5
+BOXES = {
+    "periodic": ("cyclic", "cyclic", "cyclic"),
+    "moving walls across y": ("cyclic", ((-U_WALL, 0, 0), (U_WALL, 0, 0)), "cyclic"),
+    "slip walls across y": ("cyclic", "slip", "cyclic"),
+    "walls across z": ("cyclic", "cyclic", ((0, 0, 0), (U_WALL, 0, 0))),
+    "walls across y and z": ("cyclic", ((0, 0, 0), (0, 0, 0)), ((0, 0, 0), (U_WALL, 0, 0))),
+}
+SOLVE = re.compile(r"^(\w+):\s+Solving for (\w+), Initial residual = ([0-9.eE+-]+), "
+                   r"Final residual = ([0-9.eE+-]+), No Iterations (\d+)", re.M)
+
+
+def run_free_sphere(tmp_path, name, faces, linear_solver, np_fluid=1, tol_lambda=1e-9):
+    box = case.Box((0, 0, 0), (4.0, 4.0, 4.0), 0.25, faces=faces)
+    root = str(tmp_path / ("%s_%s_np%d" % (name.replace(" ", "_"), linear_solver, np_fluid)))
+    # the inner iteration converged far below the comparison's 1e-6, the linear solves tight (relTol 0)
+    case.write_fluid_case(os.path.join(root, "fluid"), box, grad_p0=(-0.1, 0, 0), tol_lambda=tol_lambda, n_max=300,
+                          n_particles=1, tol_u=1e-10, tol_p=1e-10, linear_solver=linear_solver,
+                          momentum_predictor=True)
+    case.write_dem_input(os.path.join(root, "dem"), box, [(1.9, 2.1, 2.05, 1.0)], fix_options="move no")
+    case.run(root, np_fluid=np_fluid)
+    with open(os.path.join(root, "log.fluid")) as f:
+        log = f.read()
+    return log, output.particles(os.path.join(root, "fluid"))
+
+
+def velocities(particles):
+    """The free sphere's velocity and angular velocity (it is force-free: fix fdm/couple ... move no
+    keeps its place, not its velocity)"""
+    return np.array([particles[c][-1] for c in ("Ux", "Uy", "Uz", "Wx", "Wy", "Wz")])
+
+
+def assert_every_solve_exact(log):
+    assert "FFTBox: p solved directly" in log and "pressure reference solved exactly" in log, log[-3000:]
+    assert "fallback" not in log
+    solves = [m for m in SOLVE.finditer(log) if m.group(1) == "FFTBox"]
+    assert len(solves) > 40
+    solved = 0
+    for m in solves:
+        final, iterations = float(m.group(4)), int(m.group(5))
+        # OpenFOAM's own (normalised) residual of the matrix it assembled, after one preconditioned CG
+        # step; none where the initial residual was already below the tolerance
+        assert iterations <= 1, m.group(0)
+        if iterations:
+            assert final < 1e-11, m.group(0)
+        solved += iterations
+    assert solved > 40
+
+
+@pytest.mark.parametrize("name", ["periodic", "slip walls across y"])
+def test_direct_solve_is_exact_where_no_steady_answer_is_compared(tmp_path, env, name):
+    # the mean pressure gradient along slip walls or through a fully periodic box has no steady flow to
+    # compare (nothing holds the fluid back but the sphere): the solves are checked, not the answer;
+    # with slip walls the wall-normal velocity component has a matrix of its own
+    log, _ = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox", tol_lambda=1e-3)
+    assert_every_solve_exact(log)
+
+
+@pytest.mark.parametrize("name", ["moving walls across y", "walls across z"])
+def test_direct_solve_is_exact_and_gives_the_iterative_answer(tmp_path, env, name):
+    log, direct = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox")
+    assert_every_solve_exact(log)
+    log_iterative, iterative = run_free_sphere(tmp_path, name, BOXES[name], "GAMG")
+    scale = np.abs(velocities(iterative)).max()
+    assert np.abs(velocities(direct) - velocities(iterative)).max() < 1e-6 * scale, (velocities(direct), velocities(iterative))
+
+
+def test_walls_on_two_pairs_of_faces_fall_back_with_the_reason(tmp_path, env):
+    name = "walls across y and z"
+    log, fallback = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox")
+    assert ("FFTBox: p is solved by GAMG (the fallback): walls across y and z: FFTBox solves boxes with walls "
+            "on at most one pair of faces") in log, log[-3000:]
+    assert "FFTBox: Ux is solved by smoothSolver (the fallback)" in log
+    _, iterative = run_free_sphere(tmp_path, name, BOXES[name], "GAMG")
+    scale = np.abs(velocities(iterative)).max()
+    assert np.abs(velocities(fallback) - velocities(iterative)).max() < 1e-6 * scale
+
+
+def test_a_decomposed_mesh_falls_back_and_keeps_the_serial_answer(tmp_path, env):
+    name = "moving walls across y"
+    log, parallel = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox", np_fluid=2)
+    assert "FFTBox: p is solved by GAMG (the fallback): the mesh is decomposed over 2 processors" in log, \
+        log[-3000:]
+    _, serial = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox")
+    scale = np.abs(velocities(serial)).max()
+    assert np.abs(velocities(parallel) - velocities(serial)).max() < 1e-6 * scale
