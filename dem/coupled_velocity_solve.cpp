@@ -48,6 +48,7 @@ void CoupledVelocitySolve::resize(int n)
 void CoupledVelocitySolve::assemble(const std::vector<GatheredParticle> &particles, std::vector<double> pairBlocks,
                                     std::vector<double> wallBlocks, System::Springs springs)
 {
+  const ParticleStepProfile::Clock::time_point start = ParticleStepProfile::now();
   std::vector<System::Particle> loads(n_);
   for (int p = 0; p < n_; p++) {
     const GatheredParticle &q = particles[p];
@@ -68,6 +69,7 @@ void CoupledVelocitySolve::assemble(const std::vector<GatheredParticle> &particl
     system_.reset(new System(settings));
   }
   system_->assemble(std::move(loads), std::move(pairBlocks), std::move(wallBlocks), std::move(springs));
+  counts_.parts.lap(ParticleStepProfile::systemAssembly, start);
 }
 
 void CoupledVelocitySolve::setVolumes(const cpl::Volumes &volumes)
@@ -79,11 +81,13 @@ void CoupledVelocitySolve::setVolumes(const cpl::Volumes &volumes)
     std::copy(v.m1, v.m1 + 3, rigid[p].m1);
     std::copy(v.J, v.J + 6, rigid[p].J);
   }
+  const ParticleStepProfile::Clock::time_point start = ParticleStepProfile::now();
   try {
     system_->setVolumes(rigid);
   } catch (const System::Error &e) {
     throw problem(e, meshSize_, volumes.step, 0);
   }
+  counts_.parts.lap(ParticleStepProfile::systemFactorisation, start);
 }
 
 const std::vector<double> &CoupledVelocitySolve::solve(const cpl::Integrals &integrals)
@@ -94,11 +98,13 @@ const std::vector<double> &CoupledVelocitySolve::solve(const cpl::Integrals &int
       fluid[size_t(6) * p + d] = integrals.particles[p].F[d];
       fluid[size_t(6) * p + 3 + d] = integrals.particles[p].T[d];
     }
+  const ParticleStepProfile::Clock::time_point start = ParticleStepProfile::now();
   try {
     results_.solution = system_->solve(fluid);
   } catch (const System::Error &e) {
     throw problem(e, meshSize_, integrals.step, integrals.iteration);
   }
+  counts_.parts.lap(ParticleStepProfile::systemSolves, start);
   const long iterations = system_->lastIterations();
   counts_.coulombRoundsMax = std::max(counts_.coulombRoundsMax, system_->lastRounds());
   counts_.solves++;
@@ -126,6 +132,13 @@ void CoupledVelocitySolve::storeStepDone(const cpl::StepDone &done)
 }
 
 void CoupledVelocitySolve::finishStep(const std::vector<GatheredParticle> &particles)
+{
+  const ParticleStepProfile::Clock::time_point start = ParticleStepProfile::now();
+  finishStepUntimed(particles);
+  counts_.parts.lap(ParticleStepProfile::systemResults, start);
+}
+
+void CoupledVelocitySolve::finishStepUntimed(const std::vector<GatheredParticle> &particles)
 {
   results_.subgrid = system_->subgridForces();
   counts_.contactSlides += system_->slidingSwitches();

@@ -36,7 +36,8 @@ class CoupledVelocitySolve {
     std::vector<double> solution, hydro, fluidStress, subgrid, springs, stress;
   };
 
-  // settings: of Eq. (31) but the fluid's values; counts: where the solves are counted
+  // settings: of Eq. (31) but the fluid's values; counts: where the solves are counted, and their
+  // seconds by part (assembly, factorisation, solves, results: CouplingTiming::parts)
   CoupledVelocitySolve(const ParticleVelocitySystem::Settings &settings, CouplingTiming &counts);
   // What the fluid said at the handshake (or transport none's keywords).
   void setFluid(double alphaLambda, double rhoFluid, double viscosity, double meshSize)
@@ -84,6 +85,7 @@ class CoupledVelocitySolve {
 
  private:
   void setDrag(const std::vector<GatheredParticle> &particles, long long step);
+  void finishStepUntimed(const std::vector<GatheredParticle> &particles);  // finishStep's work
   // the fluid's force of a solve against the drag D: the drag target minus D u
   void dragForces(const coupler::Integrals &target);
 

@@ -244,6 +244,17 @@ void CouplingSession::addRun(long steps, double solve, double exchange, double g
   totalGatherScatter_ += gatherScatter;
 }
 
+void CouplingSession::addProfile(const fdm::ParticleStepProfile &run, long fluidSteps)
+{
+  totalProfile_.add(run);
+  fluidSteps_ += fluidSteps;
+}
+
+std::string CouplingSession::whoseProfile(int ranks)
+{
+  return ranks == 1 ? std::string("one rank") : "rank 0's of " + std::to_string(ranks) + " ranks";
+}
+
 void CouplingSession::finishAll(LAMMPS *lmp)
 {
   if (lmp->comm->me != 0 || !connection_) return;
@@ -264,6 +275,8 @@ void CouplingSession::finishAll(LAMMPS *lmp)
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%)\n",
                 runs_, runs_ == 1 ? "" : "s", steps_, wall, totalSolve_, totalSolve_ * percent, totalExchange_,
                 totalExchange_ * percent, totalGatherScatter_, totalGatherScatter_ * percent);
-  if (lmp->screen) fputs(line, lmp->screen);
-  if (lmp->logfile) fputs(line, lmp->logfile);
+  const std::string breakdown =
+      line + totalProfile_.report("total, coupled", whoseProfile(lmp->comm->nprocs), wall, steps_, fluidSteps_);
+  if (lmp->screen) fputs(breakdown.c_str(), lmp->screen);
+  if (lmp->logfile) fputs(breakdown.c_str(), lmp->logfile);
 }

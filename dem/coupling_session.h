@@ -14,6 +14,7 @@
 #define FDM_COUPLING_SESSION_H
 
 #include "fdm/coupler.h"
+#include "particle_step_profile.h"
 
 #include <memory>
 #include <string>
@@ -86,6 +87,10 @@ class CouplingSession {
 
   // The seconds of each coupled run (rank 0's), for the session's total.
   void addRun(long steps, double solve, double exchange, double gatherScatter);
+  // The breakdown of each run (rank 0's, the rank that solves Eq. 31 and talks to the fluid), for the
+  // session's total; whose: how the breakdown names the rank it is of
+  void addProfile(const fdm::ParticleStepProfile &run, long fluidSteps);
+  static std::string whoseProfile(int ranks);
   double totalSolve() const { return totalSolve_; }
   double totalExchange() const { return totalExchange_; }
   // Every rank, by the fdmDEM driver after the input script: tells the fluid to finish (Finish),
@@ -112,6 +117,8 @@ class CouplingSession {
   int runs_;
   long steps_;
   double totalSolve_, totalExchange_, totalGatherScatter_;
+  fdm::ParticleStepProfile totalProfile_;
+  long fluidSteps_ = 0;
 };
 
 }  // namespace LAMMPS_NS

@@ -1,10 +1,12 @@
 /* What fix fdm/couple counts over a run (wall-clock seconds of the three parts of the particle side's
-   work, Eq. (31)'s solves, the position update's log-gap targets) and the timing line it prints at the
-   end of each run (docs/dem.md, "Outputs"). No LIGGGHTS. */
+   work, and the same finer by part of the particle step (particle_step_profile.h), Eq. (31)'s solves,
+   the position update's log-gap targets) and the timing line it prints at the end of each run
+   (docs/dem.md, "Outputs"). No LIGGGHTS. */
 
 #ifndef FDM_COUPLING_TIMING_H
 #define FDM_COUPLING_TIMING_H
 
+#include "particle_step_profile.h"
 #include "position_update.h"
 
 #include <algorithm>
@@ -14,6 +16,7 @@ namespace fdm {
 
 struct CouplingTiming {
   double solve = 0, exchange = 0, gatherScatter = 0;
+  ParticleStepProfile parts;            // the same seconds finer, by part of the particle step
   long steps = 0, fluidSteps = 0, solves = 0, solverIterations = 0, solverIterationsMax = 0;
   long gapTargets = 0, gapLimited = 0;  // log-gap targets of the position update, and those limited
   long gapHeld = 0;                     // contact (or closed) gaps held at their straight-step value

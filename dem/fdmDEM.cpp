@@ -14,6 +14,7 @@
 #include "lammps.h"
 
 #include <mpi.h>
+#include <omp.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -41,6 +42,14 @@ int main(int argc, char **argv)
       std::fputs(usage, stdout);
       return 0;
     }
+  // CHOLMOD's supernodal factorisation of Eq. (31) copies each supernode in OpenMP loops of a fixed 4
+  // threads (CHOLMOD_OMP_NUM_THREADS, compiled into Debian's libcholmod): on a machine whose cores the
+  // fluid ranks and other runs share, they wait on each other for more than the copies take (the
+  // factorisation of the dense Table 8 row 1.5-2.5x slower, docs/benchmarks.md "Where a dense row's
+  // particle step goes"). Dynamic threads let OpenMP give those loops no more threads than the load
+  // leaves free. The loops only copy and scatter: the factors, hence the results, do not depend on it.
+  // OMP_DYNAMIC in the environment decides instead.
+  if (!std::getenv("OMP_DYNAMIC")) omp_set_dynamic(1);
   MPI_Init(&argc, &argv);
 
   // LIGGGHTS writes log.liggghts unless told otherwise: off by default, -log FILE to have one

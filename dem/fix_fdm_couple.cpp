@@ -17,6 +17,7 @@
 #include "force.h"
 #include "memory.h"
 #include "modify.h"
+#include "timer.h"
 #include "update.h"
 
 #include <algorithm>
@@ -193,6 +194,7 @@ void FixFdmCouple::setup(int)
   fillPerAtomArray();
   runStart_ = MPI_Wtime();
   run_ = fdm::CouplingTiming();
+  if (pair_) pair_->takeContactSeconds();  // the setup's force evaluation is not the run's
 }
 
 void FixFdmCouple::initial_integrate(int)
@@ -202,6 +204,7 @@ void FixFdmCouple::initial_integrate(int)
   // (planNextMove: Adams-Bashforth 2 with the log-gap correction of position_update.h); the very
   // first step moves with the velocities the input gave.
   if (!options_.move) return;
+  const Profile::Clock::time_point start = Profile::now();
   const double dt = update->dt;
   for (int i = 0; i < atom->nlocal; i++) {
     if (plan_.planned) {
@@ -216,6 +219,7 @@ void FixFdmCouple::initial_integrate(int)
     }
     for (int d = 0; d < 3; d++) atom->x[i][d] += dt * atom->v[i][d];
   }
+  run_.parts.lap(Profile::positionUpdate, start);
 }
 
 void FixFdmCouple::assembleSystem(const Particles &particles)
@@ -225,13 +229,17 @@ void FixFdmCouple::assembleSystem(const Particles &particles)
   const bool wallLoads = !options_.wallFile.empty();
   std::vector<double> pairs, walls, wallIndex;
   long contacts = 0;
+  Profile::Clock::time_point t = Profile::now();
   if (pair_) {
     pair_->collectBlocks(options_.stresslets, pairs, walls, wallLoads ? &wallIndex : nullptr);
     contacts = pair_->contactsLast();
+    t = run_.parts.lap(Profile::subgridBlocks, t);
   }
   checkOverlaps();
+  t = Profile::now();
   std::vector<double> allPairs = fdm::gatherToRoot(pairs, world);
   std::vector<double> allWalls = fdm::gatherToRoot(walls, world);
+  t = run_.parts.lap(Profile::gatherScatter, t);
   // implicit contact springs (docs/contact.md 2b): c1 the weight of U_{n+1} in the next position
   // update (planNextMove: ab2 once a previous step exists), gamma = -c0/c1 the weight of U_n. Decided
   // on rank 0, which plans the position update: every rank must build its blocks with the same weight.
@@ -242,11 +250,14 @@ void FixFdmCouple::assembleSystem(const Particles &particles)
   wallLoads_.springBlockWall.clear();
   if (pair_ && pair_->implicitContact() && options_.move) {
     std::vector<double> springPairs, springWalls, springWallIndex;
+    t = Profile::now();
     pair_->collectSpringBlocks(multistep ? 1.5 : 1.0, update->dt, springPairs, springWalls,
                                wallLoads ? &springWallIndex : nullptr);
+    t = run_.parts.lap(Profile::contact, t);
     springs.pairs = fdm::gatherToRoot(springPairs, world);
     springs.walls = fdm::gatherToRoot(springWalls, world);
     if (wallLoads) wallLoads_.springBlockWall = fdm::gatherToRoot(springWallIndex, world);
+    run_.parts.lap(Profile::gatherScatter, t);
     // Eq. (C5): the straight step's chord of a sliding or rolling pair, in its normal spring, from
     // U_n (kept in the checkpoints: a resumed run takes the same chord terms)
     const bool chord = options_.contactChord && plan_.haveVelocities && plan_.current.size() == size_t(6) * natoms_;
@@ -285,8 +296,10 @@ void FixFdmCouple::final_integrate()
   // Steps 3-7 of the algorithm (4.3) seen from the particles: once per time step, after LIGGGHTS
   // has summed every force. Rank 0 talks to the fluid and solves; the result is broadcast.
   double t0 = MPI_Wtime();
+  Profile::Clock::time_point t = Profile::now();
   Particles particles;
   gather(particles);
+  run_.parts.lap(Profile::gatherScatter, t);
   run_.gatherScatter += MPI_Wtime() - t0;
   t0 = MPI_Wtime();
   solve_.solverIterations = 0;
@@ -302,11 +315,15 @@ void FixFdmCouple::final_integrate()
         exchangeWithFluid(particles);
       } else {
         t0 = MPI_Wtime();
+        const double timedBefore = run_.parts.timed();
         if (options_.hasFluid())
           solve_.heldStep(particles, step, schedule_.lastFluidStep(), plan_.current, heldDrag_);
         else
           solve_.noFluidStep(particles, step, 0.5 * (domain->boxlo[1] + domain->boxhi[1]), options_.backgroundShear);
-        run_.solve += MPI_Wtime() - t0;
+        const double seconds = MPI_Wtime() - t0;
+        run_.solve += seconds;
+        // the drag's volumes and targets around the timed parts of Eq. (31)
+        run_.parts.add(Profile::systemSolves, std::max(0.0, seconds - (run_.parts.timed() - timedBefore)));
       }
       if (!options_.wallFile.empty()) writeWallLoads();
     } catch (const std::exception &e) {
@@ -315,11 +332,15 @@ void FixFdmCouple::final_integrate()
   }
   if (options_.move && comm->me == 0) {
     t0 = MPI_Wtime();
+    t = Profile::now();
     planNextMove(particles);
+    run_.parts.lap(Profile::positionUpdate, t);
     run_.solve += MPI_Wtime() - t0;
   }
   t0 = MPI_Wtime();
+  t = Profile::now();
   scatter();
+  run_.parts.lap(Profile::gatherScatter, t);
   run_.gatherScatter += MPI_Wtime() - t0;
   run_.steps++;
   if (fluidStep) {
@@ -338,10 +359,14 @@ void FixFdmCouple::exchangeWithFluid(const Particles &particles)
   const bigint step = update->ntimestep;
   const cpl::Step message = fdm::FluidExchange::makeStep(particles, box(), step, schedule_.span(step, update->dt),
                                                          update->laststep, checkpointDue(), plan_.current);
+  const double timedBefore = run_.parts.timed();
   const fdm::FluidExchange::Seconds seconds =
       fdm::FluidExchange(*connection, natoms_, options_.stresslets).run(message, solve_.exchangeHandlers(particles));
   run_.exchange += seconds.exchange;
   run_.solve += seconds.handlers;
+  // the handlers' copies of the messages around the timed parts of Eq. (31)
+  run_.parts.add(Profile::systemSolves, std::max(0.0, seconds.handlers - (run_.parts.timed() - timedBefore)));
+  run_.parts.add(Profile::fluidExchange, seconds.exchange);
 }
 
 void FixFdmCouple::writeWallLoads()
@@ -456,13 +481,23 @@ void FixFdmCouple::fillPerAtomArray()
 void FixFdmCouple::post_run()
 {
   const double now = MPI_Wtime();
+  if (pair_) run_.parts.add(Profile::contact, pair_->takeContactSeconds());
+  // LIGGGHTS's own timers of this run's loop (its Timer, zeroed before the loop; read before Finish)
+  Profile::LiggghtsTimers liggghts;
+  liggghts.neighbour = timer->array[TIME_NEIGHBOR];
+  liggghts.communication = timer->array[TIME_COMM];
+  liggghts.output = timer->array[TIME_OUTPUT];
+  run_.parts.addLiggghts(liggghts);
   session_.addRun(run_.steps, run_.solve, run_.exchange, run_.gatherScatter);
+  session_.addProfile(run_.parts, run_.fluidSteps);
   if (comm->me == 0) {
     const fdm::TimingContext c = {fdm::ParticleVelocitySystem::solverName(options_.solver), options_.adamsBashforth,
                                   options_.gapUpdate, options_.contactChord && pair_ && pair_->implicitContact(),
                                   pairBlocks_, wallBlocks_, contacts_, solve_.notConverged, options_.fluidEvery,
                                   options_.heldExtrapolated};
-    const std::string line = fdm::timingLine("of this run", run_, now - runStart_, 1, c);
+    const std::string line = fdm::timingLine("of this run", run_, now - runStart_, 1, c) +
+                             run_.parts.report("this run", session_.whoseProfile(comm->nprocs), now - runStart_,
+                                               run_.steps, run_.fluidSteps);
     if (screen) fputs(line.c_str(), screen);
     if (logfile) fputs(line.c_str(), logfile);
   }

@@ -25,7 +25,8 @@
    (couple_options.h), the configuration checks (configuration_checks.h), the exchange with the fluid
    (fluid_exchange.h), Eq. (31) within a step (coupled_velocity_solve.h), the steps between fluid steps
    (fluid_step_schedule.h, held_drag.h), the position update (position_update.h), the wall loads
-   (wall_loads_file.h) and the timing line (coupling_timing.h).
+   (wall_loads_file.h), the timing line (coupling_timing.h) and the breakdown of the particle step
+   (particle_step_profile.h).
 
    Outputs (docs/dem.md): global vector [inner iterations, lambda residual, particle-solve seconds,
    exchange seconds, linear-solver iterations, sub-grid pair blocks, wall blocks, contacts] of the
@@ -72,6 +73,7 @@ class FixFdmCouple : public Fix {
 
  private:
   using Particles = std::vector<fdm::GatheredParticle>;
+  using Profile = fdm::ParticleStepProfile;
 
   void gather(Particles &particles);
   fdm::ParticleBox box() const;

@@ -26,6 +26,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -623,8 +624,17 @@ void PairFdmSubgrid::compute(int eflag, int vflag)
       for (int c = 0; c < 6; c++) contactStress_[i][c] = 0.0;
   }
   if (!contactActive()) return;  // lubrication is no force here: it is R^SG in Eq. (31)
+  const auto start = std::chrono::steady_clock::now();
   contactForces();
   if (!walls_.empty()) wallContactForces();
+  contactSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double PairFdmSubgrid::takeContactSeconds()
+{
+  const double seconds = contactSeconds_;
+  contactSeconds_ = 0;
+  return seconds;
 }
 
 void PairFdmSubgrid::addContactStress(int i, const double force[3], const double branch[3], double weight)

@@ -89,6 +89,9 @@ class PairFdmSubgrid : public Pair {
   // contact force on the particles; 3 per wall, in the order of walls()), for fix fdm/couple's wall
   // loads (the momentum balance of a sheared suspension, docs/profiles.md).
   const std::vector<double> &wallContactLoads() const { return wallContactLoads_; }
+  // Wall-clock seconds of this rank's contact forces (compute) since the last call, which resets them
+  // (fix fdm/couple's breakdown of the particle step)
+  double takeContactSeconds();
   // Contacts (pair and wall) found by this rank in the last compute.
   long contactsLast() const { return contactsLast_; }
   // The deepest overlap of two spheres this rank's last compute found: depth = -gap/min(a_i, a_j)
@@ -146,6 +149,7 @@ class PairFdmSubgrid : public Pair {
   int nmaxStress_;
   double **contactStress_;
   long contactsLast_;
+  double contactSeconds_ = 0;
   Overlap deepest_;
   std::vector<double> wallContactLoads_;  // 3 per wall: force of the contacts on the wall (this rank)
   bool reported_;

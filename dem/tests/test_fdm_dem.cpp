@@ -157,6 +157,12 @@ TEST(FdmDEM, VelocitiesAreTheAnalyticSolutionOfEq31)
     expectContains(run.output, "fdm/couple timing of this run (1 run, 2 steps");
     expectContains(run.output, "particle solve");
     expectContains(run.output, "fdm/couple timing total (1 run, 2 steps");
+    // the breakdown of the particle step, after each run and for the session (rank 0's)
+    expectContains(run.output, "fdm/couple particle step by part (this run; one rank; 2 steps, 2 with the fluid");
+    expectContains(run.output, "fdm/couple particle step by part (total, coupled; one rank; 2 steps");
+    expectContains(run.output, "    Eq. 31 solves");
+    expectContains(run.output, "    exchange incl. fluid (waiting)");
+    expectContains(run.output, "      of which neighbour lists");
 }
 
 TEST(FdmDEM, MoveNoHoldsTheParticlesAndTheConnectionOutlivesARun)
@@ -176,6 +182,7 @@ TEST(FdmDEM, MoveNoHoldsTheParticlesAndTheConnectionOutlivesARun)
     EXPECT_EQ(fluid.steps[3].particles[0].x[0], 3.25);
     EXPECT_EQ(fluid.steps[3].step, 4u);
     expectContains(run.output, "fdm/couple timing total (3 runs, 4 steps");
+    expectContains(run.output, "fdm/couple particle step by part (total, coupled; one rank; 4 steps, 4 with the fluid");
 }
 
 TEST(FdmDEM, TwoRanksGiveTheSameVelocitiesAsOne)
