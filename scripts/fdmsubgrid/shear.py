@@ -301,6 +301,14 @@ def viscosity_curve(results: list[dict], figure: str | None = None) -> dict:
                 chi2=fit.chi2, dof=fit.dof, runs=len(results))
 
 
+def command(argv: list[str] | None = None) -> int:
+    """The fdmProfiles command (pyproject.toml's [project.scripts], scripts/fdmProfiles): main() with the
+    exit status a command gives (0; argparse's 2 on bad options), not main's results, which
+    sys.exit would print and turn into the status 1."""
+    main(argv)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> list[dict]:
     """fdmProfiles RUN_DIR [RUN_DIR ...]: the profiles and rheology of sheared-suspension runs."""
     p = argparse.ArgumentParser(
