@@ -1,4 +1,5 @@
-"""The direct solver for box meshes (FFTBox, fluid/boxSolvers) inside fdmFoam: on every kind of box the
+"""The direct solver for box meshes (FFTBox, fluid/boxSolvers) inside fdmFoam, for p and U (the cases'
+linear_solver "FFTBox-all"; their default leaves U to symGaussSeidel): on every kind of box the
 cases write it solves the real OpenFOAM matrices to round-off in one iteration (the residual is
 OpenFOAM's own, of the matrix it was given), the coupled answer is the iterative solvers' one, and
 where it cannot solve (walls on two pairs of faces, a decomposed mesh) it says why and the fallback
@@ -68,13 +69,13 @@ def test_direct_solve_is_exact_where_no_steady_answer_is_compared(tmp_path, env,
     # the mean pressure gradient along slip walls or through a fully periodic box has no steady flow to
     # compare (nothing holds the fluid back but the sphere): the solves are checked, not the answer;
     # with slip walls the wall-normal velocity component has a matrix of its own
-    log, _ = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox", tol_lambda=1e-3)
+    log, _ = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all", tol_lambda=1e-3)
     assert_every_solve_exact(log)
 
 
 @pytest.mark.parametrize("name", ["moving walls across y", "walls across z"])
 def test_direct_solve_is_exact_and_gives_the_iterative_answer(tmp_path, env, name):
-    log, direct = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox")
+    log, direct = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all")
     assert_every_solve_exact(log)
     log_iterative, iterative = run_free_sphere(tmp_path, name, BOXES[name], "GAMG")
     scale = np.abs(velocities(iterative)).max()
@@ -83,7 +84,7 @@ def test_direct_solve_is_exact_and_gives_the_iterative_answer(tmp_path, env, nam
 
 def test_walls_on_two_pairs_of_faces_fall_back_with_the_reason(tmp_path, env):
     name = "walls across y and z"
-    log, fallback = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox")
+    log, fallback = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all")
     assert ("FFTBox: p is solved by GAMG (the fallback): walls across y and z: FFTBox solves boxes with walls "
             "on at most one pair of faces") in log, log[-3000:]
     assert "FFTBox: Ux is solved by smoothSolver (the fallback)" in log

@@ -52,7 +52,7 @@ def test_installed_by_pip_with_its_command():
     assert os.path.samefile(fields["Editable project location"], os.path.join(PROJECT, "scripts")), show.stdout
     # the command pip wrote beside the interpreter (or in the user's bin folder for a user install)
     commands = [e for e in importlib.metadata.entry_points(group="console_scripts") if e.name == "fdmProfiles"]
-    assert commands and commands[0].value == "fdmsubgrid.shear:main"
+    assert commands and commands[0].value == "fdmsubgrid.shear:command"
     folders = (sysconfig.get_paths()["scripts"], os.path.join(site.getuserbase(), "bin"))
     assert any(os.access(os.path.join(d, "fdmProfiles"), os.X_OK) for d in folders), folders
 

@@ -101,7 +101,8 @@ def main(argv: list[str] | None = None) -> list[dict]:
         timing = r["timing"] or {}
         update = ""
         for line in r["log"].splitlines():
-            if "position update" in line:
+            # the timing line's counts (not the particle-step breakdown's "position update" row)
+            if "position update" in line and line.startswith("fdm/couple timing"):
                 update = line[line.index("position update"):].strip()
         row = dict(variant=name, **s, completed=r["completed"], steps=int(len(speed)),
                    max_speed=float(speed.max()) if len(speed) else None, min_pair_gap=pair, min_wall_gap=wall,

@@ -53,17 +53,24 @@ class Box:
         return [f == "cyclic" for f in self.faces]
 
 
-# The fvSolution lines of each linear-solver choice, (p, U): FFTBox solves the box meshes every case
-# writes directly (fluid/boxSolvers) and hands any other mesh to its fallback
+# The fvSolution lines of each linear-solver choice, (p, U). FFTBox solves the box meshes every case
+# writes directly (fluid/boxSolvers) and hands any other mesh to its fallback. "FFTBox" (the default)
+# solves p so and leaves U's loose momentum predictor (relTol 0.3 in the suspension scenes) to a sweep or
+# two of symGaussSeidel, which cost less than an exact solve and take no more inner iterations (Table 8
+# scene phi 0.37: 94 against 98, 52 against about 140 ms of momentum solve per inner iteration;
+# docs/benchmarks.md, "Direct solver for box meshes"); "FFTBox-all" solves U with FFTBox too.
+_FFTBOX = """        solver          FFTBox;
+        fallback        { solver GAMG; smoother GaussSeidel; }"""
+_FFTBOX_U = """        solver          FFTBox;
+        fallback        { solver smoothSolver; smoother symGaussSeidel; }"""
+_GAMG = """        solver          GAMG;
+        smoother        GaussSeidel;"""
+_SYMMETRIC_GAUSS_SEIDEL = """        solver          smoothSolver;
+        smoother        symGaussSeidel;"""
 LINEAR_SOLVERS = {
-    "FFTBox": ("""        solver          FFTBox;
-        fallback        { solver GAMG; smoother GaussSeidel; }""",
-               """        solver          FFTBox;
-        fallback        { solver smoothSolver; smoother symGaussSeidel; }"""),
-    "GAMG": ("""        solver          GAMG;
-        smoother        GaussSeidel;""",
-             """        solver          smoothSolver;
-        smoother        symGaussSeidel;"""),
+    "FFTBox": (_FFTBOX, _SYMMETRIC_GAUSS_SEIDEL),
+    "FFTBox-all": (_FFTBOX, _FFTBOX_U),
+    "GAMG": (_GAMG, _SYMMETRIC_GAUSS_SEIDEL),
 }
 # FDM_LINEAR_SOLVER=GAMG in the environment writes every case with the iterative solvers instead (for a
 # side-by-side comparison; docs/fluid.md, "Direct solver for box meshes")
@@ -76,7 +83,7 @@ if DEFAULT_LINEAR_SOLVER not in LINEAR_SOLVERS:
 # and 98), but a step stopped at the same tolLambda is further from the answer: the mirror images of
 # cases/pairPoiseuille then differ by more than their 2e-4 U_c (docs/benchmarks.md, "Direct solver for
 # box meshes"). momentum_predictor=False in write_fluid_case turns it off.
-MOMENTUM_PREDICTOR = {"FFTBox": True, "GAMG": True}
+MOMENTUM_PREDICTOR = {"FFTBox": True, "FFTBox-all": True, "GAMG": True}
 
 
 def write_control_dict(case_dir, application="fdmFoam", write_interval=100000, end_time=None, delta_t=None):
