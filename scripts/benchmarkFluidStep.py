@@ -110,7 +110,12 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     workdir = args.workdir or tempfile.mkdtemp(prefix="fdm-fluidstep-")
 
-    summary = dict(command="python3 scripts/benchmarkFluidStep.py " + " ".join(argv or sys.argv[1:]),
+    # the command as given, its work folder left out (a folder of this machine)
+    given = list(argv or sys.argv[1:])
+    if "--workdir" in given:
+        i = given.index("--workdir")
+        del given[i:i + 2]
+    summary = dict(command="python3 scripts/benchmarkFluidStep.py " + " ".join(given),
                    commit=subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], text=True,
                                          stdout=subprocess.PIPE).stdout.strip(),
                    machine=dict(cores=os.cpu_count(), load_average_start=load_average()), scenes={})
