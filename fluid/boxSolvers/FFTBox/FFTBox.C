@@ -294,13 +294,11 @@ Foam::FFTBox::FFTBox
         solverControls
     ),
     maxDeparture_(controlDict_.lookupOrDefault<scalar>("maxDeparture", 0.5)),
-    measurePlans_
-    (
-        controlDict_.lookupOrDefault<word>("fftwPlanning", "estimate") == "measure"
-    )
+    measurePlans_(false)
 {
     const word planning(controlDict_.lookupOrDefault<word>("fftwPlanning", "estimate"));
-    if (planning != "estimate" && planning != "measure")
+    measurePlans_ = (planning == "measure");
+    if (planning != "estimate" && !measurePlans_)
     {
         FatalIOErrorInFunction(controlDict_)
             << "FFTBox for " << fieldName << ": fftwPlanning " << planning
