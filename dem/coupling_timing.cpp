@@ -10,12 +10,13 @@ std::string timingLine(const char *what, const CouplingTiming &t, double wall, i
   const double percent = wall > 0 ? 100.0 / wall : 0.0;
   std::string gapStats = " (gap_update none)";
   if (c.gapUpdate) {
-    char g[300];
+    char g[400];
     std::snprintf(g, sizeof g, " with log gaps: %.3g gap targets and %.3g held contact gaps per step, at most %d "
                   "sweeps, %ld limited, %ld steps with contradictory targets (straight, gaps kept above their "
-                  "bounds to %.2g)",
+                  "bounds to %.2g), %ld steps whose compromise was pushed back to the bounds (by up to %.2g of a gap)",
                   t.steps ? double(t.gapTargets) / t.steps : 0.0, t.steps ? double(t.gapHeld) / t.steps : 0.0,
-                  t.gapSweepsMax, t.gapLimited, t.gapFallbacks, t.gapBoundWorst);
+                  t.gapSweepsMax, t.gapLimited, t.gapFallbacks, t.gapBoundWorst, t.gapCompromisesBounded,
+                  t.gapCompromiseMissMax);
     gapStats = g;
   }
   std::string chordStats;

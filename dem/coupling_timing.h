@@ -24,6 +24,8 @@ struct CouplingTiming {
                                         // straight, every gap kept above its bound)
   int gapSweepsMax = 0;
   double gapBoundWorst = 0;             // largest relative bound violation the fallback left
+  long gapCompromisesBounded = 0;       // steps whose compromise (no fallback) closed a gap below its bound
+  double gapCompromiseMissMax = 0;      // and by how much, at most (relative to the gap)
   long contactSlides = 0;               // contacts that began to slide within their step (Coulomb's law at its end)
   long factorisations = 0;              // of Eq. (31) by the direct solvers: per step, and when the downdates grow too large
   long downdates = 0;                   // contacts that began to slide handled without a factorisation (Woodbury)
@@ -39,6 +41,8 @@ struct CouplingTiming {
     gapHeld += stats.heldGaps;
     gapFallbacks += stats.fallback ? 1 : 0;
     gapBoundWorst = std::max(gapBoundWorst, stats.worstBound);
+    gapCompromisesBounded += stats.compromiseMiss > 0 ? 1 : 0;
+    gapCompromiseMissMax = std::max(gapCompromiseMissMax, stats.compromiseMiss);
     gapSweepsMax = std::max(gapSweepsMax, stats.sweeps);
   }
 };

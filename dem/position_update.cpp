@@ -141,7 +141,8 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
   }
   // One Gauss-Seidel sweep: each gap moved to its target (bounds = false), or, on the fallback,
   // only pushed apart where it is below its bound (bounds = true); returns the largest relative miss
-  const auto sweep = [&](bool bounds) {
+  // slack: on bounds, a gap within slack * scale of its bound is left alone
+  const auto sweep = [&](bool bounds, double slack) {
     double worst = 0;
     for (const Gap &g : gaps) {
       double miss;  // > 0: push apart
@@ -152,7 +153,7 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
       } else {
         miss = (bounds ? g.lower : g.target) - wallGapOf(c, y, g.i, walls[size_t(-1 - g.j)]);
       }
-      if (bounds && miss <= 0) continue;
+      if (bounds && miss <= slack * g.scale) continue;
       if (g.j >= 0) {
         // the smaller sphere (less drag) takes the larger share
         const double ai = c.radius[g.i], aj = c.radius[g.j];
@@ -171,7 +172,7 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
   };
   double previousWorst = HUGE_VAL;
   for (stats.sweeps = 1; stats.sweeps <= o.maxSweeps; stats.sweeps++) {
-    const double worst = sweep(false);
+    const double worst = sweep(false, 0.0);
     stats.worst = worst;
     if (worst <= o.tolerance) break;
     // inconsistent targets (see Options::tolerance): stop once the sweeps no longer gain
@@ -193,7 +194,21 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
     for (int i = 0; i < n; i++)
       for (int k = 0; k < 3; k++) y[3 * i + k] = c.x[3 * i + k] + dt * rate[6 * i + k];
     for (stats.boundSweeps = 1; stats.boundSweeps <= o.maxBoundSweeps; stats.boundSweeps++) {
-      stats.worstBound = sweep(true);
+      stats.worstBound = sweep(true, 0.0);
+      if (stats.worstBound <= o.tolerance) break;
+    }
+    stats.boundSweeps = std::min(stats.boundSweeps, o.maxBoundSweeps);
+  } else if (stats.worst > o.tolerance) {
+    // A compromise between targets that contradict each other mildly (a ring of close pairs
+    // through the periodic box) spreads their misses over every gap of the ring, a held contact
+    // gap too: closed a little further than the springs assumed at every step, it ratcheted into
+    // an overlap the springs could not stop (the channel of cases/poiseuille at step 220: two
+    // spheres 0.05 a1 deep, 0.0017 a1 per step beyond their straight step, docs/dem.md). The
+    // compromise keeps its positions where it meets the bounds of the fallback and is pushed apart
+    // along the lines of centres where it does not.
+    for (stats.boundSweeps = 1; stats.boundSweeps <= o.maxBoundSweeps; stats.boundSweeps++) {
+      stats.worstBound = sweep(true, o.tolerance);
+      if (stats.boundSweeps == 1) stats.compromiseMiss = stats.worstBound;
       if (stats.worstBound <= o.tolerance) break;
     }
     stats.boundSweeps = std::min(stats.boundSweeps, o.maxBoundSweeps);

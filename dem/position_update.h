@@ -17,7 +17,9 @@
    constant force (hdot/h constant), keeps gaps positive at any dt, and differs from the straight
    step by O(dt^3): the scheme stays second order. Where the targets contradict each other (the
    sweeps stall more than half a target off: dense clusters, large dt), the step falls back to the
-   straight step with every gap kept from closing below min(target, h_n). Plain C++ (no LIGGGHTS),
+   straight step with every gap kept from closing below min(target, h_n). A compromise that
+   misses its targets by less is held to the same bounds: it never closes a gap, a held contact gap
+   least of all, below where the fallback would have kept it. Plain C++ (no LIGGGHTS),
    tested in dem/tests/test_position_update.cpp. */
 
 #ifndef FDM_POSITION_UPDATE_H
@@ -72,8 +74,11 @@ struct Statistics {
   double worst = 0;                  // largest |gap - target| / target met in the last sweep
   bool fallback = false;             // the targets could not be met: the straight step, with every gap
                                      // kept from closing below min(target, h_n)
-  int boundSweeps = 0;               // sweeps of the fallback
-  double worstBound = 0;             // largest relative violation of a bound left by the fallback
+  int boundSweeps = 0;               // sweeps of the fallback, or of the bounds of a compromise
+  double worstBound = 0;             // largest relative violation of a bound left by them
+  double compromiseMiss = 0;         // a compromise (no fallback, targets missed by more than the
+                                     // tolerance): its largest relative violation of a bound before
+                                     // the bound sweeps pushed it apart (0: it met them all)
 };
 
 // The displacement rates (6n: translation, rotation) of the step from n to n+1: x_{n+1} = x_n +
