@@ -187,3 +187,33 @@ def test_report_builds_its_tables_from_the_rows_and_names_older_files(tmp_path):
     text = (tmp_path / "r.md").read_text()
     assert "| K (Eq. 40) | L/a 8, a/Δ 5, c 0.3, 64 positions | 1.532059 (+0.11 %) | 1.533 ± 0.002 | 1.532 | +0.07 % |" \
         in text
+
+
+def test_the_suspension_cases_rows_from_shipped_runs():
+    """cases/couette and cases/poiseuille turn a run's record into rows: read from the shipped results of
+    older runs (an older file reads as its data), couette's rows beside the paper's fit of Fig. 21 at the
+    run's own φ_core, poiseuille's the channel's measures."""
+    couette = load_case_module("couette")
+    record = results.read_data(os.path.join(PROJECT, "docs", "data", "validation_table8_phi0.27.json"))["mser_window"]
+    rows = {row.quantity: row for row in couette.validation_rows(record)}
+    assert rows["η_s"].value == record["eta_s"] and rows["η_s"].error == pytest.approx(
+        record["eta_s"] / rows["η_s"].reference - 1)
+    assert rows["stress balance (core against walls)"].percent
+    poiseuille = load_case_module("poiseuille")
+    record = results.read_data(os.path.join(PROJECT, "docs", "data", "validation_poiseuille_L12.json"))
+    rows = {row.quantity: row for row in poiseuille.validation_rows(record)}
+    assert len(rows) == len(poiseuille.MEASURES) and rows["φ at the centre plane"].value == record["phi_center"]
+
+
+def test_contact_tuning_rows():
+    """cases/contactTuning: the stability limits against their estimates; no rows from a partial run."""
+    module = load_case_module("contactTuning")
+    assert module.validation_rows(dict(integrator="ab2", normal={})) == []
+    figures = dict(stability_limits={"pair, lubrication, ab2": dict(dt_measured=0.03, dt_estimate=0.025),
+                                     "wall, lubrication, euler": dict(dt_measured=None, dt_estimate=0.02)},
+                   normal_gap_error=1e-4, normal_force_balance=None)
+    rows = module.validation_rows(dict(integrator="ab2", figures=figures))
+    assert [(r.quantity, r.configuration) for r in rows] == [("stability limit Δt", "pair, lubrication, ab2"),
+                                                             ("normal load: gap error / (F/k_n) (largest)",
+                                                              "integrator ab2")]
+    assert rows[0].error == pytest.approx(0.2)

@@ -175,9 +175,11 @@ def write_results(path: str, script: str, argv: Optional[Sequence[str]], options
 
     script: the case script (its __file__; the case is its name), argv: its options as given (None:
     sys.argv[1:]), options: its parsed options (the scene), rows: what it measured against its
-    references, data: its own record, started: time.time() at its start. Returns data, stamped with
-    wall_seconds and date as the document has them (what the case's main() returns)."""
-    wall_seconds = time.time() - started
+    references, data: its own record, started: time.time() at its start. The document's wall_seconds is
+    data's own where it has one (a suspension's run, analysed later), else the time since started.
+    Returns data, stamped with wall_seconds and date as the document has them (what main() returns)."""
+    # a record that carries its own wall time (a suspension run's, analysed later) keeps it
+    wall_seconds = data.get("wall_seconds") if data.get("wall_seconds") is not None else time.time() - started
     date = time.strftime("%Y-%m-%d")
     document = dict(shape=SHAPE, case=os.path.splitext(os.path.basename(script))[0],
                     command=command_line(script, argv), commit=project_commit(os.path.dirname(os.path.abspath(script))),

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Dict, List, Optional, Sequence
 
 from . import results as results_file
-from . import rheology
+from . import rheology, shear
 from .results import Row, relative
 
 __all__ = ["Case", "CASES", "Row", "relative", "run_report", "collect", "table8_rows", "squeeze_calibration_rows"]
@@ -90,22 +90,9 @@ def table8_rows(summary: dict) -> List[Row]:
     for r in summary.get("rows", []):
         if "eta_s" not in r:
             continue
-        t = r.get("table8") or {}
         config = "φ_bulk %g, %s, %.1f strain units (%s)" % (r["phi_bulk_table8"], "%d particles" % r["n_particles"],
                                                            r["strain_units"], r.get("status", ""))
-        for q, key, paper_key in (("φ_core", "phi_core", "phi_core"),
-                                  ("γ̇_core/γ̇0", "gamma_core_over_gamma0", "gamma_core_over_gamma0")):
-            paper = t.get(paper_key)
-            rows.append(Row(q, config, r[key], paper, "%g (Table 8)" % paper if paper is not None else "—",
-                            relative(r[key], paper), spread=r.get(key + "_err") or r.get(key.split("_over")[0] + "_err")))
-        # Table 8 gives no η_s: the paper's fit of its Fig. 21 (Eq. 55) at this row's own φ_core
-        paper_fit = float(rheology.maron_pierce(r["phi_core"], *rheology.PAPER_MARON_PIERCE))
-        rows.append(Row("η_s", config, r["eta_s"], paper_fit, "%.4g (Fig. 21's fit at φ_core)" % paper_fit,
-                        relative(r["eta_s"], paper_fit), spread=r["eta_s_err"]))
-        rows.append(Row("N̂1", config, r["N1_hat"], spread=r.get("N1_hat_err"), paper="Fig. 22"))
-        rows.append(Row("N̂2", config, r["N2_hat"], spread=r.get("N2_hat_err"), paper="Fig. 22"))
-        rows.append(Row("stress balance (core against walls)", config, r["stress_balance_rel_error"],
-                        percent=True))
+        rows += shear.validation_rows(r, config)
     fit = summary.get("fit")
     if fit:
         for q, key, paper in (("Maron–Pierce α", "alpha", rheology.PAPER_MARON_PIERCE[0]),
