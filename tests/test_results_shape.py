@@ -217,3 +217,20 @@ def test_contact_tuning_rows():
                                                              ("normal load: gap error / (F/k_n) (largest)",
                                                               "integrator ab2")]
     assert rows[0].error == pytest.approx(0.2)
+
+
+def test_a_record_without_rows_still_writes_its_file(tmp_path, capsys):
+    """A case's rows function that cannot read its record (a partial run) costs the rows, not the file."""
+    out = tmp_path / "results.json"
+
+    def rows_of(record):
+        return [Row("K", "c", record["K"])]
+
+    data = results.write_results(str(out), os.path.join(PROJECT, "cases", "periodicArray", "periodicArray.py"), [],
+                                 {}, rows_of, dict(runs=[]), 0.0)
+    read = results.read_results(str(out))
+    assert read.rows == [] and read.data == dict(runs=[]) and data["wall_seconds"] > 0
+    assert "periodicArray.py: no rows from this record (KeyError: 'K')" in capsys.readouterr().err
+    results.write_results(str(out), os.path.join(PROJECT, "cases", "periodicArray", "periodicArray.py"), [], {},
+                          rows_of, dict(K=1.5), 0.0)
+    assert results.read_results(str(out)).rows == [Row("K", "c", 1.5)]

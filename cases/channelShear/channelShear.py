@@ -339,7 +339,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
     results = dict(case="channelShear", size_over_a=args.size, a_over_delta=args.a_over_delta,
                    positions=args.positions, tol_lambda=args.tol_lambda, model=args.model,
                    rows=rows)
-    write_results(args.out, __file__, argv, args, validation_rows(results), results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_channelShear.png")
     plot(rows, png, "Free sphere at the centre of a sheared channel: walls %g a x %g a, a1/Delta = %g, %d positions"
          % (args.size[0], args.size[1], args.a_over_delta, args.positions))

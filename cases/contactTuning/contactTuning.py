@@ -1019,7 +1019,7 @@ def main(argv=None):
         results["implicit"] = implicit_study(res, args.workdir, args.jobs)
     if len(parts) == 3 and "implicit" not in parts:
         results["figures"] = summarise(results)
-    write_results(args.out, __file__, argv, args, validation_rows(results), results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if len(parts) == 3 and "implicit" not in parts:
         print_report(results)
         plot(results, os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_contactTuning.png"))

@@ -49,7 +49,7 @@ def validation_rows(results: dict) -> list[Row]:
 def results_writer(argv: list[str] | None, args: argparse.Namespace, started: float):
     """shear.report's writer of this case: results.json in the one shape (fdmsubgrid.results)."""
     def write(out: str, results: dict) -> None:
-        write_results(out, __file__, argv, args, validation_rows(results), results, started)
+        write_results(out, __file__, argv, args, validation_rows, results, started)
     return write
 
 

@@ -594,7 +594,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                                           e["nearest"]["xi"], e["nearest"]["Un"],
                                           "-" if e["nearest"]["Un_ratio"] is None else
                                           "%.4f" % e["nearest"]["Un_ratio"]))
-    write_results(args.out, __file__, argv, args, [] if args.convergence else validation_rows(out), out, t0)
+    write_results(args.out, __file__, argv, args, None if args.convergence else validation_rows, out, t0)
     if not args.no_plot and not args.convergence:
         png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_pairPoiseuille.png")
         plot(scenes, png)

@@ -276,7 +276,7 @@ def main(argv=None):
         results["trajectories"].append(t)
         results["summaries"].append(s)
         print(json.dumps(s))
-    write_results(args.out, __file__, argv, args, validation_rows(results), results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     plot(results, os.path.join(os.path.dirname(args.out), "results_pairShear.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))
     return results

@@ -104,7 +104,7 @@ def main(argv=None):
             for xi, v, ref, e in zip(args.xi, r["velocity"], reference, r["rel_error"]):
                 print("  xi %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (xi, v, ref, 100 * e))
         results["cases"].append(entry)
-    write_results(args.out, __file__, argv, args, validation_rows(results), results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if "nosubgrid" in results["cases"][0]:
         plot(results, os.path.join(os.path.dirname(args.out), "results_pairSqueeze.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))

@@ -116,7 +116,7 @@ def main(argv=None):
         fig = os.path.splitext(args.out)[0] + "_K_vs_L.png"
         plot(results, fig)
         summary["figures"].append(os.path.basename(fig))
-    write_results(args.out, __file__, argv, args, validation_rows(summary), summary, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, summary, t0)
     print("wrote %s" % args.out)
     return 0
 

@@ -191,7 +191,7 @@ def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional
     figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_poiseuille.png")
     poiseuille.plot(figure, fig)
     results["figure"] = os.path.basename(figure)
-    write_results(out, __file__, argv, options if options is not None else {}, validation_rows(results), results,
+    write_results(out, __file__, argv, options if options is not None else {}, validation_rows, results,
                   started)
     for k in ("phi_bulk", "time", "steady_from", "phi_center", "phi_center_initial", "phi_wall_layer",
               "jammed_width_over_a1", "u_center_star", "shear_stress_linearity_rel_error",

@@ -637,7 +637,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                    n_positions=represented, offsets=[list(o) for o in offsets], subgrid=args.subgrid,
                    model=args.model, cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda,
                    staben=staben)
-    write_results(args.out, __file__, argv, args, [] if args.convergence else validation_rows(out), out, t0)
+    write_results(args.out, __file__, argv, args, None if args.convergence else validation_rows, out, t0)
     if not args.no_plot and not args.convergence:
         png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_poiseuilleSphere.png")
         plot(rows, png, staben)

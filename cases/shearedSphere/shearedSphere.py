@@ -158,7 +158,7 @@ def main(argv=None) -> dict:
                 % (len(group), averages[-1]["S_star"], averages[-1]["S_star_min"], averages[-1]["S_star_max"],
                    averages[-1]["omega_z_over_minus_half_gamma"]))
     results = dict(case="shearedSphere", runs=runs, averages=averages)
-    write_results(args.out, __file__, argv, args, validation_rows(results), results, started)
+    write_results(args.out, __file__, argv, args, validation_rows, results, started)
     print("wrote", args.out)
     return results
 

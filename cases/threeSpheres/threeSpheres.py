@@ -478,7 +478,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                n_positions=represented, offsets=[list(o) for o in offsets], subgrid=args.subgrid, model=args.model,
                cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda, single=results[0]["single"],
                far_field=results[0]["far_field"], boxes=results, box_comparison=comparison)
-    write_results(args.out, __file__, argv, args, validation_rows(out), out, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, out, t0)
     print("wrote %s (%.0f s)" % (args.out, out["wall_seconds"]))
     return out
 

@@ -456,7 +456,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                radii=args.radius, subgrid_modes=subgrid_modes, model=args.model, cutoff_cells=args.cutoff or "default",
                wall_cutoff_cells=args.wall_cutoff or "default", tol_lambda=args.tol_lambda, boxes=results,
                box_comparison=comparison)
-    write_results(args.out, __file__, argv, args, validation_rows(out), out, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, out, t0)
     png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_wallShear.png")
     plot(results[0]["rows"], png, "Free sphere in shear near a wall (paper 5.2.1): box %g x %g x %g a1, a1/Delta %g, "
          "%d offsets" % (*results[0]["box"], args.a_over_delta, represented))

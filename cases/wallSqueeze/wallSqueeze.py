@@ -97,7 +97,7 @@ def main(argv=None):
         print("sub-grid %s: %.0f s" % ("on" if subgrid else "off", r["wall_seconds"]))
         for eps, v, ref, e in zip(args.eps, r["velocity"], reference, r["rel_error"]):
             print("  eps %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (eps, v, ref, 100 * e))
-    write_results(args.out, __file__, argv, args, validation_rows(results), results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if "nosubgrid" in results:
         plot(results, os.path.join(os.path.dirname(args.out), "results_wallSqueeze.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))

@@ -51,7 +51,7 @@ import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any, Dict, Iterable, List, Optional, Sequence
+from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Union
 
 from . import files
 
@@ -169,22 +169,32 @@ def json_value(value: Any) -> Any:
     raise TypeError("%s is not JSON serialisable" % type(value).__name__)
 
 
-def write_results(path: str, script: str, argv: Optional[Sequence[str]], options: Any, rows: Iterable[Row],
+def write_results(path: str, script: str, argv: Optional[Sequence[str]], options: Any,
+                  rows: Union[Iterable[Row], Callable[[Dict[str, Any]], Iterable[Row]], None],
                   data: Dict[str, Any], started: float) -> Dict[str, Any]:
     """Write a case's results file in the one shape (module docstring), whole or not at all.
 
     script: the case script (its __file__; the case is its name), argv: its options as given (None:
     sys.argv[1:]), options: its parsed options (the scene), rows: what it measured against its
-    references, data: its own record, started: time.time() at its start. The document's wall_seconds is
+    references, or the case's function that makes them from data (a record it cannot read, e.g. of a
+    partial run, then gives a file without rows and a line on stderr rather than no file), data: its
+    own record, started: time.time() at its start. The document's wall_seconds is
     data's own where it has one (a suspension's run, analysed later), else the time since started.
     Returns data, stamped with wall_seconds and date as the document has them (what main() returns)."""
     # a record that carries its own wall time (a suspension run's, analysed later) keeps it
+    if callable(rows):
+        try:
+            rows = list(rows(data))
+        except (KeyError, IndexError, TypeError, ValueError) as exc:
+            print("%s: no rows from this record (%s: %s); %s written without them"
+                  % (os.path.basename(script), type(exc).__name__, exc, path), file=sys.stderr)
+            rows = []
     wall_seconds = data.get("wall_seconds") if data.get("wall_seconds") is not None else time.time() - started
     date = time.strftime("%Y-%m-%d")
     document = dict(shape=SHAPE, case=os.path.splitext(os.path.basename(script))[0],
                     command=command_line(script, argv), commit=project_commit(os.path.dirname(os.path.abspath(script))),
                     date=date, wall_seconds=wall_seconds, scene=scene_of(options, script),
-                    rows=[asdict(row) for row in rows],
+                    rows=[asdict(row) for row in rows or []],
                     data={k: v for k, v in data.items() if k not in ("wall_seconds", "date")})
     files.write_json(path, document, default=json_value)
     data["wall_seconds"] = wall_seconds
