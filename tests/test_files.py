@@ -8,12 +8,18 @@ from fdmsubgrid import files
 
 
 def test_write_results_stamps_wall_time_and_date_and_round_trips(tmp_path):
+    """A case's results file (fdmsubgrid.results, written through files.write_json): stamped with the
+    wall time and the date, whole, its folder made."""
+    import os
+    from conftest import PROJECT
+    from fdmsubgrid import results as results_file
     out = tmp_path / "deeper" / "results.json"          # the folder is made
     started = time.time() - 2.5
-    results = files.write_results(str(out), dict(case="demo", rows=[dict(eps=0.1, U=0.7389)]), started)
-    assert 2.5 <= results["wall_seconds"] < 60
-    assert results["date"] == time.strftime("%Y-%m-%d")
-    assert json.loads(out.read_text()) == results
+    script = os.path.join(PROJECT, "cases", "wallSqueeze", "wallSqueeze.py")
+    data = results_file.write_results(str(out), script, [], {}, [], dict(case="demo", eps=[0.1], U=[0.7389]), started)
+    assert 2.5 <= data["wall_seconds"] < 60
+    assert data["date"] == time.strftime("%Y-%m-%d")
+    assert results_file.read_data(str(out)) == data
     assert not (tmp_path / "deeper" / "results.json.tmp").exists()
 
 

@@ -17,7 +17,7 @@ PROJECT = os.path.dirname(TESTS)
 MODULES = ("calibration", "case", "cellpositions", "channelscenes", "checkpoint", "cli", "contacts", "convergence",
            "couettescene", "decomposition", "deminput", "demonly", "environment", "files", "foamcase", "output",
            "packing", "pairshearstresslet", "pairstresslet", "pairtangential", "periodicarray", "poiseuille",
-           "profiles", "rheology", "runner", "sbm", "shear", "squeeze", "suspension", "theory", "timeseries",
+           "profiles", "results", "rheology", "runner", "sbm", "shear", "squeeze", "suspension", "theory", "timeseries",
            "validation", "wallcalibration")
 
 

@@ -50,11 +50,12 @@ import math
 import os
 import shutil
 import time
-from typing import Sequence
+from typing import List, Sequence
 
 import numpy as np
 
-from fdmsubgrid import case, channelscenes, files, output, theory
+from fdmsubgrid import case, channelscenes, output, theory
+from fdmsubgrid.results import Row, relative, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -259,6 +260,23 @@ def print_row(r: dict) -> None:
              r["n_computed"], ",".join(str(n) for n in r["inner_iterations"]), r["wall_seconds"]), flush=True)
 
 
+def validation_rows(r: dict) -> List[Row]:
+    """Omega_z/(-gamma/2) and S* at the centre of a channel against H/a; no tabulated reference (Sangani et
+    al.'s numbers are not available): the unbounded limit 1 is the reference from H/a = 10 on."""
+    rows = []
+    for row in r["rows"]:
+        config = "a %g, H/a %.4g, %s, box %s a, a/Δ %g, %d positions" % (
+            row["radius"], row["H_over_a"], "sub-grid on" if row["subgrid"] else "FDM alone",
+            "×".join("%g" % v for v in row["box"]), row["a_over_delta_sphere"], row["n_positions"])
+        wide = row["H_over_a"] >= 10
+        for q, key in (("Ω_z/(−γ̇/2)", "Wz_norm"), ("S*", "S_star")):
+            rows.append(Row(q + (" (unbounded: 1)" if wide else ""), config, row[key], 1.0 if wide else None,
+                            "Fig. 10 (Sangani et al. 2011); Ω oscillates ≤ 3 % over positions",
+                            relative(row[key], 1.0) if wide else None, spread=row[key + "_std"] or None,
+                            headline=row["subgrid"]))
+    return rows
+
+
 def main(argv: Sequence[str] | None = None) -> dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--H-over-a", type=float, nargs="+", default=None, metavar="H",
@@ -321,7 +339,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
     results = dict(case="channelShear", size_over_a=args.size, a_over_delta=args.a_over_delta,
                    positions=args.positions, tol_lambda=args.tol_lambda, model=args.model,
                    rows=rows)
-    files.write_results(args.out, results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_channelShear.png")
     plot(rows, png, "Free sphere at the centre of a sheared channel: walls %g a x %g a, a1/Delta = %g, %d positions"
          % (args.size[0], args.size[1], args.a_over_delta, args.positions))

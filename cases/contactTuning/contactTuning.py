@@ -30,18 +30,19 @@ Writes results.json and results_contactTuning.png here; run folders go to runs/.
 """
 import argparse
 import concurrent.futures
-import json
 import math
 import os
 import re
 import shutil
 import threading
 import time
+from typing import List
 
 import numpy as np
 
 from fdmsubgrid import theory
 from fdmsubgrid.demonly import fdmdem, run_in
+from fdmsubgrid.results import Row, relative, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
@@ -955,12 +956,26 @@ def print_report(results):
             g["factor_theory"], g["label"], g.get("min_gap", float("nan")), g.get("max_gap", float("nan"))))
 
 
-def _json_default(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError("%r is not JSON serialisable" % (o,))
+def validation_rows(results: dict) -> List[Row]:
+    """The named figures (summarise) as rows of fdmsubgrid.results: the stability limits of the time step
+    against their estimates (docs/contact.md), and the largest relative errors of the sweeps against the
+    contact model's own prediction. None without the three parts (--only)."""
+    figures = results.get("figures")
+    if not figures:
+        return []
+    rows = []
+    for name, limit in figures["stability_limits"].items():
+        if limit["dt_measured"] is not None:
+            rows.append(Row("stability limit Δt", name, limit["dt_measured"], limit["dt_estimate"],
+                            error=relative(limit["dt_measured"], limit["dt_estimate"])))
+    for key, quantity in (("normal_gap_error", "normal load: gap error / (F/k_n) (largest)"),
+                          ("normal_force_balance", "normal load: |F1 + F2|/F (largest)"),
+                          ("sliding_force_ratio", "sliding: |F_t/(μ F_n) − 1| (largest)"),
+                          ("sliding_speed_error", "sliding: speed against the prediction (largest)"),
+                          ("stick_force_error", "sticking: |F_t/F − 1| (largest)")):
+        if figures.get(key) is not None:
+            rows.append(Row(quantity, "integrator %s" % results["integrator"], figures[key]))
+    return rows
 
 
 def main(argv=None):
@@ -1004,9 +1019,7 @@ def main(argv=None):
         results["implicit"] = implicit_study(res, args.workdir, args.jobs)
     if len(parts) == 3 and "implicit" not in parts:
         results["figures"] = summarise(results)
-    results["wall_seconds"] = time.time() - t0
-    with open(args.out, "w") as f:
-        json.dump(results, f, indent=1, default=_json_default)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if len(parts) == 3 and "implicit" not in parts:
         print_report(results)
         plot(results, os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_contactTuning.png"))

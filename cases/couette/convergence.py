@@ -20,6 +20,8 @@ import subprocess
 import sys
 from typing import Dict, List, Tuple
 
+from fdmsubgrid import results
+
 TOL_LAMBDA = 1e-3   # the case's default
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
@@ -48,8 +50,7 @@ def run_one(a_over_delta: int, dt: float, tol_lambda: float, args: argparse.Name
                "--seed", str(args.seed), "--tol-lambda", str(tol_lambda), "--workdir", os.path.join(args.workdir, name), "--out", out, "--overwrite"]
         print("running:", " ".join(cmd), flush=True)
         subprocess.run(cmd, check=True)
-    with open(out) as f:
-        r = json.load(f)
+    r = results.read_data(out)
     return {k: r.get(k) for k in KEYS} | {"a_over_delta": a_over_delta, "tol_lambda": tol_lambda, "run": name}
 
 

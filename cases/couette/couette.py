@@ -26,15 +26,31 @@ Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png her
 
 import argparse
 import os
+import time
 from dataclasses import asdict
 
 from fdmsubgrid import case, shear, suspension
+from fdmsubgrid.results import Row, write_results
 from fdmsubgrid.couettescene import (A1, A2, ETA, FRICTION, MEASURED_DT_LIMITS, MEASURED_FLUID_DT,  # noqa: F401
                                      ROUGHNESS, SHEAR_RATE, TABLE8, UncalibratedScene, choose_springs, fluid_dt,
                                      fluid_every, largest_good_dt, measured_reference, table8_row,
                                      time_step_warning, write_case, write_run)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def validation_rows(results: dict) -> list[Row]:
+    """The run's rows (fdmsubgrid.results): phi_core, gamma_core/gamma0 (beside Table 8 for its scenes),
+    eta_s beside the paper's fit of Fig. 21 at phi_core, N1, N2 and the stress balance."""
+    return shear.validation_rows(results, "φ_bulk %g, %d particles, %.1f strain units" % (
+        results["phi_bulk"], results["n_particles"], results["strain_units"]))
+
+
+def results_writer(argv: list[str] | None, args: argparse.Namespace, started: float):
+    """shear.report's writer of this case: results.json in the one shape (fdmsubgrid.results)."""
+    def write(out: str, results: dict) -> None:
+        write_results(out, __file__, argv, args, validation_rows, results, started)
+    return write
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -75,6 +91,7 @@ def main(argv: list[str] | None = None) -> dict:
                    help="analyse this run folder as it stands (a resumed, stopped or running run) and write --out")
     case.add_run_options(p, HERE, tol_lambda=1e-3, model=True)
     args = p.parse_args(argv)
+    started = time.time()
 
     if args.analyse:
         # a run folder as it stands (finished, stopped or still going): its own files say the scene
@@ -85,7 +102,8 @@ def main(argv: list[str] | None = None) -> dict:
         if name.startswith("table8_"):
             table8 = table8_row(min(TABLE8, key=lambda k: abs(k - run.packing.phi)))
         return shear.report(run, args.out, dict(case="couette", run=name, run_dir=os.path.abspath(args.analyse),
-                                                table8=table8), h_layer=args.h_layer)
+                                                table8=table8), h_layer=args.h_layer,
+                            write=results_writer(argv, args, started))
 
     n_particles = None
     phi = args.phi
@@ -127,7 +145,8 @@ def main(argv: list[str] | None = None) -> dict:
                                 tol_lambda=args.tol_lambda, n_max=args.n_max, a_over_delta=args.a_over_delta,
                                 seed=args.seed, springs=asdict(springs),
                                 table8=None if args.table8 is None else table8_row(phi)),
-                           wall_seconds=wall, ranks=args.np_fluid + args.np_dem, h_layer=args.h_layer)
+                           wall_seconds=wall, ranks=args.np_fluid + args.np_dem, h_layer=args.h_layer,
+                           write=results_writer(argv, args, started))
     if not args.keep:
         case.delete_fields(run_dir)
     return results

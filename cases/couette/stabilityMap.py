@@ -23,7 +23,7 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
-from fdmsubgrid import couettescene, files, output
+from fdmsubgrid import couettescene, files, output, results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
@@ -84,8 +84,7 @@ def run_one(phi: float, dt: float, stiffness: float, args: argparse.Namespace) -
         row["inner_iterations_mean"] = float(np.mean(steps["innerIterations"])) if len(steps["step"]) else None
         row["unconverged_steps"] = int(np.sum(steps["converged"] == 0))
     if proc.returncode == 0:
-        with open(os.path.join(args.workdir, name + ".results.json")) as f:
-            r = json.load(f)
+        r = results.read_data(os.path.join(args.workdir, name + ".results.json"))
         for k in ("min_pair_gap", "min_wall_gap", "eta_s", "eta_s_err", "stress_balance_rel_error", "springs",
                   "core_seconds_per_strain_unit", "n_particles"):
             row[k] = r.get(k)

@@ -61,7 +61,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from typing import Dict, Iterator, List, Optional, Tuple
 
-from fdmsubgrid import checkpoint, couettescene, demonly, files, output, rheology  # couettescene: a row's time step
+from fdmsubgrid import checkpoint, couettescene, demonly, files, output, results, rheology  # couettescene: a row's time step
 from fdmsubgrid.shear import steps_planned
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -297,8 +297,7 @@ def analyse_row(phi: float, run_dir: Optional[str], args: argparse.Namespace) ->
     out = run_dir + ".results.json"
     subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--analyse", run_dir, "--out", out], check=True,
                    stdout=subprocess.DEVNULL)
-    with open(out) as f:
-        r = json.load(f)
+    r = results.read_data(out)
     keep = ("phi_bulk phi_core phi_core_err gamma_core_over_gamma0 gamma_core_err eta_s eta_s_err N1_hat N1_hat_err "
             "N2_hat N2_hat_err Sigma_c_hat Sigma_c_hat_err steady_from_strain steady_detected strain_units "
             "stress_balance_rel_error stress_balance_rel_error_err stress_gap_rel_error_max n_particles cells dt "

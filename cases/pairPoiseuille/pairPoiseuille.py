@@ -70,11 +70,12 @@ import math
 import os
 import shutil
 import time
-from typing import Sequence
+from typing import List, Sequence
 
 import numpy as np
 
-from fdmsubgrid import case, channelscenes, files
+from fdmsubgrid import case, channelscenes
+from fdmsubgrid.results import Row, relative, write_results
 from fdmsubgrid import convergence as convergence_study
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -449,6 +450,34 @@ def convergence(options, offsets, represented: int) -> tuple[list[dict], list[di
     return scenes, changes
 
 
+def validation_rows(r: dict) -> List[Row]:
+    """cases/pairPoiseuille (5.4): no tabulated reference (Bhattacharya et al. 2006 are plots in the
+    paper): the sign change of the centre-line sphere's U_y beside the paper's ~0.6, the near-contact
+    relative normal velocity with and without the correction (lubrication: -> 0), and the far pair
+    against the isolated spheres."""
+    rows = []
+    config = "H = 4a, d2/a %g, a/Δ %g, box %s a, %d positions" % (
+        r["d2_over_a"], r["a_over_delta"], "×".join("%g" % v for v in r["box"]), r["n_positions"])
+    for scene in r["scenes"]:
+        mode = "subgrid" if scene["subgrid"] else "no_subgrid"
+        summary = r["summary"][mode]
+        with_block = scene["subgrid"]
+        label = "with the correction" if with_block else "FDM alone"
+        crossings = summary.get("Uy1_sign_change_rho_over_H") or []
+        if with_block and crossings:
+            rows.append(Row("ρ12/H where U_y1 changes sign", config, crossings[0], paper="≈ 0.6 (Fig. 18)"))
+        near = summary["nearest"]
+        rows.append(Row("(U2 − U1)·n / isolated pair's, ξ = %.0e (%s)" % (near["xi"], label), config,
+                        near["Un_ratio"], paper="→ 0 with the correction (Figs. 17–18)", headline=with_block))
+        if with_block:
+            far = summary["farthest"]
+            single = scene["single"]
+            rows.append(Row("U_x2/U_c at ρ12/H %g against sphere 2 alone" % far["rho_over_H"], config,
+                            single["Ux2"] + far["Ux2_minus_single"], single["Ux2"], "far field: the isolated sphere",
+                            relative(single["Ux2"] + far["Ux2_minus_single"], single["Ux2"])))
+    return rows
+
+
 def main(argv: Sequence[str] | None = None) -> dict:
     """Parse the options (module docstring), run, print the tables, write --out and the figure."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -565,7 +594,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                                           e["nearest"]["xi"], e["nearest"]["Un"],
                                           "-" if e["nearest"]["Un_ratio"] is None else
                                           "%.4f" % e["nearest"]["Un_ratio"]))
-    files.write_results(args.out, out, t0)
+    write_results(args.out, __file__, argv, args, None if args.convergence else validation_rows, out, t0)
     if not args.no_plot and not args.convergence:
         png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_pairPoiseuille.png")
         plot(scenes, png)

@@ -26,10 +26,12 @@ import math
 import os
 import shutil
 import time
+from typing import List
 
 import numpy as np
 
-from fdmsubgrid import case, files, output, suspension
+from fdmsubgrid import case, output, suspension
+from fdmsubgrid.results import Row, relative, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -172,6 +174,31 @@ def summarise(t, h_r=None):
     return s
 
 
+# The paper's contact case (section 5.3, Fig. 14): the spheres touch for -1.39 <~ r_x/a1 <~ 0
+PAPER_CONTACT_WINDOW = (-1.39, 0.0)
+
+
+def validation_rows(results: dict) -> List[Row]:
+    """Per trajectory: the minimum gap; without contact the final offset against the initial one (Stokes
+    flow is reversible); with contact the window of r_x where the spheres touch against the paper's."""
+    rows = []
+    for s, t in zip(results["summaries"], results["trajectories"]):
+        config = "a2/a1 %g, r_y0 %g a1, %s" % (t.get("ratio", float("nan")), s["r_y_start"],
+                                              "contact" if t.get("contact") else "no contact")
+        rows.append(Row("minimum gap / a1", config, s["min_gap_over_a1"]))
+        if "fore_aft_asymmetry" in s and not t.get("contact"):
+            rows.append(Row("final offset r_y", config, s["r_y_end"], s["r_y_start"],
+                            "fore-aft symmetric (Fig. 14, top)", relative(s["r_y_end"], s["r_y_start"])))
+        if "contact_r_x_from" in s:
+            for end, value, paper in (("from", s["contact_r_x_from"], PAPER_CONTACT_WINDOW[0]),
+                                      ("to", s["contact_r_x_to"], PAPER_CONTACT_WINDOW[1])):
+                touched = value is not None    # None: the spheres never came within h_r
+                rows.append(Row("contact window r_x/a1, %s" % end, config, value, paper,
+                                "≈ %g (Fig. 14, bottom)" % paper, value - paper if touched else None,
+                                error_unit="a1"))
+    return rows
+
+
 def plot(results, path):
     import matplotlib
     matplotlib.use("Agg")
@@ -249,7 +276,7 @@ def main(argv=None):
         results["trajectories"].append(t)
         results["summaries"].append(s)
         print(json.dumps(s))
-    files.write_results(args.out, results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     plot(results, os.path.join(os.path.dirname(args.out), "results_pairShear.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))
     return results

@@ -17,9 +17,11 @@ Writes results.json and results_pairSqueeze.png here (docs/cases.md).
 import argparse
 import os
 import time
+from typing import List
 
-from fdmsubgrid import case, files, theory
+from fdmsubgrid import case, theory
 from fdmsubgrid import squeeze
+from fdmsubgrid.results import Row, write_results
 from fdmsubgrid.squeeze import box_extrapolated, run_pair
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -55,6 +57,14 @@ def plot(results, path):
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def validation_rows(results: dict) -> List[Row]:
+    """The closing velocity at every gap and size ratio against the two-sphere theory, with the sub-grid
+    correction and (comparison rows) without."""
+    return [row for c in results["cases"] for row in
+            squeeze.validation_rows("a2/a1 %g, %s, " % (c["lambda"], squeeze.box_text(results)), c["xi"], "ξ",
+                                    c["theory"], c)]
 
 
 def main(argv=None):
@@ -94,7 +104,7 @@ def main(argv=None):
             for xi, v, ref, e in zip(args.xi, r["velocity"], reference, r["rel_error"]):
                 print("  xi %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (xi, v, ref, 100 * e))
         results["cases"].append(entry)
-    files.write_results(args.out, results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if "nosubgrid" in results["cases"][0]:
         plot(results, os.path.join(os.path.dirname(args.out), "results_pairSqueeze.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))

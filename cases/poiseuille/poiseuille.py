@@ -24,10 +24,13 @@ L_y = 40 a1 (docs/validation.md, "Pressure-driven flow").
 import argparse
 import os
 import shutil
+import time
+from typing import Any, List, Optional, Sequence
 
 import numpy as np
 
 from fdmsubgrid import case, packing, poiseuille, sbm, suspension
+from fdmsubgrid.results import Row, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -73,12 +76,13 @@ def main(argv: list[str] | None = None) -> dict:
                    "another dt), both averaged over the same window (from the later steady start, or --from-time)")
     case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
     args = p.parse_args(argv)
+    started = time.time()
     material = sbm.from_couette_results(args.couette) if args.couette else None
 
     if args.analyse and args.compare:
         return compare(args.analyse, args.compare, material, args.from_time)
     if args.analyse:
-        return report(args.analyse, args.out, material, args.from_time)
+        return report(args.analyse, args.out, material, args.from_time, argv, args, started)
 
     if args.paper:
         args.size = list(PAPER_SIZE)
@@ -127,7 +131,7 @@ def main(argv: list[str] | None = None) -> dict:
         return dict(run_dir=run_dir, **scene)
 
     case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
-    results = report(run_dir, args.out, material, args.from_time)
+    results = report(run_dir, args.out, material, args.from_time, argv, args, started)
     if not args.keep:
         case.delete_fields(run_dir)
     return results
@@ -159,16 +163,36 @@ def compare(run_a: str, run_b: str, material=None, from_time=None) -> dict:
     return out
 
 
-def report(run_dir: str, out: str, material=None, from_time=None) -> dict:
-    """Analyse a run folder (fdmsubgrid.poiseuille.analyse), write `out` and the figure beside it."""
-    import json
+# The run's measures the report shows (rows of fdmsubgrid.results): key, quantity, a fraction shown in per cent
+MEASURES = (("phi_center", "φ at the centre plane", False),
+            ("u_center_star", "u_p*/(2 U_c) at the centre plane", False),
+            ("sbm_phi_rms_diff", "φ profile against the SBM (rms difference)", False),
+            ("sbm_u_rms_diff", "u_p* profile against the SBM (rms difference)", False),
+            ("shear_stress_linearity_rel_error", "shear stress against the linear profile (largest)", True),
+            ("wall_force_balance_rel_error", "force balance on the walls", True))
+
+
+def validation_rows(results: dict) -> List[Row]:
+    """The run's measures (MEASURES) in one configuration; no tabulated reference (the paper's Figs. 23-25
+    are plots): the SBM's profiles are the comparison."""
+    config = "φ_bulk %g, channel %s a1, dt %g, averaged from t %g" % (
+        results["phi_bulk"], " × ".join("%g" % v for v in results["L"]), results["dt"], results["steady_from"])
+    return [Row(quantity, config, results[key], paper="Figs. 23–25", percent=percent)
+            for key, quantity, percent in MEASURES if results.get(key) is not None]
+
+
+def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional[Sequence[str]] = None,
+           options: Any = None, started: Optional[float] = None) -> dict:
+    """Analyse a run folder (fdmsubgrid.poiseuille.analyse), write `out` (fdmsubgrid.results: argv and
+    options are the command's) and the figure beside it."""
+    started = time.time() if started is None else started
     results, fig = poiseuille.analyse(run_dir, material, from_time)
     results.update(case="poiseuille", run=os.path.basename(os.path.normpath(run_dir)), run_dir=os.path.abspath(run_dir))
     figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_poiseuille.png")
     poiseuille.plot(figure, fig)
     results["figure"] = os.path.basename(figure)
-    with open(out, "w") as f:
-        json.dump(results, f, indent=1)
+    write_results(out, __file__, argv, options if options is not None else {}, validation_rows, results,
+                  started)
     for k in ("phi_bulk", "time", "steady_from", "phi_center", "phi_center_initial", "phi_wall_layer",
               "jammed_width_over_a1", "u_center_star", "shear_stress_linearity_rel_error",
               "shear_stress_linearity_wall_layer_rel_error", "wall_force_balance_rel_error", "wall_shear_stress_asymmetry", "sbm_phi_rms_diff",

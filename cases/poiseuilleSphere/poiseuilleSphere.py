@@ -75,11 +75,12 @@ import math
 import os
 import shutil
 import time
-from typing import Sequence
+from typing import List, Sequence
 
 import numpy as np
 
-from fdmsubgrid import case, channelscenes, files
+from fdmsubgrid import case, channelscenes
+from fdmsubgrid.results import Row, relative, write_results
 from fdmsubgrid import convergence as convergence_study
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -500,6 +501,31 @@ def convergence(options, offsets, represented: int, staben: list[dict]) -> tuple
     return rows, changes
 
 
+def validation_rows(r: dict) -> List[Row]:
+    """U_x/U_c against Staben et al. (2003) where it applies, else against Faxen's laws with the leading wall
+    reflections where those are a reference (the centre 2 radii or more from both walls: the case's
+    wall_estimate_applies; nearer, the row has no reference), Omega_z a/U_c and S* likewise."""
+    rows = []
+    for row in r["rows"]:
+        config = "a %g, 2a/H %g, d/a %s, a/Δ %.3g, box %s a, %d positions" % (
+            row["radius"], row["two_a_over_H"], "%.4g (centre)" % row["d_over_a"] if row["centre_plane"] else
+            "%g" % row["d_over_a"], row["a_over_delta"], "×".join("%g" % v for v in row["box"]), row["n_positions"])
+        faxen = row["faxen_wall"] if row.get("faxen_wall_applies") else {}
+        if row.get("staben_Ux_norm") is not None:
+            rows.append(Row("U_x/U_c (Staben)", config, row["Ux_norm"], row["staben_Ux_norm"],
+                            "%g (Staben et al. 2003; Fig. 12: very good agreement)" % row["staben_Ux_norm"],
+                            relative(row["Ux_norm"], row["staben_Ux_norm"]), spread=row["Ux_norm_std"] or None))
+        else:
+            rows.append(Row("U_x/U_c (Faxén + walls)", config, row["Ux_norm"], faxen.get("Ux_norm"), "Fig. 12",
+                            relative(row["Ux_norm"], faxen.get("Ux_norm")), spread=row["Ux_norm_std"] or None))
+        if not row["centre_plane"]:
+            rows.append(Row("Ω_z a/U_c (Faxén + walls)", config, row["Wz_norm"], faxen.get("Wz_norm"), "Fig. 12",
+                            relative(row["Wz_norm"], faxen.get("Wz_norm")), spread=row["Wz_norm_std"] or None))
+            rows.append(Row("S* (Faxén + walls)", config, row["S_star"], faxen.get("S_star"), "Fig. 13 (2a/H 0.4)",
+                            relative(row["S_star"], faxen.get("S_star")), spread=row["S_star_std"] or None))
+    return rows
+
+
 def main(argv: Sequence[str] | None = None) -> dict:
     """Parse the options (module docstring), run every channel, print the table, write --out and the figure."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -611,7 +637,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                    n_positions=represented, offsets=[list(o) for o in offsets], subgrid=args.subgrid,
                    model=args.model, cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda,
                    staben=staben)
-    files.write_results(args.out, out, t0)
+    write_results(args.out, __file__, argv, args, None if args.convergence else validation_rows, out, t0)
     if not args.no_plot and not args.convergence:
         png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_poiseuilleSphere.png")
         plot(rows, png, staben)

@@ -24,13 +24,15 @@ What it measures:
 Writes results.json here (docs/cases.md).
 """
 import argparse
-import json
 import os
 import shutil
+import time
+from typing import List
 
 import numpy as np
 
 from fdmsubgrid import case, channelscenes, output, profiles, rheology
+from fdmsubgrid.results import Row, relative, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -105,6 +107,20 @@ def average(group: list) -> dict:
                 wall_seconds=float(sum(r["wall_seconds"] for r in group)))
 
 
+def validation_rows(results: dict) -> List[Row]:
+    """S* and the rotation against the unbounded sphere's 1, and the walls' momentum balance, per box."""
+    rows = []
+    for a in results["averages"]:
+        config = "L×H×L = %g×%g×%g a, a/Δ %g, %d positions" % (*a["size"], a["a_over_delta"], a["positions"])
+        rows.append(Row("S* (unbounded: 1)", config, a["S_star"], 1.0, "→ 1 as H grows (Fig. 10)",
+                        relative(a["S_star"], 1.0), spread=a["S_star_std"] or None))
+        rows.append(Row("Ω_z/(−γ̇/2)", config, a["omega_z_over_minus_half_gamma"], 1.0, "→ 1 as H grows (Fig. 10)",
+                        relative(a["omega_z_over_minus_half_gamma"], 1.0)))
+        rows.append(Row("momentum balance on the walls (largest)", config, a["wall_balance_rel_error_max"],
+                        percent=True))
+    return rows
+
+
 SWEEP = [(8, 20, 8), (12, 20, 12), (16, 20, 16), (20, 20, 20), (12, 30, 12)]
 
 
@@ -121,6 +137,7 @@ def main(argv=None) -> dict:
     p.add_argument("--sweep", action="store_true", help="the box sizes of SWEEP (module docstring)")
     case.add_run_options(p, HERE, tol_lambda=1e-5)
     args = p.parse_args(argv)
+    started = time.time()
     sizes = SWEEP if args.sweep else [tuple(args.size)]
     offsets = [tuple(args.offset)] if args.positions <= 1 else cell_positions(args.positions)
     runs, averages = [], []
@@ -141,8 +158,7 @@ def main(argv=None) -> dict:
                 % (len(group), averages[-1]["S_star"], averages[-1]["S_star_min"], averages[-1]["S_star_max"],
                    averages[-1]["omega_z_over_minus_half_gamma"]))
     results = dict(case="shearedSphere", runs=runs, averages=averages)
-    with open(args.out, "w") as f:
-        json.dump(results, f, indent=1)
+    write_results(args.out, __file__, argv, args, validation_rows, results, started)
     print("wrote", args.out)
     return results
 

@@ -48,7 +48,8 @@ from typing import Sequence
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from fdmsubgrid import case, files, squeeze, wallcalibration
+from fdmsubgrid import case, squeeze, wallcalibration
+from fdmsubgrid.results import write_results
 import freeSphereWall
 import wallShear
 
@@ -286,6 +287,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
     """Parse the options (module docstring), run every box, print the table, write --out."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_split_options(p, EPS_DEFAULT, BOXES_DEFAULT, "three: extrapolated to an infinite box")
+    p.set_defaults(out=os.path.join(HERE, "results_shearLoad.json"))   # a study: not the case's results.json
     p.add_argument("--no-corrected", action="store_true",
                    help="skip the free sphere with the correction on (run by default beside the split)")
     args = p.parse_args(argv)
@@ -307,7 +309,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                by_box=boxes, corrected_by_box=corrected,
                conventions="GCB's factors in the case's frame (module docstring); rel_error = solver/theory - 1; "
                            "Ux_norm_exactR, Wz_norm_exactR: the free sphere with the exact R and the solver's Fs, Ts")
-    files.write_results(args.out, out, t0)
+    write_results(args.out, __file__, argv, args, [], out, t0)
     print("wrote %s (%.0f s)" % (args.out, out["wall_seconds"]))
     return out
 

@@ -37,7 +37,8 @@ from typing import Sequence
 
 import numpy as np
 
-from fdmsubgrid import files, squeeze
+from fdmsubgrid import squeeze
+from fdmsubgrid.results import write_results
 import freeSphereWall
 import shearLoad
 import wallShear
@@ -127,6 +128,7 @@ def print_rows(title: str, rows: Sequence[dict]) -> None:
 def main(argv: Sequence[str] | None = None) -> dict:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     shearLoad.add_split_options(p, EPS_DEFAULT, BOXES_DEFAULT, "two: extrapolated as Q_inf + c L^-3")
+    p.set_defaults(out=os.path.join(HERE, "results_shearStresslet.json"))   # a study: not the case's results.json
     args = p.parse_args(argv)
     shearLoad.check_split_options(p, args, (1, 2))
     offsets, _ = wallShear.cell_offsets(args.positions)
@@ -145,7 +147,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                conventions="S* = S_xy/((10/3) pi eta a^3 gamma_dot) = held - (g U_x + h Omega_z); held: the sphere "
                            "held fixed in the shear (S-hat^gamma-dot, Eq. D.5); g, h per U_x, Omega_z (a = eta = 1); "
                            "_fdm: the correction off, _corrected: on (model)")
-    files.write_results(args.out, out, t0)
+    write_results(args.out, __file__, argv, args, [], out, t0)
     print("wrote %s (%.0f s)" % (args.out, out["wall_seconds"]))
     return out
 

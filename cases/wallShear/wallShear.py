@@ -68,11 +68,12 @@ import math
 import os
 import shutil
 import time
-from typing import Sequence
+from typing import List, Sequence
 
 import numpy as np
 
-from fdmsubgrid import case, files, output
+from fdmsubgrid import case, output
+from fdmsubgrid.results import Row, write_results
 import freeSphereWall
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -344,6 +345,22 @@ def plot(rows: list[dict], path: str, title: str) -> None:
     plt.close(fig)
 
 
+def validation_rows(r: dict) -> List[Row]:
+    """U_x/(gamma d), Omega_z/(gamma/2) against the free sphere of the wall resistance functions, S* against
+    Sangani's fit (Eq. 46), with and without the sub-grid wall correction."""
+    rows = []
+    for row in r["rows"]:
+        config = "a %g, ε %g, %s, box %s a1, a1/Δ %g, %d positions" % (
+            row["radius"], row["eps"], "sub-grid on (%s model)" % (r.get("model") or "cutoff") if row["subgrid"]
+            else "FDM alone", "×".join("%g" % v for v in row["box"]), row["a_over_delta"], row["n_positions"])
+        for q, key, paper in (("U_x/(γ̇d)", "Ux_norm", "Fig. 7: very good agreement"),
+                              ("Ω_z/(γ̇/2)", "Wz_norm", "Fig. 7: very good agreement"),
+                              ("S* (Eq. 46)", "S_star", "Fig. 8: very good agreement")):
+            rows.append(Row(q, config, row[key], row[key + "_ref"], paper, row[key + "_rel_error"],
+                            spread=row[key + "_std"] or None, headline=row["subgrid"]))
+    return rows
+
+
 def main(argv: Sequence[str] | None = None) -> dict:
     """Parse the options (module docstring), run every box, print the tables, write --out and the plot."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -439,7 +456,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
                radii=args.radius, subgrid_modes=subgrid_modes, model=args.model, cutoff_cells=args.cutoff or "default",
                wall_cutoff_cells=args.wall_cutoff or "default", tol_lambda=args.tol_lambda, boxes=results,
                box_comparison=comparison)
-    files.write_results(args.out, out, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, out, t0)
     png = os.path.join(os.path.dirname(os.path.abspath(args.out)), "results_wallShear.png")
     plot(results[0]["rows"], png, "Free sphere in shear near a wall (paper 5.2.1): box %g x %g x %g a1, a1/Delta %g, "
          "%d offsets" % (*results[0]["box"], args.a_over_delta, represented))

@@ -17,9 +17,11 @@ Writes results.json and results_wallSqueeze.png here (docs/cases.md).
 import argparse
 import os
 import time
+from typing import List
 
-from fdmsubgrid import case, files, theory
+from fdmsubgrid import case, theory
 from fdmsubgrid import squeeze
+from fdmsubgrid.results import Row, write_results
 from fdmsubgrid.squeeze import box_extrapolated, run_wall
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -52,6 +54,12 @@ def plot(results, path):
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def validation_rows(results: dict) -> List[Row]:
+    """The velocity toward the wall at every gap against Brenner (1961), with the sub-grid correction and
+    (comparison rows) without."""
+    return squeeze.validation_rows(squeeze.box_text(results) + ", ", results["eps"], "ε", results["theory"], results)
 
 
 def main(argv=None):
@@ -89,7 +97,7 @@ def main(argv=None):
         print("sub-grid %s: %.0f s" % ("on" if subgrid else "off", r["wall_seconds"]))
         for eps, v, ref, e in zip(args.eps, r["velocity"], reference, r["rel_error"]):
             print("  eps %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (eps, v, ref, 100 * e))
-    files.write_results(args.out, results, t0)
+    write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if "nosubgrid" in results:
         plot(results, os.path.join(os.path.dirname(args.out), "results_wallSqueeze.png"))
     print("wrote %s (%.0f s)" % (args.out, results["wall_seconds"]))

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import os
-import time
 
 
 def write_atomically(path: str, data: str | bytes) -> None:
@@ -27,15 +26,6 @@ def write_json(path: str, obj, indent: int | None = 1, **dump_options) -> None:
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
     write_atomically(path, json.dumps(obj, indent=indent, **dump_options))
-
-
-def write_results(path: str, results: dict, started: float) -> dict:
-    """A case's results file: `results` stamped with its wall time since `started` (time.time()) and
-    today's date, written whole (write_json). Returns `results`, stamped."""
-    results["wall_seconds"] = time.time() - started
-    results["date"] = time.strftime("%Y-%m-%d")
-    write_json(path, results)
-    return results
 
 
 def relative_paths(obj, start: str | None = None):

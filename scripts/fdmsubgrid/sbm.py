@@ -42,7 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid, solve_ivp
 from scipy.optimize import brentq, curve_fit
 
-from . import rheology
+from . import results, rheology
 
 # The paper's material functions (section 6): Maron-Pierce fit of Fig. 21 (Eq. 55) with the jamming
 # fraction of section 6.2 (phi_m = 0.592, where section 6.1's fit rounds to 0.59)
@@ -236,8 +236,7 @@ def from_couette_results(paths: Sequence[str], phi_m: float | None = None) -> Ma
     (fit_contact_power_law)."""
     rows = []
     for path in paths:
-        with open(path) as f:
-            data = json.load(f)
+        data = results.read_data(path)   # a case's results file (either shape) or fdmProfiles' summary
         data = data.get("mser_window", data)
         try:
             rows.append((float(data["phi_core"]), float(data["eta_s"]), float(data["eta_s_err"]),

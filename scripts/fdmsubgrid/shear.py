@@ -22,10 +22,12 @@ import os
 import re
 import sys
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
 from . import demonly, output, packing, profiles, rheology
+from .results import Row, relative
 
 H_LAYER = 5.0    # the default wall layer H_layer in units of a1 (paper section 6.1)
 MIN_SAMPLES = 8  # the fewest snapshots a time average takes (block averaging: 4 blocks of 2)
@@ -244,11 +246,39 @@ def figure_path(out: str) -> str:
     return os.path.join(os.path.dirname(os.path.abspath(out)), "results_couette.png")
 
 
+def validation_rows(r: dict, configuration: str) -> list[Row]:
+    """The rows (fdmsubgrid.results) of one sheared suspension's results `r` (analyse(); a row of
+    cases/couette/table8.py's summary has the same keys): phi_core and gamma_core/gamma0 beside the paper's
+    Table 8 where r['table8'] has the scene, eta_s beside the paper's fit of Fig. 21 (Eq. 55) at the run's
+    own phi_core (Table 8 gives no eta_s), the normal-stress differences (Fig. 22) and the stress balance."""
+    rows = []
+    t = r.get("table8") or {}
+    for q, key in (("φ_core", "phi_core"), ("γ̇_core/γ̇0", "gamma_core_over_gamma0")):
+        paper = t.get(key)
+        rows.append(Row(q, configuration, r[key], paper, "%g (Table 8)" % paper if paper is not None else "—",
+                        relative(r[key], paper), spread=r.get(key + "_err") or r.get(key.split("_over")[0] + "_err")))
+    paper_fit = float(rheology.maron_pierce(r["phi_core"], *rheology.PAPER_MARON_PIERCE))
+    rows.append(Row("η_s", configuration, r["eta_s"], paper_fit, "%.4g (Fig. 21's fit at φ_core)" % paper_fit,
+                    relative(r["eta_s"], paper_fit), spread=r["eta_s_err"]))
+    rows.append(Row("N̂1", configuration, r["N1_hat"], spread=r.get("N1_hat_err"), paper="Fig. 22"))
+    rows.append(Row("N̂2", configuration, r["N2_hat"], spread=r.get("N2_hat_err"), paper="Fig. 22"))
+    rows.append(Row("stress balance (core against walls)", configuration, r["stress_balance_rel_error"],
+                    percent=True))
+    return rows
+
+
+def write_json_summary(out: str, results: dict) -> None:
+    """report()'s default writer: the summary as JSON (fdmProfiles --out)."""
+    with open(out, "w") as f:
+        json.dump(results, f, indent=1)
+
+
 def report(run: ShearRun, out: str, extra: dict | None = None, wall_seconds: float | None = None,
            ranks: int | None = None, h_layer: float = H_LAYER, from_strain: float | None = None,
-           quiet: bool = False) -> dict:
-    """analyse() the run, write `out` (the JSON summary, with `extra`) and the profile figure beside
-    it (figure_path), print the summary unless quiet; returns the results."""
+           quiet: bool = False, write: Callable[[str, dict], None] = write_json_summary) -> dict:
+    """analyse() the run, write `out` (the JSON summary, with `extra`; `write(out, results)`: a case writes
+    its results file in the shape of fdmsubgrid.results) and the profile figure beside it (figure_path),
+    print the summary unless quiet; returns the results."""
     results, (channel, avg, fine, _) = analyse(run, wall_seconds, ranks, h_layer, from_strain)
     results.update(extra or {})
     # the position update's counts (fdmRun's log.dem, every session): too many limited targets mean too large a dt
@@ -261,8 +291,7 @@ def report(run: ShearRun, out: str, extra: dict | None = None, wall_seconds: flo
     figure = figure_path(out)
     profiles.plot_profiles(figure, channel, avg, fine)
     results["figure"] = os.path.basename(figure)
-    with open(out, "w") as f:
-        json.dump(results, f, indent=1)
+    write(out, results)
     if not quiet:
         print_summary(results)
         print("wrote %s and %s" % (out, figure))

@@ -16,11 +16,12 @@ import json
 import math
 import os
 import shutil
-from typing import Sequence
+from typing import List, Sequence
 
 import numpy as np
 
 from . import deminput, files, foamcase, runner
+from .results import Row, relative
 
 # Where the scene sits inside its first mesh cell (fractions of Delta along x, y, z): off the mesh's
 # symmetry planes, as the squeeze cases have always used.
@@ -200,3 +201,25 @@ def box_extrapolated(first: dict, second: dict, L1: float, L2: float) -> dict:
                 wall_seconds=first["wall_seconds"] + second["wall_seconds"], cells=[first["cells"], second["cells"]],
                 inner_iterations=first["inner_iterations"] + second["inner_iterations"],
                 converged=first["converged"] and second["converged"])
+
+
+def box_text(results: dict) -> str:
+    """The mesh and box of a squeeze case's results: 'a1/Δ 4, L 8 a1', and ' (→ ∞ with L 12)' if the box effect
+    was extrapolated away with a second box."""
+    text = "a1/Δ %g, L %g a1" % (results["a_over_delta"], results["L_over_a"])
+    return text + (" (→ ∞ with L %g)" % results["box_extrapolated_with"] if results.get("box_extrapolated_with")
+                   else "")
+
+
+def validation_rows(label: str, gaps: Sequence[float], gap_name: str, reference: Sequence[float],
+                    entry: dict) -> List[Row]:
+    """The closing velocity at each gap against theory (fdmsubgrid.results rows), with the sub-grid
+    correction (entry['subgrid']) and, as comparison rows, without it (entry['nosubgrid'])."""
+    rows = []
+    for switch, name in (("subgrid", "with the sub-grid correction"), ("nosubgrid", "FDM alone")):
+        if switch not in entry:
+            continue
+        for gap, v, ref in zip(gaps, entry[switch]["velocity"], reference):
+            rows.append(Row("closing velocity, %s" % name, "%s%s %g" % (label, gap_name, gap), v, ref,
+                            error=relative(v, ref), headline=switch == "subgrid"))
+    return rows
