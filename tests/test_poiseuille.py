@@ -10,7 +10,7 @@ import pytest
 from conftest import load_case_module
 from fdmsubgrid import output, poiseuille, shear
 
-SMALL = ["--size", "8", "12", "8", "--duration", "2", "--dump-every", "0.1", "--seed", "2"]
+SMALL = ["--size", "8", "12", "8", "--duration", "2", "--dump-every", "0.1", "--seed", "2", "--fluid-every", "1"]
 
 
 @pytest.fixture(scope="module")
@@ -140,7 +140,7 @@ def test_default_channel_holds_its_contacts_into_the_dense_core(case_module, tmp
     between contradictory gap targets, now held to the fallback's bounds: docs/dem.md, "Position
     update"). Every recorded pair stays within the roughness layer h_r = 0.005 a1 (about 3.5 minutes)."""
     work = tmp_path_factory.mktemp("poiseuilleDense")
-    r = case_module.main(["--duration", "11.5", "--dump-every", "0.05", "--workdir", str(work),
+    r = case_module.main(["--duration", "11.5", "--dump-every", "0.05", "--fluid-every", "1", "--workdir", str(work),
                           "--out", str(work / "results.json")])
     assert r["steps"] == 230 and r["unconverged_steps"] == 0
     records = output.read_particle_records(os.path.join(r["run_dir"], "dem", "particles.records"))
@@ -153,3 +153,20 @@ def test_default_channel_holds_its_contacts_into_the_dense_core(case_module, tmp
         np.fill_diagonal(gaps, np.inf)
         worst = min(worst, gaps.min())
     assert len(records) == 230 and worst > -0.005, worst
+
+
+def test_a_channel_starts_from_the_last_record_of_another(case_module, small_run, tmp_path):
+    """--from-records: the packing is the last record's particles (by tag), in the same box with its walls;
+    a records file of another box is refused with its name and both boxes."""
+    path = os.path.join(small_run["run_dir"], "dem", "particles.records")
+    records = output.read_particle_records(path)
+    pack = poiseuille.packing_from_records(path, [8, 12, 8])
+    last = records.blocks[-1]["particles"]
+    order = np.argsort(last["tag"])
+    assert pack.n == records.n_particles and pack.walls == (1,) and pack.boundary == "p f p"
+    assert np.array_equal(pack.positions, last["x"][order]) and np.array_equal(pack.radii, last["radius"][order])
+    assert pack.phi == pytest.approx(small_run["phi_bulk"], rel=1e-12)
+    with pytest.raises(ValueError, match=r"particles\.records: box .* not the channel \[0, \[8, 16, 8\]\]"):
+        poiseuille.packing_from_records(path, [8, 16, 8])
+    with pytest.raises(SystemExit):
+        case_module.main(["--from-records", path, "--size", "8", "16", "8", "--workdir", str(tmp_path)])

@@ -11,7 +11,7 @@ scene written by the same code (fdmsubgrid.suspension); the springs by docs/cont
 wall shear stress tau_w.
 
   poiseuille.py                 the small channel (8 x 12 x 8 a1, phi_bulk 0.45, a1/Delta = 3, 40 time
-                                units at dt 0.05): migration begins; about 15 minutes
+                                units at dt 0.05): migration begins; about 6 minutes
   poiseuille.py --duration 2    a few steps (the CI test)
   poiseuille.py --paper         writes the paper's (40, 40, 20) a1 channel (not run; --run runs it)
   poiseuille.py --analyse RUN   the analysis of a run folder as it stands
@@ -74,6 +74,15 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--compare", metavar="RUN_DIR", default=None, help="with --analyse: the rms and largest "
                    "differences of the coarse phi and u_p* profiles from this other run of the same channel (e.g. "
                    "another dt), both averaged over the same window (from the later steady start, or --from-time)")
+    p.add_argument("--fluid-every", type=int, default=1, metavar="K",
+                   help="solve the fluid every K-th particle step, the steps between holding its drag "
+                        "(fix fdm/couple fluid_every; docs/benchmarks.md, 'The channel's time step')")
+    p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
+                   help="with --fluid-every: the held drag extrapolated from the last two fluid steps, or constant")
+    p.add_argument("--from-records", metavar="RECORDS", default=None,
+                   help="start from the particles of the last block of this particle records file (dem/"
+                        "particles.records of a run of the same channel, e.g. its dense core) instead of a "
+                        "random packing; the contacts' tangential history and the fluid start afresh")
     case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
     args = p.parse_args(argv)
     started = time.time()
@@ -94,13 +103,21 @@ def main(argv: list[str] | None = None) -> dict:
         p.error("--duration and --dt must be positive")
     if not 0 < args.phi < 0.6:
         p.error("--phi %g: a random packing needs 0 < phi_bulk < 0.6" % args.phi)
+    if args.fluid_every < 1:
+        p.error("--fluid-every must be at least 1")
 
     width = float(args.size[1])
     grad, u_c = pressure_gradient(width)
     time_unit = width / (2 * u_c)
     dt = args.dt * time_unit
-    pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
-                                   wall_gap=2 * suspension.ROUGHNESS)
+    if args.from_records:
+        try:
+            pack = poiseuille.packing_from_records(args.from_records, args.size)
+        except (OSError, ValueError) as e:
+            p.error("--from-records: %s" % e)
+    else:
+        pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
+                                       wall_gap=2 * suspension.ROUGHNESS)
     print("packing:", pack.summary())
     missing = case.uncalibrated(pack.radii, delta, walls=True, model=args.model)
     if missing:
@@ -109,19 +126,24 @@ def main(argv: list[str] | None = None) -> dict:
     springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt)
     print(springs.describe(dt))
 
-    name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (args.phi, *args.size, args.a_over_delta, args.dt, args.seed,
-                                                  "_" + args.model)
+    name = "phi%g_%gx%gx%g_ad%g_dt%g_%s%s%s" % (args.phi, *args.size, args.a_over_delta, args.dt,
+                                                 "records" if args.from_records else "seed%d" % args.seed,
+                                                 "_" + args.model,
+                                                 "_fluidEvery%d" % args.fluid_every if args.fluid_every > 1 else "")
     run_dir = os.path.join(args.workdir, name)
     if os.path.exists(run_dir):
         if not args.overwrite:
             raise SystemExit("poiseuille: %s already holds a run; --overwrite replaces it" % run_dir)
         shutil.rmtree(run_dir)
     steps = int(round(args.duration / args.dt))
-    every = max(1, int(round(args.dump_every / args.dt)))
-    write_every = max(1, int(round(args.write_every / args.dt)))
+    K = args.fluid_every
+    # snapshots on steps the fluid solves: multiples of K
+    every = K * max(1, int(round(args.dump_every / args.dt / K)))
+    write_every = K * max(1, int(round(args.write_every / args.dt / K)))
     scene = suspension.write_case(run_dir, pack, springs, args.a_over_delta, dt, steps, every, args.tol_lambda,
                                   args.acceleration, args.n_max, write_every, model=args.model,
-                                  grad_p0=(grad, 0.0, 0.0), name="in.poiseuille")
+                                  grad_p0=(grad, 0.0, 0.0), name="in.poiseuille", fluid_every=K,
+                                  held_drag=args.held_drag)
     print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, channel %s a1, %d cells, dP0/dx = %.4g Pa/m (U_c = %g), "
           "%d steps of dt %g L_y/(2U_c), a snapshot every %d steps"
           % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,

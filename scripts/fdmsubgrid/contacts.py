@@ -52,6 +52,19 @@ def close_pairs(x: NDArray, radii: NDArray, period: NDArray, max_gap: float) -> 
     return np.stack([i, j], axis=1)[keep], gaps[keep]
 
 
+def smallest_gaps(records: ParticleRecords | str) -> NDArray:
+    """The smallest pair surface gap of each record (T,) (negative: an overlap), e.g. how deep the
+    contacts of a run went into each other (the roughness layer is h_r deep)."""
+    rec = read_particle_records(records) if isinstance(records, str) else records
+    out = np.full(len(rec), np.inf)
+    for k in range(len(rec)):
+        radii = rec["radius"][k]
+        _, gaps = close_pairs(rec["x"][k], radii, rec.period, float(radii.min()))
+        if len(gaps):
+            out[k] = gaps.min()
+    return out
+
+
 def contact_set(x: NDArray, radii: NDArray, period: NDArray, roughness: float) -> set:
     """The pairs (i, j), i < j, in contact: surface gap below the roughness height."""
     pairs, _ = close_pairs(x, radii, period, roughness)

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from . import output, profiles, rheology, sbm, shear, timeseries
+from . import output, packing, profiles, rheology, sbm, shear, timeseries
 
 CENTRAL_HALF_WIDTH = 1.0        # a1: the central slab of the migration series
 WALL_LAYER = sbm.LAYER_OVER_A1  # a1: the wall layers (the region the SBM leaves out)
@@ -99,6 +99,40 @@ def fluid_shear_stress_in_bins(u: NDArray, delta: float, eta: float, edges: NDAr
     u_faces = np.concatenate([[0.0], 0.5 * (u[1:] + u[:-1]), [0.0]])
     at = np.interp(edges, faces, u_faces)
     return eta * np.diff(at) / np.diff(edges)
+
+
+def packing_from_records(path: str, size) -> packing.Packing:
+    """The particles of the last complete block of a particle records file (fix fdm/output) as the
+    packing of a new channel run of the same size (walls normal to y): a dense state reached by an
+    earlier run, to start a short run there (e.g. the time-step measurements where the core is
+    densest). Raises ValueError if the file's box is not `size`, or if it has no walls on y."""
+    records = output.read_particle_records(path)
+    if len(records) == 0:
+        raise ValueError("%s holds no complete block" % path)
+    lo = np.asarray(records.header["box_lo"], dtype=float)
+    hi = np.asarray(records.header["box_hi"], dtype=float)
+    if not np.allclose(hi - lo, np.asarray(size, dtype=float)) or np.any(lo != 0):
+        raise ValueError("%s: box %s to %s, not the channel [0, %s]" % (path, lo.tolist(), hi.tolist(),
+                                                                          list(size)))
+    if list(records.header.get("periodic", [])) != [1, 0, 1]:
+        raise ValueError("%s: periodic %s, not a channel with walls normal to y (1 0 1)"
+                         % (path, records.header.get("periodic")))
+    last = records.blocks[-1]["particles"]
+    order = np.argsort(last["tag"])
+    return packing.Packing(last["x"][order], last["radius"][order], last["type"][order], hi - lo,
+                           dict(records=os.path.basename(path), step=int(records.steps[-1])), walls=(1,))
+
+
+def flow_rate(run_dir: str) -> tuple[NDArray, NDArray]:
+    """The bulk velocity of the channel at every fluid step: times (in L_y/(2 U_c)) and the mean of U_x
+    over the whole box (fluid and particle interiors, fdmFoam's steps.dat) over 2 U_c, the Newtonian
+    parabola's being 1/3. At an imposed pressure gradient this is what a suspension's viscosity sets,
+    as the wall stress is at an imposed shear rate: the quantity the time-step measurements compare."""
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    width = float(np.asarray(output.read_records_header(
+        os.path.join(run_dir, "dem", "particles.records"))["box_hi"])[1])
+    u_c = width / 4   # Eq. 58 with the cases' U_c = L_y/4
+    return np.asarray(steps["time"]) / (width / (2 * u_c)), np.asarray(steps["meanUx"]) / (2 * u_c)
 
 
 def migration_time(times: NDArray, phi_center: NDArray) -> tuple[float, float, float]:
