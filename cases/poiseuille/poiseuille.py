@@ -11,7 +11,8 @@ scene written by the same code (fdmsubgrid.suspension); the springs by docs/cont
 wall shear stress tau_w.
 
   poiseuille.py                 the small channel (8 x 12 x 8 a1, phi_bulk 0.45, a1/Delta = 3, 40 time
-                                units at dt 0.05): migration begins; about 6 minutes
+                                units, the particles at dt 0.05, the fluid every 4th step): migration
+                                begins; about 4 minutes
   poiseuille.py --duration 2    a few steps (the CI test)
   poiseuille.py --paper         writes the paper's (40, 40, 20) a1 channel (not run; --run runs it)
   poiseuille.py --analyse RUN   the analysis of a run folder as it stands
@@ -24,6 +25,7 @@ L_y = 40 a1 (docs/validation.md, "Pressure-driven flow").
 import argparse
 import os
 import shutil
+import sys
 import time
 from typing import Any, List, Optional, Sequence
 
@@ -54,7 +56,9 @@ def main(argv: list[str] | None = None) -> dict:
                    "(with --run, run)")
     p.add_argument("--run", action="store_true", help="with --paper: run it too")
     p.add_argument("--a-over-delta", type=float, default=3.0, help="a1/Delta, mesh cells per small radius")
-    p.add_argument("--dt", type=float, default=0.05, help="time step in units of L_y/(2 U_c)")
+    p.add_argument("--dt", type=float, default=poiseuille.DEFAULT_DT,
+                   help="particle time step in units of L_y/(2 U_c) (measured: docs/benchmarks.md, \"The channel's "
+                        "time step\")")
     p.add_argument("--duration", type=float, default=40.0, help="time to run, in units of L_y/(2 U_c)")
     p.add_argument("--seed", type=int, default=1, help="seed of the random packing")
     p.add_argument("--dump-every", type=float, default=0.5, help="time between two particle snapshots")
@@ -74,7 +78,7 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--compare", metavar="RUN_DIR", default=None, help="with --analyse: the rms and largest "
                    "differences of the coarse phi and u_p* profiles from this other run of the same channel (e.g. "
                    "another dt), both averaged over the same window (from the later steady start, or --from-time)")
-    p.add_argument("--fluid-every", type=int, default=1, metavar="K",
+    p.add_argument("--fluid-every", type=int, default=poiseuille.DEFAULT_FLUID_EVERY, metavar="K",
                    help="solve the fluid every K-th particle step, the steps between holding its drag "
                         "(fix fdm/couple fluid_every; docs/benchmarks.md, 'The channel's time step')")
     p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
@@ -125,6 +129,9 @@ def main(argv: list[str] | None = None) -> dict:
     tau_w = abs(grad) * width / 2
     springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt)
     print(springs.describe(dt))
+    warning = poiseuille.time_step_warning(args.dt, args.fluid_every)
+    if warning:
+        print(warning, file=sys.stderr)
 
     name = "phi%g_%gx%gx%g_ad%g_dt%g_%s%s%s" % (args.phi, *args.size, args.a_over_delta, args.dt,
                                                  "records" if args.from_records else "seed%d" % args.seed,

@@ -123,6 +123,30 @@ def packing_from_records(path: str, size) -> packing.Packing:
                            dict(records=os.path.basename(path), step=int(records.steps[-1])), walls=(1,))
 
 
+# The channel's measured time steps (docs/benchmarks.md, "The channel's time step"; times in L_y/(2 U_c)):
+# the bulk velocity within 1 % rms of the finest step with the particles at up to 0.1 and the fluid every
+# 0.2 (0.4: 1.7-3.1 % rms); the particles at 0.2 went 8 % rms off with pairs pressed into their roughness.
+MEASURED_PARTICLE_DT = 0.1
+MEASURED_FLUID_DT = 0.4
+DEFAULT_DT, DEFAULT_FLUID_EVERY = 0.05, 4
+
+
+def time_step_warning(dt: float, fluid_every: int) -> str | None:
+    """A warning when the particle step dt or the fluid's step fluid_every*dt (in L_y/(2 U_c)) is beyond
+    what was measured good in the channel, else None."""
+    beyond = []
+    if dt > MEASURED_PARTICLE_DT * (1 + 1e-9):
+        beyond.append("the particle step %g above %g (at 0.2 the bulk velocity went 8 %% rms off and pairs were "
+                      "pressed into their roughness layer)" % (dt, MEASURED_PARTICLE_DT))
+    if dt * fluid_every > MEASURED_FLUID_DT * (1 + 1e-9):
+        beyond.append("the fluid's step %g (dt %g x fluid_every %d) above %g, not measured"
+                      % (dt * fluid_every, dt, fluid_every, MEASURED_FLUID_DT))
+    if not beyond:
+        return None
+    return ("WARNING: %s: docs/benchmarks.md, \"The channel's time step\" (the measured defaults: --dt %g "
+            "--fluid-every %d)" % ("; ".join(beyond), DEFAULT_DT, DEFAULT_FLUID_EVERY))
+
+
 def flow_rate(run_dir: str) -> tuple[NDArray, NDArray]:
     """The bulk velocity of the channel at every fluid step: times (in L_y/(2 U_c)) and the mean of U_x
     over the whole box (fluid and particle interiors, fdmFoam's steps.dat) over 2 U_c, the Newtonian
