@@ -68,10 +68,12 @@ def ct():
 
 @pytest.fixture(scope="module")
 def res(ct, tmp_path_factory):
-    """The contact modes' resistances (Stokes drag + sub-grid lubrication) at the cut-offs fdmDEM uses."""
+    """The contact modes' resistances (Stokes drag + sub-grid lubrication, fdmsubgrid.contactstability) at the
+    cut-offs fdmDEM uses."""
+    from fdmsubgrid import contactstability
     cutoff, wall_cutoff = ct.probe_cutoffs(str(tmp_path_factory.mktemp("probe")))
     p = ct.BASE
-    return ct.Resistance(p["a"], p["eta"], p["delta"], cutoff, wall_cutoff)
+    return contactstability.ContactResistances(p["a"], p["eta"], p["delta"], cutoff, wall_cutoff)
 
 
 def pytest_configure(config):

@@ -74,7 +74,7 @@ def test_stability_limit_of_the_time_step(tmp_path, env, ct, res, integrator):
     # (ab2), r = dt k_n / zeta, zeta = 3 pi eta a + X^A_SG(gap) (fdmResistance): stable below
     # r = 2 (euler) or 1 (ab2)
     c = ct.StabilityConfig(res, "pair, lubrication", "pair", True, integrator)
-    assert abs(c.zeta / (3 * math.pi + res.pair_XA(c.g_ss)) - 1) < 1e-12
+    assert abs(c.zeta / (3 * math.pi + res.pair_squeeze(c.g_ss)) - 1) < 1e-12
     well_below = c.run(str(tmp_path), 0.5 * c.dt_estimate)
     assert well_below["ok"] and well_below["stable"] and well_below["label"] == "converged", well_below
     # the measured growth factor per step is the linear theory's

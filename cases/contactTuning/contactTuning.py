@@ -40,18 +40,16 @@ from typing import List
 
 import numpy as np
 
-from fdmsubgrid import theory
+from fdmsubgrid import contactstability as cs, theory
 from fdmsubgrid.demonly import fdmdem, run_in
 from fdmsubgrid.results import Row, relative, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
 
-PI = math.pi
 # the scene: every length in units of a = 1 m, eta = 1 Pa s (the velocity scale F/(6 pi eta a))
 BASE = dict(a=1.0, eta=1.0, delta=0.2, hr=0.01, kn=2000.0, kt=2000.0, mu=0.5)
 LOAD = 10.0                      # N: F/k_n = h_r/2 at the base k_n
-MIN_GAP = 1e-5                   # the resistance functions are frozen below this reduced gap (docs/resistance.md)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -108,215 +106,6 @@ def probe_cutoffs(workdir):
     return (r["cutoff"] or pair_default, r["wall_cutoff"] or wall_default)
 
 
-# ---------------------------------------------------------------------------------------------
-# resistances (fdmResistance): the zeta of the estimates
-# ---------------------------------------------------------------------------------------------
-
-class Resistance:
-    """Normal and tangential resistances of the scenes, from the sub-grid functions of the
-    resistance library (fdmResistance, the code the pair style calls) plus the isolated Stokes drag
-    that fix fdm/couple transport none puts in Eq. (31)."""
-
-    def __init__(self, a, eta, delta, cutoff, wall_cutoff):
-        self.a, self.eta, self.delta, self.cutoff, self.wall_cutoff = a, eta, delta, cutoff, wall_cutoff
-        self._cache = {}
-        self._lock = threading.Lock()
-        self._tables = {}
-        self._table_lock = threading.Lock()
-
-    def _call(self, key, *args):
-        with self._lock:
-            if key in self._cache:
-                return self._cache[key]
-        value = theory.resistance(*args)
-        with self._lock:
-            self._cache[key] = value
-        return value
-
-    def pair_XA(self, gap):
-        """Sub-grid squeeze resistance X^A_11 (N s/m) of two equal spheres at surface gap `gap`."""
-        xi = gap / self.a
-        if xi >= self.cutoff * self.delta / self.a:
-            return 0.0
-        xi = max(xi, MIN_GAP)
-        out = self._call(("pair", round(math.log(xi), 12)), "pair", "--a1", self.a, "--a2", self.a, "--xi", "%.17g" % xi,
-                         "--subgrid", "--delta", self.delta, "--cutoff", self.cutoff)
-        return self.eta * out["dimensional_over_eta"]["XA11"]
-
-    def wall_functions(self, gap):
-        """Sub-grid wall functions (XA, YA, ... dimensional, N s/m etc.) at surface gap `gap`."""
-        eps = gap / self.a
-        if eps >= self.wall_cutoff * self.delta / self.a:
-            return dict(XA=0.0, YA=0.0)
-        eps = max(eps, MIN_GAP)
-        out = self._call(("wall", round(math.log(eps), 12)), "wall", "--a", self.a, "--eps", "%.17g" % eps,
-                         "--delta", self.delta, "--cutoff", self.wall_cutoff)
-        return {k: self.eta * v for k, v in out["subgrid_dimensional_over_eta"].items()}
-
-    # zeta: force per unit velocity of the mode the contact spring acts on
-    def zeta_pair(self, gap, lubrication=True):
-        """Normal resistance of two free equal spheres: F = zeta (U1 - U2).n, F the load on each."""
-        return 3 * PI * self.eta * self.a + (self.pair_XA(gap) if lubrication else 0.0)
-
-    def zeta_wall(self, gap, lubrication=True):
-        return 6 * PI * self.eta * self.a + (self.wall_functions(gap)["XA"] if lubrication else 0.0)
-
-    def zeta_sandwich_tangential(self, gap, lubrication=True):
-        """A sphere translating between two walls at the same gap (no rotation, by symmetry)."""
-        return 6 * PI * self.eta * self.a + (2 * self.wall_functions(gap)["YA"] if lubrication else 0.0)
-
-    def zeta_pair_slip(self, gap, lubrication=True):
-        """Tangential (slip) resistance of the contact of two free equal spheres: equal and opposite
-        tangential forces f at the contact points (with their torques) make the contact points slip
-        at f/zeta_t; the spheres translate and rotate (Stokes drag, 8 pi eta a^3, plus the sub-grid
-        pair block of `fdmResistance matrix`). 12/7 pi eta a without lubrication."""
-        return theory.pair_mode_resistances(self.a, self.a, gap, self.delta, self.eta, self.cutoff,
-                                            subgrid=lubrication, contact_in_mid_gap=True)[1]
-
-    def table(self, kind, lubrication, points=40, jobs=2):
-        """zeta(gap) for the gap-history predictions: sampled on log-spaced gaps, interpolated in
-        log(gap) on gap * zeta (smooth: the lubrication is ~1/gap)."""
-        key = (kind, lubrication)
-        with self._table_lock:
-            if key not in self._tables:
-                self._tables[key] = self._make_table(kind, lubrication, points, jobs)
-            return self._tables[key]
-
-    def _make_table(self, kind, lubrication, points, jobs):
-        if not lubrication:
-            z = self.zeta_pair(1.0, False) if kind == "pair" else self.zeta_wall(1.0, False)
-            f = lambda gap: z  # noqa: E731
-        else:
-            cut = (self.cutoff if kind == "pair" else self.wall_cutoff) * self.delta
-            gaps = np.geomspace(MIN_GAP * self.a, cut, points)
-            zeta = self.zeta_pair if kind == "pair" else self.zeta_wall
-            with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-                values = np.array(list(pool.map(zeta, gaps)))
-            far = zeta(2 * cut)
-            logs, products = np.log(gaps), gaps * values
-
-            def f(gap):
-                if gap >= cut:
-                    return far
-                if gap <= gaps[0]:
-                    return values[0]
-                # quadratic (Lagrange) through the three nearest samples, in log(gap)
-                s = math.log(gap)
-                i = min(max(int(np.searchsorted(logs, s)), 1), len(logs) - 2)
-                x0, x1, x2 = logs[i - 1], logs[i], logs[i + 1]
-                y0, y1, y2 = products[i - 1], products[i], products[i + 1]
-                y = (y0 * (s - x1) * (s - x2) / ((x0 - x1) * (x0 - x2)) + y1 * (s - x0) * (s - x2) / ((x1 - x0) * (x1 - x2))
-                     + y2 * (s - x0) * (s - x1) / ((x2 - x0) * (x2 - x1)))
-                return y / gap
-        return f
-
-
-# ---------------------------------------------------------------------------------------------
-# the overdamped equation of the scenes, integrated as fix fdm/couple does
-# ---------------------------------------------------------------------------------------------
-
-def predict_gap(gap0, load, kn, hr, dt, steps, zeta, integrator="ab2", settle=None):
-    """Gap history of a sphere pressed by `load` onto a partner (pair: zeta of the pair; wall), with the
-    contact force kn (hr - gap) for gap < hr, exactly as fix fdm/couple steps it: the velocity is
-    solved at step n from the positions of step n (initial velocity 0), the position moves at the
-    next step with it (euler) or with 3/2 U_n - 1/2 U_(n-1) (ab2, from the third step on).
-    With `settle` = (g_ss, tol): stops 20 steps after |gap - g_ss| < tol holds."""
-    g = []
-    x, current, previous = gap0, 0.0, None
-    quiet = 0
-    for n in range(steps):
-        if integrator == "ab2" and previous is not None:
-            x -= dt * (1.5 * current - 0.5 * previous)
-        else:
-            x -= dt * current
-        v = (load - kn * max(0.0, hr - x)) / zeta(x)
-        if n > 0:
-            previous = current
-        current = v
-        g.append(x)
-        if settle is not None:
-            quiet = quiet + 1 if abs(x - settle[0]) < settle[1] else 0
-            if quiet > 20:
-                break
-    return np.array(g)
-
-
-def amplification_theory(r, integrator):
-    """|growth factor per step| of the linearised contact: euler 1 - r; ab2 the largest root of
-    l^2 - (1 - 3r/2) l - r/2 = 0."""
-    if integrator == "euler":
-        return abs(1 - r)
-    roots = np.roots([1.0, -(1 - 1.5 * r), -0.5 * r])
-    return float(max(abs(roots)))
-
-
-def implicit_factor(r, integrator):
-    """Growth factor per step of the linearised contact with implicit springs (docs/contact.md 3c,
-    Eq. C4): (1 + r/2)/(1 + 3r/2) with ab2, 1/(1 + r) with euler; below 1 at every r, no oscillation."""
-    return (1 + 0.5 * r) / (1 + 1.5 * r) if integrator == "ab2" else 1.0 / (1 + r)
-
-
-def limit_factor(integrator):
-    """r = dt k / zeta at the stability limit: 2 (euler), 1 (ab2)."""
-    return 2.0 if integrator == "euler" else 1.0
-
-
-# ---------------------------------------------------------------------------------------------
-# analysis helpers
-# ---------------------------------------------------------------------------------------------
-
-def settle_index(gap, target, tol):
-    """First index after which |gap - target| <= tol for good (None if never)."""
-    bad = np.nonzero(np.abs(gap - target) > tol)[0]
-    if len(bad) == 0:
-        return 0
-    return None if bad[-1] == len(gap) - 1 else int(bad[-1] + 1)
-
-
-def classify(error, scale, hr=None, gap=None, g_ss=None):
-    """Stability of a perturbed steady state from its error series (gap - g_ss, or the tangential
-    force error), error[0] being the initial perturbation. Linear stability: the perturbation never
-    grows beyond 1.5 times its initial size (a stable run of either integrator stays below it; an
-    unstable one, even growing by 0.1 % per step, passes it within the run). The late behaviour is
-    labelled too (beyond the limit the contact is nonlinear: limit cycles, contact loss, overlap)."""
-    e = np.abs(np.asarray(error, float))
-    n = len(e)
-    e0 = e[0]
-    w = max(5, min(40, n // 8))
-    last = e[-w:].max()
-    grew = bool(e[1:].max() > 1.5 * e0)
-    stable = not grew
-    if last < 1e-6 * e0 or last < 1e-10 * scale:   # 1e-10: round-off of positions ~ 1e-15 m
-        label = "converged"
-    elif stable:
-        label = "decaying"
-    else:
-        label = "growing"
-        if gap is not None:
-            late = gap[-max(w, n // 2):]
-            if late.max() >= hr:
-                label = "chatter (contact lost and made again)"
-            elif late.min() < 0 and late.min() < g_ss - (hr - g_ss):
-                label = "deep overlap"
-            else:
-                label = "bounded oscillation"
-    # growth factor per step in the linear window (|e| between 1e-9 and 20 times the start)
-    lo = 3
-    hi = lo
-    while hi + 1 < n and hi - lo < 60 and 1e-9 * e0 < e[hi + 1] < 20 * e0:
-        hi += 1
-    factor = None
-    if hi - lo >= 4:
-        # envelope: the larger of each pair of neighbours (the error alternates in sign)
-        a, b = max(e[lo], e[lo + 1]), max(e[hi - 1], e[hi])
-        if a > 0 and b > 0:
-            factor = float((b / a) ** (1.0 / (hi - 1 - lo)))
-    elif n > lo + 1 and e[lo + 1] <= 1e-9 * e0:
-        factor = 0.0
-    return dict(stable=stable, label=label, factor_measured=factor, max_error_over_initial=float(e.max() / e0),
-                late_error_over_initial=float(last / e0))
-
-
 def parallel(jobs, function, items):
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
         return list(pool.map(function, items))
@@ -333,15 +122,15 @@ def normal_run(res, workdir, geometry, kn, load, hr, lubrication=True, integrato
     comes from the predicted gap history (until settled to 1e-9 F/kn), unless `steps` is given
     (then no prediction)."""
     a, eta = p["a"], p["eta"]
-    zeta_of = res.zeta_pair if geometry == "pair" else res.zeta_wall
-    g_ss = hr - load / kn
+    zeta_of = res.pair_normal if geometry == "pair" else res.wall_normal
+    g_ss = cs.steady_gap(hr, load, kn)
     compression = load / kn
     zeta_entry = zeta_of(hr, lubrication)
     zeta_ss = zeta_of(g_ss, lubrication)
     dt = r_target * min(zeta_entry, zeta_ss) / kn
     if steps is None:
-        table = res.table(geometry, lubrication)
-        predicted = predict_gap(gap0, load, kn, hr, dt, max_steps, table, integrator,
+        table = res.gap_table(geometry, lubrication)
+        predicted = cs.step_gap_history(gap0, load, kn, hr, dt, max_steps, table, integrator,
                                 settle=(g_ss, 1e-9 * compression))
         steps = min(max_steps, int(1.15 * len(predicted)) + 40)
     else:
@@ -373,12 +162,12 @@ def normal_run(res, workdir, geometry, kn, load, hr, lubrication=True, integrato
         t_contact=float(t[np.argmax(gap < hr)]) if (gap < hr).any() else None,
         min_gap=float(gap.min()),
     )
-    i = settle_index(gap, g_ss, 0.01 * compression)
+    i = cs.settle_index(gap, g_ss, 0.01 * compression)
     out["t_settle"] = float(t[i]) if i is not None else None
     if predicted is not None:
         n_pred = min(len(predicted), len(gap))
         out["history_vs_prediction"] = float(np.max(np.abs(gap[:n_pred] - predicted[:n_pred])) / compression)
-        j = settle_index(predicted, g_ss, 0.01 * compression)
+        j = cs.settle_index(predicted, g_ss, 0.01 * compression)
         out["t_settle_predicted"] = float((j + 1) * dt) if j is not None else None
     if out["t_settle"] is not None and out["t_contact"] is not None:
         out["relaxation_over_tau"] = (out["t_settle"] - out["t_contact"]) / out["tau_steady"]
@@ -415,8 +204,8 @@ def sliding_run(res, workdir, ratio, integrator="ab2", lubrication=True, Fn=LOAD
     """Ft = ratio mu_s Fn per contact."""
     kn, kt, mu, hr = p["kn"], kt or p["kt"], p["mu"], p["hr"]
     Ft = ratio * mu * Fn
-    g_w = hr - Fn / kn
-    zeta_t = res.zeta_sandwich_tangential(g_w, lubrication)
+    g_w = cs.steady_gap(hr, Fn, kn)
+    zeta_t = res.between_walls_tangential(g_w, lubrication)
     dt = r_target * zeta_t / (2 * kt)
     variables = dict(kn=kn, kt=kt, mu=mu, hr=hr, Fn=Fn, Ft=Ft, dt=dt, steps=steps, a=p["a"], eta=p["eta"],
                      delta=p["delta"], lub="yes" if lubrication else "no", integ=integrator, cint=cint)
@@ -430,7 +219,7 @@ def sliding_run(res, workdir, ratio, integrator="ab2", lubrication=True, Fn=LOAD
     u, ft, dx = d[:, 2], d[:, 4], d[:, 1]
     scale = 2 * Ft / zeta_t                               # the initial speed
     stuck = bool(abs(u[-1]) < 1e-8 * scale)
-    sliding_speed = 2 * (Ft - mu * Fn) / zeta_t
+    sliding_speed = cs.sliding_speed_between_walls(Ft, Fn, mu, zeta_t)
     out.update(stuck=stuck, U_end=float(u[-1]), ft_end=float(ft[-1]), ft_over_Ft=float(ft[-1] / Ft),
                ft_over_muFn=float(ft[-1] / (mu * Fn)), displacement=float(dx[-1]),
                spring_theory=Ft / kt, omega_max=float(np.max(np.abs(d[:, 3]))),
@@ -482,8 +271,8 @@ def rolling_runs(res, workdir, jobs, integrator):
         kn, F, Ft = BASE["kn"], LOAD, 1.0
         # the slip of the contact point of a free sphere: translation and rotation, Stokes drag only
         # (a lower bound of the resistance), 1/zeta = 1/(6 pi eta a) + a^2/(8 pi eta a^3)
-        zeta_slip = 24.0 / 7.0 * PI * BASE["eta"] * BASE["a"]
-        dt = 0.25 * min(res.zeta_wall(BASE["hr"], lubrication), zeta_slip) / max(kn, BASE["kt"])
+        zeta_slip = cs.wall_slip_resistance_stokes(BASE["a"], BASE["eta"])
+        dt = 0.25 * min(res.wall_normal(BASE["hr"], lubrication), zeta_slip) / max(kn, BASE["kt"])
         # settle the normal gap, then the rolling: several normal and tangential time scales
         steps = 3000 if not lubrication else 1500
         r = run_scene("wall", dict(kn=kn, kt=BASE["kt"], mu=BASE["mu"], hr=BASE["hr"], F=F, Ft=Ft, dt=dt, steps=steps,
@@ -494,7 +283,7 @@ def rolling_runs(res, workdir, jobs, integrator):
             d = r["data"]
             ux, w, ft = d[-1, 8], d[-1, 9], d[-1, 10]
             out.update(ft_over_Ft=float(-ft / Ft), U=float(ux), a_omega=float(-BASE["a"] * w),
-                       slip_over_U=float((ux + BASE["a"] * w) / ux), theory_no_lubrication=4.0 / 7.0)
+                       slip_over_U=float((ux + BASE["a"] * w) / ux), theory_no_lubrication=cs.ROLLING_CONTACT_FRACTION)
         else:
             out["log"] = r["log"]
         return out
@@ -517,29 +306,29 @@ class StabilityConfig:
         if geometry == "tangential":
             self.Fn = LOAD
             self.Ft = 0.1 * p["mu"] * LOAD          # far below the cap: the growth is seen before sliding
-            self.g_w = self.hr - self.Fn / self.kn
-            self.zeta = res.zeta_sandwich_tangential(self.g_w, lubrication)
+            self.g_w = cs.steady_gap(self.hr, self.Fn, self.kn)
+            self.zeta = res.between_walls_tangential(self.g_w, lubrication)
             self.stiffness = 2 * self.kt            # two springs on one sphere
         elif geometry == "pair_tangential":
             # two free spheres at their steady gap; a tangential kick of one step loads the spring,
             # which then relaxes (or not) with the spheres translating and rotating
             self.load = LOAD
-            self.g_ss = self.hr - self.load / self.kn
+            self.g_ss = cs.steady_gap(self.hr, self.load, self.kn)
             self.kick = 0.01 * p["mu"] * LOAD
-            self.zeta = res.zeta_pair_slip(self.g_ss, lubrication)
+            self.zeta = res.pair_slip(self.g_ss, lubrication)
             self.stiffness = self.kt
         else:
             self.load = LOAD
-            self.g_ss = self.hr - self.load / self.kn
+            self.g_ss = cs.steady_gap(self.hr, self.load, self.kn)
             self.compression = self.load / self.kn
             self.perturbation = 0.01 * self.compression
-            zeta = res.zeta_pair if geometry == "pair" else res.zeta_wall
+            zeta = res.pair_normal if geometry == "pair" else res.wall_normal
             self.zeta = zeta(self.g_ss, lubrication)
             self.zeta_at_start = zeta(self.g_ss + self.perturbation, lubrication)
             self.stiffness = self.kn
         # the tangential spring is integrated with the displacement of the step, so by the fix's integrator
-        self.limit_r = limit_factor(integrator)
-        self.dt_estimate = self.limit_r * self.zeta / self.stiffness
+        self.limit_r = cs.limit_ratio(integrator)
+        self.dt_estimate = cs.explicit_time_step_limit(self.zeta, self.stiffness, integrator)
 
     def run(self, workdir, dt, steps=400):
         p = self.p
@@ -559,21 +348,21 @@ class StabilityConfig:
             return out
         d = r["data"]
         if self.geometry == "tangential":
-            c = classify(d[:, 4] - self.Ft, self.Ft)
+            c = cs.classify_perturbation(d[:, 4] - self.Ft, self.Ft)
             out["ft_max"] = float(np.abs(d[:, 4]).max())
             out["sliding_seen"] = bool(np.abs(d[:, 4]).max() >= 0.999 * p["mu"] * self.Fn)
             if c["label"] == "growing":
                 c["label"] = "chatter at the Coulomb cap" if out["sliding_seen"] else "growing"
         elif self.geometry == "pair_tangential":
             ft = d[1:, 10]                          # tangential contact force on sphere 1, after the kick
-            c = classify(ft, self.kick)
+            c = cs.classify_perturbation(ft, self.kick)
             out["ft_max"] = float(np.abs(ft).max())
             out["sliding_seen"] = bool(out["ft_max"] >= 0.999 * p["mu"] * self.load)
             if c["label"] == "growing":
                 c["label"] = "chatter at the Coulomb cap" if out["sliding_seen"] else "growing"
         else:
             gap = d[:, 1]
-            c = classify(gap - self.g_ss, self.compression, self.hr, gap, self.g_ss)
+            c = cs.classify_perturbation(gap - self.g_ss, self.compression, self.hr, gap, self.g_ss)
             out["min_gap"] = float(gap.min())
             out["max_gap"] = float(gap.max())
             # zeta from the fix's own outputs at the first step: -(F^SG + F^FDM)/closing speed
@@ -582,38 +371,13 @@ class StabilityConfig:
             else:
                 out["zeta_from_outputs"] = float(-(d[0, 4] + d[0, 5]) / d[0, 2])
         out.update(c)
-        out["factor_theory"] = (implicit_factor(out["r"], self.integrator) if self.cint == "implicit"
-                                else amplification_theory(out["r"], self.integrator))
+        out["factor_theory"] = (cs.implicit_growth_factor(out["r"], self.integrator) if self.cint == "implicit"
+                                else cs.explicit_growth_factor(out["r"], self.integrator))
         return out
 
     def find_limit(self, workdir, rel_tol=0.01, steps=400):
         """Bisection in dt between a stable and an unstable run, starting from the estimate."""
-        lo, hi = 0.8 * self.dt_estimate, 1.25 * self.dt_estimate
-        runs = []
-        r_lo, r_hi = self.run(workdir, lo, steps), self.run(workdir, hi, steps)
-        runs += [r_lo, r_hi]
-        for _ in range(6):
-            if r_lo["stable"]:
-                break
-            hi, r_hi = lo, r_lo
-            lo /= 1.5
-            r_lo = self.run(workdir, lo, steps)
-            runs.append(r_lo)
-        for _ in range(6):
-            if not r_hi["stable"]:
-                break
-            lo, r_lo = hi, r_hi
-            hi *= 1.5
-            r_hi = self.run(workdir, hi, steps)
-            runs.append(r_hi)
-        while hi / lo - 1 > rel_tol:
-            mid = math.sqrt(lo * hi)
-            r = self.run(workdir, mid, steps)
-            runs.append(r)
-            if r["stable"]:
-                lo = mid
-            else:
-                hi = mid
+        lo, hi, runs = cs.bisect_stability_limit(lambda dt: self.run(workdir, dt, steps), self.dt_estimate, rel_tol)
         measured = math.sqrt(lo * hi)
         summary = dict(name=self.name, geometry=self.geometry, lubrication=self.lubrication,
                        integrator=self.integrator, stiffness=self.stiffness, zeta=self.zeta,
@@ -715,8 +479,8 @@ def implicit_equilibrium(res, workdir, jobs, multiple=10):
              dict(geometry="pair", kn=2e5, lubrication=True, dt=0.4646754831724052)]
 
     def one(c):
-        zeta_of = res.zeta_pair if c["geometry"] == "pair" else res.zeta_wall
-        g_ss = p["hr"] - LOAD / c["kn"]
+        zeta_of = res.pair_normal if c["geometry"] == "pair" else res.wall_normal
+        g_ss = cs.steady_gap(p["hr"], LOAD, c["kn"])
         zeta_ss = zeta_of(g_ss, c["lubrication"])
         dt = c.get("dt", multiple * zeta_ss / c["kn"])
         steps = 300
@@ -736,7 +500,7 @@ def implicit_equilibrium(res, workdir, jobs, multiple=10):
         out.update(gap_end=float(gap[-1]), gap_error=float((gap[-1] - g_ss) / compression),
                    normal_force_error=float((force - LOAD) / LOAD), min_gap=float(gap.min()),
                    force_balance=float(np.max(np.abs(d[:, 4] + d[:, 5])) / LOAD) if c["geometry"] == "pair" else None,
-                   settled_step=settle_index(gap, g_ss, 1e-6 * compression))
+                   settled_step=cs.settle_index(gap, g_ss, 1e-6 * compression))
         return out
     return parallel(jobs, one, cases)
 
@@ -839,7 +603,7 @@ def plot(results, path):
         a.plot([g["r"] for g in pts], [g["factor_measured"] for g in pts], marker, mfc="none",
                label="measured, %s" % integrator)
         rr = np.linspace(0.01, max(g["r"] for g in grid) * 1.05, 300)
-        a.plot(rr, [amplification_theory(x, integrator) for x in rr], "-", lw=0.8, label="theory, %s" % integrator)
+        a.plot(rr, [cs.explicit_growth_factor(x, integrator) for x in rr], "-", lw=0.8, label="theory, %s" % integrator)
     a.axhline(1.0, color="k", lw=0.8)
     a.set_xlabel("r = dt k_n / zeta (zeta at the steady gap)")
     a.set_ylabel("|growth factor of the gap error per step|")
@@ -938,7 +702,7 @@ def print_report(results):
     for r in results["rolling"]:
         if r["ok"]:
             print("  one wall, pulled at the centre (rolls), lubrication %s: ft/Ft = %.6f (4/7 = %.6f without "
-                  "lubrication), slip/U %.1e" % ("yes" if r["lubrication"] else "no", r["ft_over_Ft"], 4 / 7.,
+                  "lubrication), slip/U %.1e" % ("yes" if r["lubrication"] else "no", r["ft_over_Ft"], cs.ROLLING_CONTACT_FRACTION,
                                                  r["slip_over_U"]))
     print("(c) stability limit of dt (bisection to %g %%):" % (100 * results["stability"]["bisection_tolerance"]))
     print("  %-42s %-5s %10s %12s %12s %8s %8s" % ("scene", "integ", "zeta", "dt measured", "dt estimate", "ratio",
@@ -998,7 +762,7 @@ def main(argv=None):
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()
     cutoff, wall_cutoff = probe_cutoffs(args.workdir)
-    res = Resistance(BASE["a"], BASE["eta"], BASE["delta"], cutoff, wall_cutoff)
+    res = cs.ContactResistances(BASE["a"], BASE["eta"], BASE["delta"], cutoff, wall_cutoff)
     results = dict(case="contactTuning", full=args.full, units="SI, a = 1 m, eta = 1 Pa s",
                    parameters=dict(BASE, load=LOAD, cutoff_cells=cutoff, wall_cutoff_cells=wall_cutoff),
                    integrator=args.integrator)

@@ -48,7 +48,7 @@ def paper_contact(a1=1.0, kn=2e4, kt=200.0):
     r_x = 0). Both springs are within the ab2 limit (1) at dt = 0.05: dt kn/zeta_n = 0.62 and
     dt kt/zeta_t = 0.44, with zeta_n = 1617 and zeta_t = 22.6 N s/m the normal and slip resistances
     of the free pair at a gap of 4e-3 a1 (Stokes drag + sub-grid block at a1/Delta = 3, computed as
-    in contactTuning's Resistance.zeta_pair_slip)."""
+    in fdmsubgrid.contactstability.ContactResistances.pair_slip)."""
     return (kn, kt, 0.5, 5e-3 * a1)
 
 

@@ -6,8 +6,9 @@ offsets in a mesh cell), the scenes several cases share (channelscenes: the shea
 channel; convergence: the mesh and box study; couettescene: the Couette suspension of Table 8), pack
 spheres (packing), read what the runs write (output), compute the profiles of a wall-bounded suspension and its rheology (profiles,
 rheology, timeseries), and the analysis of a sheared-suspension run folder (shear, the fdmProfiles
-command) and of its contacts (contacts); squeeze flows and the calibration of the solver's own
-resistance, the squeeze and the tangential wall functions (squeeze, calibration, wallcalibration),
+command) and of its contacts (contacts); the contact springs' stability theory and the resistances
+they act against (contactstability: time-step limits, steady gaps, the spring recipe); squeeze flows
+and the calibration of the solver's own resistance, the squeeze and the tangential wall functions (squeeze, calibration, wallcalibration),
 and the measurement of the tangential pair modes (pairtangential); the probe of the pair's squeeze
 stresslet (pairstresslet) and of its shear-mode stresslets (pairshearstresslet); the validation report
 (validation).

@@ -23,11 +23,10 @@ plus the sub-grid block at this a1/Delta, fdmResistance).
 """
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
 
-from . import deminput, foamcase, output, packing, rheology, theory
+from . import contactstability, deminput, foamcase, output, packing, rheology, theory
 
 A1 = 1.0
 A2 = packing.A2_OVER_A1 * A1
@@ -75,14 +74,16 @@ class Springs:
 def choose_springs(stress: float, dt: float, delta: float, kn: float | None = None,
                    kt: float | None = None) -> Springs:
     """The springs by the rule of the module docstring for the shear stress `stress` [Pa], unless
-    given."""
-    design_load = 6 * math.pi * A2 ** 2 * stress
+    given (fdmsubgrid.contactstability: the design load, the recipe's k_n, the explicit springs' limits)."""
+    design_load = contactstability.design_load(A2, stress)
     zeta_n, zeta_t = theory.pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta, ETA)
-    kn = 2.0 * design_load / ROUGHNESS if kn is None else kn
+    kn = contactstability.normal_stiffness(design_load, ROUGHNESS) if kn is None else kn
     # k_t independent of dt: until the return mapping of docs/contact.md 2c the rule was
     # min(k_n, 0.5 zeta_t/dt), which softened friction as dt grew (eta_s at phi 0.47 fell with dt)
     kt = kn if kt is None else kt
-    return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t, zeta_n / kn, zeta_t / kt)
+    return Springs(kn, kt, FRICTION, ROUGHNESS, design_load, zeta_n, zeta_t,
+                   contactstability.explicit_time_step_limit(zeta_n, kn, "ab2"),
+                   contactstability.explicit_time_step_limit(zeta_t, kt, "ab2"))
 
 
 # fix fdm/couple's held_drag: how the particle steps between fluid steps hold the fluid's force; the first
