@@ -3,8 +3,9 @@ linear_solver "FFTBox-all"; their default leaves U to symGaussSeidel): on every 
 cases write it solves the real OpenFOAM matrices to round-off in one iteration (the residual is
 OpenFOAM's own, of the matrix it was given), the coupled answer is the iterative solvers' one, and
 where it cannot solve (walls on two pairs of faces, a decomposed mesh) it says why and the fallback
-gives the same answer. The separable solve itself is tested without OpenFOAM in
-fluid/tests/test_separable_box_solver.cpp."""
+gives the same answer. The box solve as a preconditioner of OpenFOAM's PCG (`preconditioner FFTBox;`)
+is what the solver runs, and falls back to DIC with its reason. The separable solve itself is tested
+without OpenFOAM in fluid/tests/test_separable_box_solver.cpp."""
 import os
 import re
 
@@ -27,14 +28,22 @@ SOLVE = re.compile(r"^(\w+):\s+Solving for (\w+), Initial residual = ([0-9.eE+-]
                    r"Final residual = ([0-9.eE+-]+), No Iterations (\d+)", re.M)
 
 
-def run_free_sphere(tmp_path, name, faces, linear_solver, np_fluid=1, tol_lambda=1e-9):
+def run_free_sphere(tmp_path, name, faces, linear_solver, np_fluid=1, tol_lambda=1e-9, edit=None):
+    """edit(fvSolution text) -> text: the written fvSolution changed before the run"""
     box = case.Box((0, 0, 0), (4.0, 4.0, 4.0), 0.25, faces=faces)
-    root = str(tmp_path / ("%s_%s_np%d" % (name.replace(" ", "_"), linear_solver, np_fluid)))
+    root = str(tmp_path / ("%s_%s_np%d%s" % (name.replace(" ", "_"), linear_solver, np_fluid,
+                                             "_" + edit.__name__ if edit else "")))
     # the inner iteration converged far below the comparison's 1e-6, the linear solves tight (relTol 0)
     case.write_fluid_case(os.path.join(root, "fluid"), box, grad_p0=(-0.1, 0, 0), tol_lambda=tol_lambda, n_max=300,
                           n_particles=1, tol_u=1e-10, tol_p=1e-10, linear_solver=linear_solver,
                           momentum_predictor=True)
     case.write_dem_input(os.path.join(root, "dem"), box, [(1.9, 2.1, 2.05, 1.0)], fix_options="move no")
+    if edit:
+        path = os.path.join(root, "fluid", "system", "fvSolution")
+        with open(path) as f:
+            text = f.read()
+        with open(path, "w") as f:
+            f.write(edit(text))
     case.run(root, np_fluid=np_fluid)
     with open(os.path.join(root, "log.fluid")) as f:
         log = f.read()
@@ -101,3 +110,37 @@ def test_a_decomposed_mesh_falls_back_and_keeps_the_serial_answer(tmp_path, env)
     _, serial = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox")
     scale = np.abs(velocities(serial)).max()
     assert np.abs(velocities(parallel) - velocities(serial)).max() < 1e-6 * scale
+
+
+def pcg_preconditioned_by_fftbox(fv_solution):
+    """Every `solver FFTBox; fallback {...}` of fvSolution written as OpenFOAM's PCG with the FFTBox
+    preconditioner"""
+    text, n = re.subn(r"solver\s+FFTBox;\s*fallback\s*\{[^}]*\}",
+                      "solver          PCG;\n        preconditioner  FFTBox;", fv_solution)
+    assert n == 2, fv_solution
+    return text
+
+
+def test_the_preconditioner_in_openfoams_pcg_is_what_the_solver_runs(tmp_path, env):
+    """`solver PCG; preconditioner FFTBox;` (the box solve as an lduMatrix::preconditioner in OpenFOAM's own
+    PCG) is what `solver FFTBox;` runs: every solve the same residuals and iterations, the same answer bit
+    for bit; where the box solve cannot serve, the preconditioner says why and preconditions with its
+    fallback (DIC), and the answer is the iterative solvers' one."""
+    name = "moving walls across y"
+    log_solver, solver = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all")
+    log_pcg, pcg = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all", edit=pcg_preconditioned_by_fftbox)
+    assert "FFTBox: p preconditioned by the box solve on 16 x 16 x 16 cells, walls across y" in log_pcg, log_pcg[-3000:]
+    by_solver = [m.groups() for m in SOLVE.finditer(log_solver)]
+    by_pcg = [m.groups() for m in SOLVE.finditer(log_pcg)]
+    assert len(by_solver) > 40 and {s[0] for s in by_solver} == {"FFTBox"} and {s[0] for s in by_pcg} == {"FFTBoxPCG"}
+    assert [s[1:] for s in by_pcg] == [s[1:] for s in by_solver]
+    assert np.array_equal(velocities(pcg), velocities(solver))
+
+    name = "walls across y and z"
+    log, fallback = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all", edit=pcg_preconditioned_by_fftbox)
+    assert ("FFTBox: p is preconditioned by DIC (the fallback): walls across y and z: FFTBox solves boxes with "
+            "walls on at most one pair of faces") in log, log[-3000:]
+    assert "FFTBox: Ux is preconditioned by DIC (the fallback)" in log
+    _, iterative = run_free_sphere(tmp_path, name, BOXES[name], "GAMG")
+    scale = np.abs(velocities(iterative)).max()
+    assert np.abs(velocities(fallback) - velocities(iterative)).max() < 1e-6 * scale

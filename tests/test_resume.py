@@ -300,9 +300,13 @@ def test_resume_step_mismatch_at_the_handshake(tmp_path, env, reference):
 def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, reference_gamg):
     """A run planned to 32 steps, finished, then continued with `fdmRun --resume --until 50` (from the
     checkpoint written at its last step): the 50-step run's trajectory and records, every step once,
-    and the input now says `run 50 upto`. With GAMG: with FFTBox for p the extended run leaves the
-    uninterrupted one by 4e-13 of the positions (round-off; the runs killed and resumed mid-run are
-    bit-identical with it), which the records' bit-for-bit check would refuse; why is open."""
+    and the input now says `run 50 upto`. With GAMG: with FFTBox for p a run resumed from step 32 (this
+    one, or one killed after step 34 and resumed from its checkpoint of 32) leaves the uninterrupted one
+    by 4.3e-13 of the positions, which the records' bit-for-bit check would refuse; resumed from steps
+    10-31, 33, 35 or 40 it is bit-identical. Not FFTBox's state: at step 33 fdmFoam's p solves (matrix,
+    source, initial guess, answer) and everything it sends fdmDEM in the first inner iteration (the
+    integrals) are bit-identical to the uninterrupted run's; the particle velocities fdmDEM answers
+    (Eq. 31) are not, so what a resumed fdmDEM lacks at step 32 is in dem/."""
     reference = reference_gamg
     root = make_scene(str(tmp_path), steps=32, linear_solver="GAMG")
     r = fdm_run(root, env)
