@@ -170,3 +170,15 @@ def test_a_channel_starts_from_the_last_record_of_another(case_module, small_run
         poiseuille.packing_from_records(path, [8, 16, 8])
     with pytest.raises(SystemExit):
         case_module.main(["--from-records", path, "--size", "8", "16", "8", "--workdir", str(tmp_path)])
+
+
+def test_budget_predicts_the_run_it_was_measured_on(case_module, small_run):
+    """--budget: the fluid steps a duration needs at the run's own fluid step, and its wall time from the
+    median step after the cold first one; predicted for the small run's own duration, it is that run's
+    summed step seconds within the steps' scatter; a run without two fluid steps is refused."""
+    b = poiseuille.budget(small_run["run_dir"], 2.0)
+    steps = output.steps(os.path.join(small_run["run_dir"], "fluid"))
+    assert b["fluid_dt"] == pytest.approx(0.05) and b["fluid_steps"] == 40 and b["measured_fluid_steps"] == 40
+    actual = sum(float(np.sum(steps[k])) for k in ("fluidSeconds", "particleSeconds", "exchangeSeconds"))
+    assert b["predicted_seconds"] == pytest.approx(actual, rel=0.3)
+    assert case_module.main(["--budget", small_run["run_dir"], "--duration", "20"])["fluid_steps"] == 400

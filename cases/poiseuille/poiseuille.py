@@ -83,6 +83,9 @@ def main(argv: list[str] | None = None) -> dict:
                         "(fix fdm/couple fluid_every; docs/benchmarks.md, 'The channel's time step')")
     p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
                    help="with --fluid-every: the held drag extrapolated from the last two fluid steps, or constant")
+    p.add_argument("--budget", metavar="RUN_DIR", default=None,
+                   help="predict the wall time of --duration from a short run of the same scene (RUN_DIR: at least "
+                        "two fluid steps, e.g. --paper --run --duration 1) and exit")
     p.add_argument("--from-records", metavar="RECORDS", default=None,
                    help="start from the particles of the last block of this particle records file (dem/"
                         "particles.records of a run of the same channel, e.g. its dense core) instead of a "
@@ -92,6 +95,19 @@ def main(argv: list[str] | None = None) -> dict:
     started = time.time()
     material = sbm.from_couette_results(args.couette) if args.couette else None
 
+    if args.budget:
+        try:
+            b = poiseuille.budget(args.budget, args.duration)
+        except (OSError, ValueError) as e:
+            p.error("--budget: %s" % e)
+        print("budget of %s for %g time units: %d fluid steps of %g (the particles at the run's own dt), %.1f s each "
+              "(fluid %.1f, particles %.1f, exchange %.1f; %.0f inner iterations) after a first step of %.0f s: "
+              "%.1f h at the load the short run had" % (
+                  args.budget, b["duration"], b["fluid_steps"], b["fluid_dt"], b["seconds_per_fluid_step"],
+                  b["parts_per_fluid_step"]["fluid"], b["parts_per_fluid_step"]["particle"],
+                  b["parts_per_fluid_step"]["exchange"], b["inner_iterations_per_fluid_step"],
+                  b["first_step_seconds"], b["predicted_hours"]))
+        return b
     if args.analyse and args.compare:
         return compare(args.analyse, args.compare, material, args.from_time)
     if args.analyse:

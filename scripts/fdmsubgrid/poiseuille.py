@@ -148,6 +148,33 @@ def time_step_warning(dt: float, fluid_every: int) -> str | None:
             "--fluid-every %d)" % ("; ".join(beyond), DEFAULT_DT, DEFAULT_FLUID_EVERY))
 
 
+def budget(run_dir: str, duration: float) -> dict:
+    """The wall time a channel run would take for `duration` (in L_y/(2 U_c)), predicted from a short run
+    of the same scene (run_dir: at least two fluid steps): the median seconds of a fluid step after the
+    first (fluid solve, the particle steps between, exchange; fdmFoam's steps.dat), times the fluid steps
+    the duration needs, plus the first (cold) step as measured. A run at the same load as the short one
+    is assumed: quote the load beside it."""
+    steps = output.steps(os.path.join(run_dir, "fluid"))
+    if len(steps["step"]) < 2:
+        raise ValueError("%s: %d fluid step(s) in steps.dat; the budget needs at least two (the first is cold)"
+                         % (run_dir, len(steps["step"])))
+    width = float(np.asarray(output.read_records_header(
+        os.path.join(run_dir, "dem", "particles.records"))["box_hi"])[1])
+    time_unit = width / (2 * (width / 4))            # L_y/(2 U_c) with U_c = L_y/4
+    times = np.asarray(steps["time"]) / time_unit
+    fluid_dt = float(np.median(np.diff(times[1:]))) if len(times) > 2 else float(times[1] - times[0])
+    parts = {k: np.asarray(steps[k + "Seconds"], dtype=float) for k in ("fluid", "particle", "exchange")}
+    per_step = {k: float(np.median(v[1:])) for k, v in parts.items()}
+    first = float(sum(v[0] for v in parts.values()))
+    each = sum(per_step.values())
+    fluid_steps = int(math.ceil(duration / fluid_dt))
+    seconds = first + (fluid_steps - 1) * each
+    return dict(duration=duration, fluid_dt=fluid_dt, fluid_steps=fluid_steps, measured_fluid_steps=len(times),
+                first_step_seconds=first, seconds_per_fluid_step=each, parts_per_fluid_step=per_step,
+                inner_iterations_per_fluid_step=float(np.median(np.asarray(steps["innerIterations"])[1:])),
+                predicted_seconds=seconds, predicted_hours=seconds / 3600)
+
+
 def flow_rate(run_dir: str) -> tuple[NDArray, NDArray]:
     """The bulk velocity of the channel at every fluid step: times (in L_y/(2 U_c)) and the mean of U_x
     over the whole box (fluid and particle interiors, fdmFoam's steps.dat) over 2 U_c, the Newtonian
