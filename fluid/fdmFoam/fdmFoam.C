@@ -32,6 +32,7 @@ Usage
 #include "OFstream.H"
 #include "OStringStream.H"
 #include "emptyFvPatch.H"
+#include "fixedValueFvPatchFields.H"
 #include "uniformCartesianMesh.H"
 #include "particleForcing.H"
 #include "fluidCoupling.H"
@@ -44,6 +45,17 @@ Usage
 
 namespace
 {
+    //- What the construction of an fvMatrix does to its field first (the
+    //  matrices of UEqn.H and pEqn.H are kept, not constructed again): the
+    //  patches' coefficients updated, its event number left as it was
+    template<class Type>
+    void updatePatchCoeffs(Foam::GeometricField<Type, Foam::fvPatchField, Foam::volMesh>& psi)
+    {
+        const Foam::label eventNo = psi.eventNo();
+        psi.boundaryFieldRef().updateCoeffs();
+        psi.eventNo() = eventNo;
+    }
+
     double wallClock()
     {
         using namespace std::chrono;
@@ -177,7 +189,7 @@ int main(int argc, char *argv[])
         // Step 2
         forcing.truncateLambda(lambda);
         forcing.pseudoTimeCoefficient(rDTau, rDTauInside, rDTauOutside);
-        rAUCurrent = false;     // UEqn.H recomputes 1/A with this rDTau
+        rAUCurrent = false;     // matrixCache.H: the matrices for this rDTau
         meanFlow.setForcedCells(forcing.covered());
         stepParticleTime += wallClock() - stepStart;
 
@@ -395,6 +407,8 @@ int main(int argc, char *argv[])
             << pct(checkpointTime) << " %; every "
             << coupling.checkpointEvery() << " steps and at the end)" << nl;
     }
+    Info<< "fdmFoam momentum and pressure matrices assembled " << nMatrixAssemblies
+        << " times (pseudo-time coefficient or wall velocities changed)" << nl;
     Info<< "fdmFoam inner iterations by part (" << nInnerTotal << " inner iterations, "
         << profile.total() << " s):" << nl
         << profile.report(profile.total(), nInnerTotal, "iteration").c_str() << endl;
