@@ -41,6 +41,7 @@ Usage
 #include "fluidCheckpoint.H"
 #include "meanFlowCorrection.H"
 #include "runProfile.H"
+#include "fieldKernels.H"
 #include <chrono>
 
 namespace
@@ -220,7 +221,7 @@ int main(int argc, char *argv[])
             profile.start();
             if (accelerate)
             {
-                anderson.pack(U, lambda, p, state);
+                anderson.pack(U, lambda, p, forcing.coveredCells(), state);
                 profile.lap("Anderson mixing");
             }
             convergence.startIteration(U);
@@ -290,7 +291,7 @@ int main(int argc, char *argv[])
             {
                 t0 = wallClock();
                 profile.start();
-                anderson.accelerate(state, U, lambda, p);
+                anderson.accelerate(state, forcing.coveredCells(), U, lambda, p);
                 profile.lap("Anderson mixing");
                 stepFluidTime += wallClock() - t0;
             }
