@@ -408,8 +408,9 @@ int main(int argc, char *argv[])
             << pct(checkpointTime) << " %; every "
             << coupling.checkpointEvery() << " steps and at the end)" << nl;
     }
-    Info<< "fdmFoam momentum and pressure matrices assembled " << nMatrixAssemblies
-        << " times (pseudo-time coefficient or wall velocities changed)" << nl;
+    Info<< "fdmFoam momentum and pressure matrices assembled at "
+        << nMatrixAssemblies << " of " << nStepsDone << " steps (when the"
+        << " pseudo-time coefficient or a wall velocity changed)" << nl;
     Info<< "fdmFoam inner iterations by part (" << nInnerTotal << " inner iterations, "
         << profile.total() << " s):" << nl
         << profile.report(profile.total(), nInnerTotal, "iteration").c_str() << endl;

@@ -201,9 +201,12 @@ void Foam::fieldKernels::HbyA
         h[i] = r[i]*H[i];
     }
 
-    // Walls: U's value where it cannot be assigned (constrainHbyA), else
-    // rAU times H extrapolated (H's extrapolatedCalculated patches).
-    // Coupled patches take their neighbours' cell values where used.
+    // Coupled patches: the neighbours' HbyA (a processor patch holds the
+    // other rank's cell values, which the flux reads; there rAU_b H_b is
+    // that rank's own product, the same bits). Walls: U's value where it
+    // cannot be assigned (constrainHbyA), else rAU times H extrapolated
+    // (H's extrapolatedCalculated patches).
+    HbyA.correctBoundaryConditions();
     volVectorField::Boundary& hbf = HbyA.boundaryFieldRef();
     forAll(hbf, patchi)
     {
