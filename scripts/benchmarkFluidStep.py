@@ -3,9 +3,9 @@
 docs/benchmarks.md "Direct solver for box meshes (FFTBox)").
 
 Two scenes, each written twice by the cases' own writers, once per linear-solver choice
-(FDM_LINEAR_SOLVER, fdmsubgrid.foamcase: "FFTBox" = FFTBox for p and U with the momentum predictor off,
-the cases' default; "GAMG" = GAMG for p, symGaussSeidel for U, the momentum predictor on, the cases'
-fvSolution before FFTBox):
+(FDM_LINEAR_SOLVER, fdmsubgrid.foamcase: "FFTBox" = FFTBox for p, smoothSolver symGaussSeidel for U,
+the momentum predictor on, the cases' default; "GAMG" = GAMG for p, symGaussSeidel for U, the momentum
+predictor on, the cases' fvSolution before FFTBox):
 
   table8    the Table 8 scene at phi_bulk 0.37 (481 spheres, 60^3 = 216 000 cells:
             couette.py --table8 0.37 --dt 0.04 --tol-lambda 0.01), --steps steps;

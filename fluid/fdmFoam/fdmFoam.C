@@ -32,6 +32,7 @@ Usage
 #include "OFstream.H"
 #include "OStringStream.H"
 #include "emptyFvPatch.H"
+#include "fixedValueFvPatchFields.H"
 #include "uniformCartesianMesh.H"
 #include "particleForcing.H"
 #include "fluidCoupling.H"
@@ -40,10 +41,22 @@ Usage
 #include "fluidCheckpoint.H"
 #include "meanFlowCorrection.H"
 #include "runProfile.H"
+#include "fieldKernels.H"
 #include <chrono>
 
 namespace
 {
+    //- What the construction of an fvMatrix does to its field first (the
+    //  matrices of UEqn.H and pEqn.H are kept, not constructed again): the
+    //  patches' coefficients updated, its event number left as it was
+    template<class Type>
+    void updatePatchCoeffs(Foam::GeometricField<Type, Foam::fvPatchField, Foam::volMesh>& psi)
+    {
+        const Foam::label eventNo = psi.eventNo();
+        psi.boundaryFieldRef().updateCoeffs();
+        psi.eventNo() = eventNo;
+    }
+
     double wallClock()
     {
         using namespace std::chrono;
@@ -177,7 +190,7 @@ int main(int argc, char *argv[])
         // Step 2
         forcing.truncateLambda(lambda);
         forcing.pseudoTimeCoefficient(rDTau, rDTauInside, rDTauOutside);
-        rAUCurrent = false;     // UEqn.H recomputes 1/A with this rDTau
+        rAUCurrent = false;     // matrixCache.H: the matrices for this rDTau
         meanFlow.setForcedCells(forcing.covered());
         stepParticleTime += wallClock() - stepStart;
 
@@ -208,7 +221,7 @@ int main(int argc, char *argv[])
             profile.start();
             if (accelerate)
             {
-                anderson.pack(U, lambda, p, state);
+                anderson.pack(U, lambda, p, forcing.coveredCells(), state);
                 profile.lap("Anderson mixing");
             }
             convergence.startIteration(U);
@@ -278,7 +291,7 @@ int main(int argc, char *argv[])
             {
                 t0 = wallClock();
                 profile.start();
-                anderson.accelerate(state, U, lambda, p);
+                anderson.accelerate(state, forcing.coveredCells(), U, lambda, p);
                 profile.lap("Anderson mixing");
                 stepFluidTime += wallClock() - t0;
             }
@@ -395,6 +408,9 @@ int main(int argc, char *argv[])
             << pct(checkpointTime) << " %; every "
             << coupling.checkpointEvery() << " steps and at the end)" << nl;
     }
+    Info<< "fdmFoam momentum and pressure matrices assembled at "
+        << nMatrixAssemblies << " of " << nStepsDone << " steps (when the"
+        << " pseudo-time coefficient or a wall velocity changed)" << nl;
     Info<< "fdmFoam inner iterations by part (" << nInnerTotal << " inner iterations, "
         << profile.total() << " s):" << nl
         << profile.report(profile.total(), nInnerTotal, "iteration").c_str() << endl;

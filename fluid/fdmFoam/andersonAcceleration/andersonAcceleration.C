@@ -42,6 +42,7 @@ void Foam::andersonAcceleration::pack
     const volVectorField& U,
     const volVectorField& lambda,
     const volScalarField& p,
+    const labelUList& lambdaCells,
     scalarField& x
 ) const
 {
@@ -49,16 +50,30 @@ void Foam::andersonAcceleration::pack
     const vectorField& l = lambda.primitiveField();
     const scalarField& pk = p.primitiveField();
     const label n = u.size();
+    const label m = lambdaCells.size();
 
-    x.setSize(7*n);
+    // u, then lambda in the covered cells, then p: the order of the full
+    // state with lambda's zeros left out, so every inner product adds the
+    // same nonzero terms in the same order
+    x.setSize(4*n + 3*m);
+    scalar* xu = x.data();
+    scalar* xl = xu + 3*n;
+    scalar* xp = xl + 3*m;
     for (label i = 0; i < n; ++i)
     {
         for (direction d = 0; d < 3; ++d)
         {
-            x[3*i + d] = u[i][d];
-            x[3*n + 3*i + d] = lambdaScale_*l[i][d];
+            xu[3*i + d] = u[i][d];
         }
-        x[6*n + i] = pressureScale_*pk[i];
+        xp[i] = pressureScale_*pk[i];
+    }
+    for (label j = 0; j < m; ++j)
+    {
+        const vector& lj = l[lambdaCells[j]];
+        for (direction d = 0; d < 3; ++d)
+        {
+            xl[3*j + d] = lambdaScale_*lj[d];
+        }
     }
 }
 
@@ -66,13 +81,14 @@ void Foam::andersonAcceleration::pack
 void Foam::andersonAcceleration::accelerate
 (
     const scalarField& x,
+    const labelUList& lambdaCells,
     volVectorField& U,
     volVectorField& lambda,
     volScalarField& p
 )
 {
     scalarField& next = next_;
-    pack(U, lambda, p, next);
+    pack(U, lambda, p, lambdaCells, next);
     if (!mixing_.mix(x.cdata(), next.data(), next.size()))
     {
         return;     // no history yet: the fields already hold G(x_k)
@@ -82,14 +98,25 @@ void Foam::andersonAcceleration::accelerate
     vectorField& l = lambda.primitiveFieldRef();
     scalarField& pk = p.primitiveFieldRef();
     const label n = u.size();
+    const label m = lambdaCells.size();
+    const scalar* xu = next.cdata();
+    const scalar* xl = xu + 3*n;
+    const scalar* xp = xl + 3*m;
     for (label i = 0; i < n; ++i)
     {
         for (direction d = 0; d < 3; ++d)
         {
-            u[i][d] = next[3*i + d];
-            l[i][d] = next[3*n + 3*i + d]/lambdaScale_;
+            u[i][d] = xu[3*i + d];
         }
-        pk[i] = next[6*n + i]/pressureScale_;
+        pk[i] = xp[i]/pressureScale_;
+    }
+    for (label j = 0; j < m; ++j)
+    {
+        vector& lj = l[lambdaCells[j]];
+        for (direction d = 0; d < 3; ++d)
+        {
+            lj[d] = xl[3*j + d]/lambdaScale_;
+        }
     }
     U.correctBoundaryConditions();
     lambda.correctBoundaryConditions();

@@ -101,11 +101,24 @@ void Foam::innerConvergence::endIteration
 {
     lambdaResidual_ = lambdaResidual;
 
+    // max |u|, sum |u - u_before|^2 and sum |u|^2 in one loop, each sum in
+    // the order gSum adds (max |u| as the root of max |u|^2: the root is
+    // monotonic and correctly rounded, so the same number)
     const vectorField& u = U.primitiveField();
-    const scalar uMax = max(gMax(mag(u)), VSMALL);
+    scalar uMax2 = 0, sumChange2 = 0, sumU2 = 0;
+    forAll(u, celli)
+    {
+        const scalar u2 = magSqr(u[celli]);
+        uMax2 = max(uMax2, u2);
+        sumChange2 += magSqr(u[celli] - flowBefore_[celli]);
+        sumU2 += u2;
+    }
+    reduce(uMax2, maxOp<scalar>());
+    reduce(sumChange2, sumOp<scalar>());
+    reduce(sumU2, sumOp<scalar>());
+    const scalar uMax = max(Foam::sqrt(uMax2), VSMALL);
     flowChange_ =
-        Foam::sqrt(gSum(magSqr(u - flowBefore_)))
-       /max(Foam::sqrt(gSum(magSqr(u))), VSMALL);
+        Foam::sqrt(sumChange2)/max(Foam::sqrt(sumU2), VSMALL);
 
     // The first inner iteration of a step has no previous velocities of
     // this step to compare with: its change counts as large.

@@ -20,6 +20,8 @@ Foam::particleForcing::particleForcing
     offset_(1, 0),
     IuScale_(grid.mesh().nCells(), 1.0),
     covered_(grid.mesh().nCells(), false),
+    du_(grid.mesh().nCells(), Zero),
+    dLambda_(grid.mesh().nCells(), Zero),
     maxCoreSlip_(0),
     lambdaNorm_(0),
     wallOverlapReported_(false)
@@ -186,11 +188,17 @@ void Foam::particleForcing::setParticles(const List<fdmParticle>& particles)
     {
         Ilambda_[e] = 1.0/count[cell_[e]];
     }
+    DynamicList<label> coveredCells(cell_.size());
     forAll(count, celli)
     {
         covered_[celli] = count[celli] > 0;
         IuScale_[celli] = 1.0/max(scalar(1), IuSum[celli]);
+        if (covered_[celli])
+        {
+            coveredCells.append(celli);
+        }
     }
+    coveredCells_.transfer(coveredCells);
 
     // The rigid-body block of Eq. (31) (fdm/coupler.h, Volumes): the discrete
     // sphere's volume, first moment and inertia tensor, so that U + Omega x r
@@ -300,9 +308,11 @@ Foam::scalar Foam::particleForcing::correct
     vectorField& l = lambda.primitiveFieldRef();
 
     // Corrections are computed from u* for every particle before any is
-    // applied, so that overlapping particles see the same u*.
-    vectorField du(u.size(), Zero);
-    vectorField dLambda(u.size(), Zero);
+    // applied, so that overlapping particles see the same u*. They are
+    // summed in fields kept zero outside the particles' cells (du_,
+    // dLambda_), which are the only cells visited.
+    vectorField& du = du_;
+    vectorField& dLambda = dLambda_;
     scalar sumDl2 = 0, sumL2 = 0;
     maxCoreSlip_ = 0;
 
@@ -323,8 +333,11 @@ Foam::scalar Foam::particleForcing::correct
             }
         }
     }
-    u += du;
-    l += dLambda;
+    for (const label celli : coveredCells_)
+    {
+        u[celli] += du[celli];
+        l[celli] += dLambda[celli];
+    }
 
     // The residual is the change of the cell's lambda, not the sum of each
     // particle's share: where two particles overlap (I_lambda = 0.5 each) and
@@ -335,6 +348,12 @@ Foam::scalar Foam::particleForcing::correct
         const label celli = cell_[e];
         sumDl2 += Ilambda_[e]*magSqr(dLambda[celli])*V[celli];
         sumL2 += Ilambda_[e]*magSqr(l[celli])*V[celli];
+    }
+
+    for (const label celli : coveredCells_)
+    {
+        du[celli] = Zero;
+        dLambda[celli] = Zero;
     }
 
     reduce(sumDl2, sumOp<scalar>());

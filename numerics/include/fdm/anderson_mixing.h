@@ -77,29 +77,38 @@ public:
     //  left as G(x_k): the plain step).
     bool mix(const double* x, double* g, std::size_t n)
     {
-        // f = G(x) - x into the spare buffer, which then becomes previousF_
-        f_.resize(n);
-        for (std::size_t i = 0; i < n; ++i)
-        {
-            f_[i] = g[i] - x[i];
-        }
         if (!havePrevious_)
         {
             previousG_.assign(g, g + n);
-            previousF_.swap(f_);
+            previousF_.resize(n);
+            for (std::size_t i = 0; i < n; ++i)
+            {
+                previousF_[i] = g[i] - x[i];
+            }
             havePrevious_ = true;
             return false;
         }
+        // one pass over the vectors: f = G(x) - x, the new differences
+        // dG = G - G_prev and df = f - f_prev, and G and f kept as the
+        // previous ones (separate loops read g three times)
         std::vector<double> dG = spareVector(n), dF = spareVector(n);
-        for (std::size_t i = 0; i < n; ++i)
         {
-            dG[i] = g[i] - previousG_[i];
-            dF[i] = f_[i] - previousF_[i];
+            double* pG = previousG_.data();
+            double* pF = previousF_.data();
+            double* dGi = dG.data();
+            double* dFi = dF.data();
+            for (std::size_t i = 0; i < n; ++i)
+            {
+                const double gi = g[i];
+                const double fi = gi - x[i];
+                dGi[i] = gi - pG[i];
+                dFi[i] = fi - pF[i];
+                pG[i] = gi;
+                pF[i] = fi;
+            }
         }
         dG_.push_back(std::move(dG));
         dF_.push_back(std::move(dF));
-        std::copy(g, g + n, previousG_.begin());
-        previousF_.swap(f_);
         const std::vector<double>& f = previousF_;
         const std::vector<double>& dFNew = dF_.back();
 
@@ -280,8 +289,6 @@ private:
     std::deque<std::vector<double> > gram_;
     std::vector<double> previousG_;
     std::vector<double> previousF_;
-    //- Work vector of the new residual
-    std::vector<double> f_;
     //- Vectors of dropped differences, reused
     std::vector<std::vector<double> > spare_;
     //- Entries per block of the blocked loops (fits the L1/L2 caches)
