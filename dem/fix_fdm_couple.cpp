@@ -64,6 +64,15 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   size_peratom_cols = perAtomColumns_;
   session_.attach(this, options_.sessionRequest());
   if (!session_.resumeFile().empty() && !session_.connected()) readResumeCheckpoint();
+  // LIGGGHTS re-neighbours at every checkpoint step (initial_integrate names it): the positions a
+  // checkpoint holds are then wrapped into the box and the neighbour lists built from them, as a
+  // resumed run's set-up wraps and lists them (else a particle that crossed a periodic face since the
+  // last re-neighbouring is wrapped at the resume but later in the uninterrupted run: x + L + dx is
+  // not x + dx + L in floating point)
+  if (options_.checkpointEvery > 0) {
+    force_reneighbor = 1;
+    next_reneighbor = -1;
+  }
 }
 
 FixFdmCouple::~FixFdmCouple()
@@ -203,6 +212,7 @@ void FixFdmCouple::initial_integrate(int)
   // (Eqs. 28d-e). The displacement rates were planned at the end of the previous step
   // (planNextMove: Adams-Bashforth 2 with the log-gap correction of position_update.h); the very
   // first step moves with the velocities the input gave.
+  if (force_reneighbor) next_reneighbor = checkpointDue() ? update->ntimestep : -1;
   if (!options_.move) return;
   const Profile::Clock::time_point start = Profile::now();
   const double dt = update->dt;

@@ -657,7 +657,7 @@ void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const dou
 {
   // The tangential spring and the Coulomb cap shared by pair and wall contacts: the elongation
   // accumulates the tangential relative velocity of the contact points over dt (0 in setup force
-  // evaluations, which do not advance time), stays in the tangent plane, and kt |shear| is capped
+  // evaluations, which do not advance time and hand a copy of it), stays in the tangent plane, and kt |shear| is capped
   // at mu_s |F_n| (sliding: the spring is reset to the cap). Returns the total force on the
   // particle on the n side, and n x F_t for the torques.
   const double vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
@@ -733,8 +733,13 @@ void PairFdmSubgrid::contactForces()
       for (int d = 0; d < 3; d++) w[d] = leverI * omega[i][d] + leverJ * omega[j][d];
       const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - v[j][d] - wxn[d];
-      double force[3], nxft[3];
-      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
+      // a setup force evaluation (a run's start, a resumed run's first) reads the spring and leaves it
+      // as it is: the law's projection onto the tangent plane and its Coulomb cap, applied again at
+      // the same positions, may move it by an ulp, and a resumed run would not continue the springs of
+      // the run it continues (contactLaw on a copy)
+      double force[3], nxft[3], setupShear[3] = {shear[0], shear[1], shear[2]};
+      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, update->setupflag ? setupShear : shear, force,
+                 nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= leverI * nxft[d];
@@ -793,8 +798,10 @@ void PairFdmSubgrid::wallContactForces()
       const double aw[3] = {radius[i] * omega[i][0], radius[i] * omega[i][1], radius[i] * omega[i][2]};
       const double wxn[3] = {aw[1] * n[2] - aw[2] * n[1], aw[2] * n[0] - aw[0] * n[2], aw[0] * n[1] - aw[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - wall.velocity[d] - wxn[d];
-      double force[3], nxft[3];
-      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, shear, force, nxft);
+      // a setup force evaluation leaves the spring as it is (as for pairs, contactForces)
+      double force[3], nxft[3], setupShear[3] = {shear[0], shear[1], shear[2]};
+      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, update->setupflag ? setupShear : shear, force,
+                 nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];

@@ -382,6 +382,44 @@ TEST(PairFdmSubgrid, ContactForcesAreEqualOppositeAndEnterEq31)
     }
 }
 
+TEST(PairFdmSubgrid, ASecondRunContinuesTheContactSpringsBitForBit)
+{
+    // A run split in two (run k, then run N upto) is the one run: the force evaluation of the second
+    // run's setup reads the tangential springs but leaves them as they are (re-projecting a spring onto
+    // the tangent plane, or capping it at mu_s |F_n| again, moves it by an ulp; a resumed run starts
+    // with that evaluation too). Sliding contacts (mu_s small), one between two spheres, one with a
+    // moving wall, so that both are capped at every step.
+    Scene scene;
+    scene.boundary = "p f p";
+    const double r = 1.02, n[3] = {0.6, 0.48, 0.64};
+    scene.spheres = {{3.0, 0.52, 4.0, 0.5, 2500.0}, {5.0, 4.0, 4.0, 0.5, 2500.0},
+                     {5.0 + r * n[0], 4.0 + r * n[1], 4.0 + r * n[2], 0.5, 2500.0}};
+    scene.pairStyle = "fdm/subgrid lubrication no contact 100 80 0.001 0.05 unstable_step warn "
+                      "wall ylo 0.3 0 0.1 wall yhi 0 0 0";
+    std::vector<std::vector<double> > runs;
+    for (const std::string& split : {std::string(), std::string("4"), std::string("7")}) {
+        const std::string dir = workDir("splitrun" + split);
+        scene.runs = split.empty() ? "run             12" : "run             " + split + "\nrun             12 upto";
+        FakeFluid fluid(dir);
+        movingWall(fluid);
+        const DemRun run = runWithFluid(dir, scene, fluid);
+        ASSERT_EQ(run.status, 0) << run.output;
+        ASSERT_TRUE(fluid.error.empty()) << fluid.error;
+        expectContains(run.output, "2 contacts");
+        std::vector<double> all;
+        for (const cpl::Velocities& v : fluid.velocities) {
+            const std::vector<double> u = flat(v);
+            all.insert(all.end(), u.begin(), u.end());
+        }
+        ASSERT_EQ(all.size(), size_t(12 * 3 * 18));   // 12 steps of 3 inner iterations, 3 particles
+        runs.push_back(all);
+    }
+    for (size_t s = 1; s < runs.size(); ++s)
+        for (size_t k = 0; k < runs[0].size(); ++k)
+            ASSERT_EQ(runs[s][k], runs[0][k]) << "split " << (s == 1 ? 4 : 7) << ": step " << k / 54 + 1
+                                              << ", value " << k % 54 << " (bit for bit)";
+}
+
 TEST(PairFdmSubgridErrors, UndeclaredFluidWall)
 {
     Scene scene = wallScene();
