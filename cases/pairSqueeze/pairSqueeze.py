@@ -22,7 +22,7 @@ from typing import List
 from fdmsubgrid import case, theory
 from fdmsubgrid import squeeze
 from fdmsubgrid.results import Row, write_results
-from fdmsubgrid.squeeze import box_extrapolated, run_pair
+from fdmsubgrid.squeeze import run_pair
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -89,20 +89,11 @@ def main(argv=None):
     for ratio in args.ratios:
         reference = [theory.pair_squeeze_velocity(1.0, ratio, xi) for xi in args.xi]
         entry = dict(**{"lambda": ratio}, xi=args.xi, theory=reference)
-        for subgrid in ([True] if args.no_reference else [True, False]):
-            options = "model %s" % args.model if subgrid else ""
-            r = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.L_over_a, args.tol_lambda,
-                         args.cutoff, args.np_fluid, args.keep, pair_options=options, offset=args.offset)
-            if args.box_extrapolate:
-                r2 = run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, args.box_extrapolate,
-                              args.tol_lambda, args.cutoff, args.np_fluid, args.keep, pair_options=options,
-                              offset=args.offset)
-                r = box_extrapolated(r, r2, args.L_over_a, args.box_extrapolate)
-            r["rel_error"] = theory.relative_errors(r["velocity"], reference)
-            entry["subgrid" if subgrid else "nosubgrid"] = r
-            print("lambda %g, sub-grid %s: %.0f s" % (ratio, "on" if subgrid else "off", r["wall_seconds"]))
-            for xi, v, ref, e in zip(args.xi, r["velocity"], reference, r["rel_error"]):
-                print("  xi %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (xi, v, ref, 100 * e))
+        entry.update(squeeze.against_theory(
+            lambda L, subgrid, options: run_pair(args.workdir, ratio, args.xi, subgrid, args.a_over_delta, L,
+                                                 args.tol_lambda, args.cutoff, args.np_fluid, args.keep,
+                                                 pair_options=options, offset=args.offset),
+            args.xi, "xi", reference, args, label="lambda %g, " % ratio))
         results["cases"].append(entry)
     write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if "nosubgrid" in results["cases"][0]:

@@ -22,7 +22,7 @@ from typing import List
 from fdmsubgrid import case, theory
 from fdmsubgrid import squeeze
 from fdmsubgrid.results import Row, write_results
-from fdmsubgrid.squeeze import box_extrapolated, run_wall
+from fdmsubgrid.squeeze import run_wall
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -82,21 +82,11 @@ def main(argv=None):
     results = dict(case="wallSqueeze", a_over_delta=args.a_over_delta, L_over_a=args.L_over_a, H_over_a=args.H_over_a,
                    box_extrapolated_with=args.box_extrapolate, model=args.model,
                    cutoff_cells=args.cutoff or "default", tol_lambda=args.tol_lambda, eps=args.eps, theory=reference)
-    for subgrid in ([True] if args.no_reference else [True, False]):
-        options = "model %s" % args.model if subgrid else ""
-        r = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.L_over_a, args.H_over_a, args.tol_lambda,
-                     args.cutoff, args.np_fluid, args.keep, pair_options=options, offset=args.offset)
-        if args.box_extrapolate:
-            scale = args.box_extrapolate / args.L_over_a
-            r2 = run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, args.box_extrapolate,
-                          args.H_over_a * scale, args.tol_lambda, args.cutoff, args.np_fluid, args.keep,
-                          pair_options=options, offset=args.offset)
-            r = box_extrapolated(r, r2, args.L_over_a, args.box_extrapolate)
-        r["rel_error"] = theory.relative_errors(r["velocity"], reference)
-        results["subgrid" if subgrid else "nosubgrid"] = r
-        print("sub-grid %s: %.0f s" % ("on" if subgrid else "off", r["wall_seconds"]))
-        for eps, v, ref, e in zip(args.eps, r["velocity"], reference, r["rel_error"]):
-            print("  eps %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (eps, v, ref, 100 * e))
+    results.update(squeeze.against_theory(
+        lambda L, subgrid, options: run_wall(args.workdir, args.eps, subgrid, args.a_over_delta, L,
+                                             args.H_over_a * (L / args.L_over_a), args.tol_lambda, args.cutoff,
+                                             args.np_fluid, args.keep, pair_options=options, offset=args.offset),
+        args.eps, "eps", reference, args))
     write_results(args.out, __file__, argv, args, validation_rows, results, t0)
     if "nosubgrid" in results:
         plot(results, os.path.join(os.path.dirname(args.out), "results_wallSqueeze.png"))

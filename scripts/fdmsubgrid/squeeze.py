@@ -22,6 +22,7 @@ import numpy as np
 
 from . import deminput, files, foamcase, runner
 from .results import Row, relative
+from .theory import relative_errors
 
 # Where the scene sits inside its first mesh cell (fractions of Delta along x, y, z): off the mesh's
 # symmetry planes, as the squeeze cases have always used.
@@ -209,6 +210,27 @@ def box_text(results: dict) -> str:
     text = "a1/Δ %g, L %g a1" % (results["a_over_delta"], results["L_over_a"])
     return text + (" (→ ∞ with L %g)" % results["box_extrapolated_with"] if results.get("box_extrapolated_with")
                    else "")
+
+
+def against_theory(run, gaps: Sequence[float], gap_name: str, reference: Sequence[float], options,
+                   label: str = "") -> dict:
+    """A squeeze case's measurement: run(L_over_a, subgrid, pair_options) with the sub-grid correction
+    (pair_options 'model MODEL') and, unless options.no_reference, without it; with options.box_extrapolate
+    each also in that second box and extrapolated (box_extrapolated). Each result gets its rel_error against
+    `reference` and is printed gap by gap. Returns {'subgrid': result, 'nosubgrid': result}."""
+    out = {}
+    for subgrid in ([True] if options.no_reference else [True, False]):
+        pair_options = "model %s" % options.model if subgrid else ""
+        r = run(options.L_over_a, subgrid, pair_options)
+        if options.box_extrapolate:
+            r = box_extrapolated(r, run(options.box_extrapolate, subgrid, pair_options), options.L_over_a,
+                                 options.box_extrapolate)
+        r["rel_error"] = relative_errors(r["velocity"], reference)
+        out["subgrid" if subgrid else "nosubgrid"] = r
+        print("%ssub-grid %s: %.0f s" % (label, "on" if subgrid else "off", r["wall_seconds"]))
+        for gap, v, ref, e in zip(gaps, r["velocity"], reference, r["rel_error"]):
+            print("  %s %-8g V %-12.6g theory %-12.6g error %+7.2f %%" % (gap_name, gap, v, ref, 100 * e))
+    return out
 
 
 def validation_rows(label: str, gaps: Sequence[float], gap_name: str, reference: Sequence[float],
