@@ -55,7 +55,7 @@ def write_scene(scene: str, variant: str, workdir: str, args: argparse.Namespace
                "--write-only", "--workdir", target]
     else:
         cmd = [sys.executable, os.path.join(ROOT, "cases", "poiseuille", "poiseuille.py"), "--paper",
-               "--duration", "%g" % (0.05 * args.channel_steps), "--workdir", target]
+               "--duration", "%g" % (0.05 * args.channel_steps), "--fluid-every", "1", "--workdir", target]
     subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL)
     (run_dir,) = [os.path.join(target, d) for d in os.listdir(target) if os.path.isdir(os.path.join(target, d))]
     if scene == "channel":
