@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import load_case_module
-from fdmsubgrid import output, poiseuille, shear
+from fdmsubgrid import contacts, output, poiseuille, shear
 
 SMALL = ["--size", "8", "12", "8", "--duration", "2", "--dump-every", "0.1", "--seed", "2", "--fluid-every", "1"]
 
@@ -182,3 +182,18 @@ def test_budget_predicts_the_run_it_was_measured_on(case_module, small_run):
     actual = sum(float(np.sum(steps[k])) for k in ("fluidSeconds", "particleSeconds", "exchangeSeconds"))
     assert b["predicted_seconds"] == pytest.approx(actual, rel=0.3)
     assert case_module.main(["--budget", small_run["run_dir"], "--duration", "20"])["fluid_steps"] == 400
+
+
+def test_channel_at_its_defaults_migrates_and_balances(case_module, tmp_path_factory, env):
+    """The README's channel at its defaults (the particles at dt 0.05, the fluid every 4th step with the
+    held drag extrapolated) for 11.5 time units: the walls carry the pressure gradient's force at every
+    fluid step (1 %), the spheres migrate toward the centre (phi_center up from its start, the wall
+    layers down) and no pair goes deeper than the roughness layer (about 20 s)."""
+    work = tmp_path_factory.mktemp("poiseuilleDefaults")
+    r = case_module.main(["--duration", "11.5", "--dump-every", "0.2", "--workdir", str(work),
+                          "--out", str(work / "results.json")])
+    assert 230 / 4 <= r["steps"] <= 230 / 4 + 2 and r["unconverged_steps"] == 0   # fluid steps: every 4th, and the first
+    assert r["wall_force_balance_rel_error"] < 0.01
+    assert r["phi_center"] > r["phi_center_initial"] + 0.01
+    gaps = contacts.smallest_gaps(os.path.join(r["run_dir"], "dem", "particles.records"))
+    assert gaps.min() > -0.005, gaps.min()

@@ -12,7 +12,7 @@ wall shear stress tau_w.
 
   poiseuille.py                 the small channel (8 x 12 x 8 a1, phi_bulk 0.45, a1/Delta = 3, 40 time
                                 units, the particles at dt 0.05, the fluid every 4th step): migration
-                                begins; about 4 minutes
+                                begins; about a minute
   poiseuille.py --duration 2    a few steps (the CI test)
   poiseuille.py --paper         writes the paper's (40, 40, 20) a1 channel (not run; --run runs it)
   poiseuille.py --analyse RUN   the analysis of a run folder as it stands
