@@ -170,6 +170,18 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
     }
     return worst;
   };
+  // Bound sweeps until no gap is below its bound by more than the tolerance (gaps within slack of
+  // theirs left alone); returns the first sweep's largest violation
+  const auto holdToBounds = [&](double slack) {
+    double first = 0;
+    for (stats.boundSweeps = 1; stats.boundSweeps <= o.maxBoundSweeps; stats.boundSweeps++) {
+      stats.worstBound = sweep(true, slack);
+      if (stats.boundSweeps == 1) first = stats.worstBound;
+      if (stats.worstBound <= o.tolerance) break;
+    }
+    stats.boundSweeps = std::min(stats.boundSweeps, o.maxBoundSweeps);
+    return first;
+  };
   double previousWorst = HUGE_VAL;
   for (stats.sweeps = 1; stats.sweeps <= o.maxSweeps; stats.sweeps++) {
     const double worst = sweep(false, 0.0);
@@ -193,11 +205,7 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
     stats.fallback = true;
     for (int i = 0; i < n; i++)
       for (int k = 0; k < 3; k++) y[3 * i + k] = c.x[3 * i + k] + dt * rate[6 * i + k];
-    for (stats.boundSweeps = 1; stats.boundSweeps <= o.maxBoundSweeps; stats.boundSweeps++) {
-      stats.worstBound = sweep(true, 0.0);
-      if (stats.worstBound <= o.tolerance) break;
-    }
-    stats.boundSweeps = std::min(stats.boundSweeps, o.maxBoundSweeps);
+    holdToBounds(0.0);
   } else if (stats.worst > o.tolerance) {
     // A compromise between targets that contradict each other mildly (a ring of close pairs
     // through the periodic box) spreads their misses over every gap of the ring, a held contact
@@ -206,12 +214,7 @@ Statistics displacementRates(const Configuration &c, const std::vector<int> &clo
     // spheres 0.05 a1 deep, 0.0017 a1 per step beyond their straight step, docs/dem.md). The
     // compromise keeps its positions where it meets the bounds of the fallback and is pushed apart
     // along the lines of centres where it does not.
-    for (stats.boundSweeps = 1; stats.boundSweeps <= o.maxBoundSweeps; stats.boundSweeps++) {
-      stats.worstBound = sweep(true, o.tolerance);
-      if (stats.boundSweeps == 1) stats.compromiseMiss = stats.worstBound;
-      if (stats.worstBound <= o.tolerance) break;
-    }
-    stats.boundSweeps = std::min(stats.boundSweeps, o.maxBoundSweeps);
+    stats.compromiseMiss = holdToBounds(o.tolerance);
   }
   for (int i = 0; i < n; i++)
     if (touched[i])
