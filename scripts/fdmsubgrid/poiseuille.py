@@ -158,10 +158,7 @@ def budget(run_dir: str, duration: float) -> dict:
     if len(steps["step"]) < 2:
         raise ValueError("%s: %d fluid step(s) in steps.dat; the budget needs at least two (the first is cold)"
                          % (run_dir, len(steps["step"])))
-    width = float(np.asarray(output.read_records_header(
-        os.path.join(run_dir, "dem", "particles.records"))["box_hi"])[1])
-    time_unit = width / (2 * (width / 4))            # L_y/(2 U_c) with U_c = L_y/4
-    times = np.asarray(steps["time"]) / time_unit
+    times = np.asarray(steps["time"]) / scales(shear.read_run(run_dir)).time_unit
     fluid_dt = float(np.median(np.diff(times[1:]))) if len(times) > 2 else float(times[1] - times[0])
     parts = {k: np.asarray(steps[k + "Seconds"], dtype=float) for k in ("fluid", "particle", "exchange")}
     per_step = {k: float(np.median(v[1:])) for k, v in parts.items()}
@@ -181,10 +178,8 @@ def flow_rate(run_dir: str) -> tuple[NDArray, NDArray]:
     parabola's being 1/3. At an imposed pressure gradient this is what a suspension's viscosity sets,
     as the wall stress is at an imposed shear rate: the quantity the time-step measurements compare."""
     steps = output.steps(os.path.join(run_dir, "fluid"))
-    width = float(np.asarray(output.read_records_header(
-        os.path.join(run_dir, "dem", "particles.records"))["box_hi"])[1])
-    u_c = width / 4   # Eq. 58 with the cases' U_c = L_y/4
-    return np.asarray(steps["time"]) / (width / (2 * u_c)), np.asarray(steps["meanUx"]) / (2 * u_c)
+    sc = scales(shear.read_run(run_dir))
+    return np.asarray(steps["time"]) / sc.time_unit, np.asarray(steps["meanUx"]) / (2 * sc.u_c)
 
 
 def migration_time(times: NDArray, phi_center: NDArray) -> tuple[float, float, float]:
