@@ -447,7 +447,14 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p.add_argument("--interpolate", action="store_true", help="no run: the shipped table with the blocks it lacks "
                    "for --a-over-delta x --ratios (and the walls at each a/Delta unless --no-wall; with "
                    "--no-pairs the walls only) interpolated from the measured ones (subgridinterp.py), in --out")
+    p.add_argument("--interpolation-errors", action="store_true", help="no run: the interpolation's error on "
+                   "every held-back block (each shipped block from the others, and the direct calibrations kept "
+                   "out of the table), per gap, averaged over the positions in the cell")
     args = p.parse_args(argv)
+    if args.interpolation_errors:
+        from . import subgridinterp
+        subgridinterp.print_errors()
+        return []
     if args.interpolate:
         if not args.out:
             p.error("--interpolate needs --out")

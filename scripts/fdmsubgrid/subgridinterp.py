@@ -169,6 +169,7 @@ class HeldBack:
     ratio: float
     u: float
     sources_u: List[float]
+    sources_ratio: List[float]
     gaps: List[float]
     interpolated: List[float]         # position-averaged error, interpolated correction
     interpolated_std: List[float]     # its standard deviation over the positions
@@ -176,8 +177,8 @@ class HeldBack:
     positions: int
 
     def distance(self) -> float:
-        """How far outside its sources' u the block lies, ln(u/u_max) or ln(u_min/u); 0 inside."""
-        return max(0.0, math.log(self.u / max(self.sources_u)), math.log(min(self.sources_u) / self.u))
+        """How far outside its sources the block lies (`outside`); 0 inside."""
+        return outside(self.u, self.ratio, self.sources_u, self.sources_ratio)
 
     def added(self) -> np.ndarray:
         """Per gap the interpolation's error: interpolated minus direct, position-averaged."""
@@ -208,6 +209,7 @@ def hold_back(target: CollapsedBlock, sources: Sequence[CollapsedBlock]) -> Held
     err = position_errors(target, predicted)
     own = position_errors(target, np.array(target.summary["correction"]))
     return HeldBack(target.kind, target.a_over_delta, target.ratio, target.u(), [b.u() for b in same],
+                    [b.ratio for b in same],
                     target.gaps.tolist(), err.mean(axis=0).tolist(), err.std(axis=0).tolist(),
                     own.mean(axis=0).tolist(), len(err))
 
@@ -234,17 +236,26 @@ def held_back_measurements(blocks: Sequence[CollapsedBlock] | None = None,
     return out
 
 
+def outside(u: float, ratio: float, sources_u: Sequence[float], sources_ratio: Sequence[float]) -> float:
+    """How far a block (a*/Delta u, a2/a1 ratio) lies outside the measured blocks it is interpolated from:
+    in ln u beyond their smallest or largest u, or in ln ratio beyond their largest ratio (the collapse
+    puts the ratio into u; how far that holds is measured, not assumed), whichever is farther; 0 inside."""
+    return max(0.0, math.log(u / max(sources_u)), math.log(min(sources_u) / u), math.log(ratio / max(sources_ratio)))
+
+
 def error_bound(kind: str, distance: float, tests: Sequence[HeldBack]) -> float | None:
     """The interpolation's error to expect for a block of `kind` lying `distance` outside the u of the
-    measured blocks (0 inside): the worst of the held-back tests of that kind in the same situation
-    (inside: the tests inside their sources; outside: the tests at least as far outside), None when no
-    test is in that situation (an extrapolation farther than any measured)."""
+    measured blocks (0 inside): the worst of the held-back tests of that kind inside their sources and,
+    outside, of those at least as far outside (an extrapolation is never trusted more than an
+    interpolation); None when no test lies that far outside (an extrapolation farther than any measured)."""
     same = [t for t in tests if t.kind == kind]
+    inside = [t.worst() for t in same if t.distance() == 0]
     if distance <= 0:
-        chosen = [t for t in same if t.distance() == 0]
-    else:
-        chosen = [t for t in same if t.distance() >= distance]
-    return max((t.worst() for t in chosen), default=None)
+        return max(inside, default=None)
+    farther = [t.worst() for t in same if t.distance() >= distance - 1e-9]
+    if not farther:
+        return None
+    return max(inside + farther)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -358,9 +369,8 @@ def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, t
         if _table_grid(shipped, kind, ad, ratio):
             out.append(PairCoverage((a, b), "calibrated", None, kind, key_ad, key_ratio, command, cost))
             continue
-        us = [x.u() for x in blocks if x.kind == kind]
-        u = reduced_radius(kind, ratio) * ad
-        distance = max(0.0, math.log(u / max(us)), math.log(min(us) / u))
+        same = [x for x in blocks if x.kind == kind]
+        distance = outside(reduced_radius(kind, ratio) * ad, ratio, [x.u() for x in same], [x.ratio for x in same])
         bound = error_bound(kind, distance, tests)
         status = "interpolated" if bound is not None and bound <= TOLERANCE else "refused"
         out.append(PairCoverage((a, b), status, bound, kind, key_ad, key_ratio, command, cost))
@@ -399,9 +409,10 @@ def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], ta
             done.append(dict(kind=kind, a_over_delta=ad, ratio=ratio, status="in the table"))
             continue
         rows = interpolated_rows(blocks, kind, ad, ratio)
-        us = sorted(b.u() for b in blocks if b.kind == kind)
+        same = [b for b in blocks if b.kind == kind]
+        us = sorted(b.u() for b in same)
         u = reduced_radius(kind, ratio) * ad
-        distance = max(0.0, math.log(u / us[-1]), math.log(us[0] / u))
+        distance = outside(u, ratio, us, [b.ratio for b in same])
         bound = error_bound(kind, distance, tests)
         note = ("# interpolated (fdmsubgrid.subgridinterp): %s a1/Delta %g a2/a1 %g, a*/Delta %.4g from the %s "
                 "blocks at a*/Delta %s; held-back error in this situation %s\n"
@@ -414,3 +425,22 @@ def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], ta
     from .files import write_atomically
     write_atomically(out, text + "".join(added))
     return done
+
+
+def print_errors(tests: Sequence[HeldBack] | None = None) -> None:
+    """Every held-back test (each shipped block from the others, and the direct calibrations kept out of the
+    table) as a text table in %: per gap the interpolated correction's closing-velocity error against the
+    theory averaged over the positions in the cell, ± its standard deviation over them, the block's own
+    calibration's, and the interpolation's error (their difference)."""
+    if tests is None:
+        blocks = load_blocks()
+        tests = list(leave_one_out(blocks)) + held_back_measurements(blocks)
+    for t in tests:
+        print("%s a1/Delta %g a2/a1 %g (a*/Delta %.3g, %s, %d positions): interpolation error %.1f %%"
+              % (t.kind, t.a_over_delta, t.ratio, t.u, "inside its sources" if t.distance() == 0
+                 else "%.2f outside its sources" % t.distance(), t.positions, 100 * t.worst()))
+        print("  gap               " + " ".join("%6.3g" % g for g in t.gaps))
+        for name, values in (("interpolated", t.interpolated), ("  +- positions", t.interpolated_std),
+                             ("direct", t.direct), ("difference", t.added())):
+            form = "%6.2f" if name.startswith(" ") else "%+6.2f"
+            print("  %-16s " % name + " ".join(form % (100 * v) for v in values))
