@@ -447,6 +447,9 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p.add_argument("--interpolate", action="store_true", help="no run: the shipped table with the blocks it lacks "
                    "for --a-over-delta x --ratios (and the walls at each a/Delta unless --no-wall; with "
                    "--no-pairs the walls only) interpolated from the measured ones (subgridinterp.py), in --out")
+    p.add_argument("--max-error", type=float, default=0.02, help="with --interpolate: write only the blocks whose "
+                   "interpolation error, measured on held-back blocks in the same situation, is within this "
+                   "(default 0.02; inf also writes those no held-back test reaches)")
     p.add_argument("--interpolation-errors", action="store_true", help="no run: the interpolation's error on "
                    "every held-back block (each shipped block from the others, and the direct calibrations kept "
                    "out of the table), per gap, averaged over the positions in the cell")
@@ -461,11 +464,13 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
         from . import subgridinterp
         targets = (([] if args.no_pairs else [("pair", ad, r) for ad in args.a_over_delta for r in args.ratios])
                    + ([] if args.no_wall else [("wall", ad, 1.0) for ad in args.a_over_delta]))
-        done = subgridinterp.write_interpolated(args.out, targets)
+        done = subgridinterp.write_interpolated(args.out, targets, max_error=args.max_error)
         for d in done:
-            print("%s a1/Delta %g a2/a1 %g: %s%s" % (d["kind"], d["a_over_delta"], d["ratio"], d["status"],
-                                                   "" if "error" not in d else ", held-back error %s"
-                                                   % ("not measured" if d["error"] is None else "%.1f %%" % (100 * d["error"]))))
+            print("%s a1/Delta %g a2/a1 %g: %s%s%s" % (
+                d["kind"], d["a_over_delta"], d["ratio"], d["status"],
+                "" if "error" not in d else ", held-back error %s" % (
+                    "not measured this far outside" if d["error"] is None else "%.1f %%" % (100 * d["error"])),
+                "" if "command" not in d else " (beyond --max-error %g; measure it: %s)" % (args.max_error, d["command"])))
         return done
     if args.position_errors:
         print_position_errors(args.position_errors)

@@ -176,8 +176,8 @@ class HeldBack:
     direct: List[float]               # position-averaged error, the block's own calibration
     positions: int
 
-    def distance(self) -> float:
-        """How far outside its sources the block lies (`outside`); 0 inside."""
+    def distance(self) -> Tuple[float, float, float]:
+        """How far outside its sources the block lies (`outside`); (0, 0, 0) inside."""
         return outside(self.u, self.ratio, self.sources_u, self.sources_ratio)
 
     def added(self) -> np.ndarray:
@@ -189,7 +189,7 @@ class HeldBack:
 
     def as_dict(self) -> Dict:
         d = dict(self.__dict__)
-        d.update(distance=self.distance(), added=self.added().tolist(), worst=self.worst())
+        d.update(distance=list(self.distance()), added=self.added().tolist(), worst=self.worst())
         return d
 
 
@@ -236,23 +236,25 @@ def held_back_measurements(blocks: Sequence[CollapsedBlock] | None = None,
     return out
 
 
-def outside(u: float, ratio: float, sources_u: Sequence[float], sources_ratio: Sequence[float]) -> float:
-    """How far a block (a*/Delta u, a2/a1 ratio) lies outside the measured blocks it is interpolated from:
-    in ln u beyond their smallest or largest u, or in ln ratio beyond their largest ratio (the collapse
-    puts the ratio into u; how far that holds is measured, not assumed), whichever is farther; 0 inside."""
-    return max(0.0, math.log(u / max(sources_u)), math.log(min(sources_u) / u), math.log(ratio / max(sources_ratio)))
+def outside(u: float, ratio: float, sources_u: Sequence[float],
+            sources_ratio: Sequence[float]) -> Tuple[float, float, float]:
+    """How far a block (a*/Delta u, a2/a1 ratio) lies outside the measured blocks it is interpolated from,
+    in three directions: ln u below their smallest u, ln u above their largest, ln ratio beyond their largest
+    ratio (the collapse puts the ratio into u; how far that holds is measured, not assumed); 0 where inside."""
+    return (max(0.0, math.log(min(sources_u) / u)), max(0.0, math.log(u / max(sources_u))),
+            max(0.0, math.log(ratio / max(sources_ratio))))
 
 
-def error_bound(kind: str, distance: float, tests: Sequence[HeldBack]) -> float | None:
-    """The interpolation's error to expect for a block of `kind` lying `distance` outside the u of the
-    measured blocks (0 inside): the worst of the held-back tests of that kind inside their sources and,
-    outside, of those at least as far outside (an extrapolation is never trusted more than an
-    interpolation); None when no test lies that far outside (an extrapolation farther than any measured)."""
+def error_bound(kind: str, distance: Sequence[float], tests: Sequence[HeldBack]) -> float | None:
+    """The interpolation's error to expect for a block of `kind` lying `distance` (`outside`) outside the
+    measured blocks: the worst of the held-back tests of that kind inside their sources and, for a block
+    outside, of those at least as far outside in each direction (an extrapolation is never trusted more than
+    an interpolation); None when no test lies that far outside (an extrapolation farther than any measured)."""
     same = [t for t in tests if t.kind == kind]
-    inside = [t.worst() for t in same if t.distance() == 0]
-    if distance <= 0:
+    inside = [t.worst() for t in same if not any(t.distance())]
+    if not any(d > 0 for d in distance):
         return max(inside, default=None)
-    farther = [t.worst() for t in same if t.distance() >= distance - 1e-9]
+    farther = [t.worst() for t in same if all(td >= d - 1e-9 for td, d in zip(t.distance(), distance))]
     if not farther:
         return None
     return max(inside + farther)
@@ -391,10 +393,13 @@ def refusal(entry: PairCoverage) -> str:
 # Writing a table with interpolated blocks
 
 
-def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], table: str | None = None) -> List[Dict]:
+def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], table: str | None = None,
+                       max_error: float = TOLERANCE) -> List[Dict]:
     """Copy the calibration table (default: the shipped one) to `out` with an interpolated block for each
-    (kind, a1/Delta, a2/a1) of `targets` it lacks, each preceded by a comment line and its header marked
-    `interpolated`. Returns per target what was done."""
+    (kind, a1/Delta, a2/a1) of `targets` it lacks whose measured error (`error_bound`) is within max_error
+    (math.inf: also those no held-back test reaches), each preceded by a comment line and its header marked
+    `interpolated`. Returns per target what was done (status "in the table", "interpolated" or "left out",
+    with the measured error and, left out, the command that measures it)."""
     table = table or _project_file(os.path.join("dem", "resistance", "data", "subgrid_calibration.dat"))
     present = calibration.read_table(table)
     blocks = load_blocks()
@@ -414,6 +419,10 @@ def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], ta
         u = reduced_radius(kind, ratio) * ad
         distance = outside(u, ratio, us, [b.ratio for b in same])
         bound = error_bound(kind, distance, tests)
+        if not ((bound if bound is not None else math.inf) <= max_error):
+            done.append(dict(kind=kind, a_over_delta=ad, ratio=ratio, status="left out", error=bound,
+                             command=measure_command(kind, ad, ratio)))
+            continue
         note = ("# interpolated (fdmsubgrid.subgridinterp): %s a1/Delta %g a2/a1 %g, a*/Delta %.4g from the %s "
                 "blocks at a*/Delta %s; held-back error in this situation %s\n"
                 % (kind, ad, ratio, u, kind, " ".join("%.4g" % v for v in us),
@@ -437,10 +446,23 @@ def print_errors(tests: Sequence[HeldBack] | None = None) -> None:
         tests = list(leave_one_out(blocks)) + held_back_measurements(blocks)
     for t in tests:
         print("%s a1/Delta %g a2/a1 %g (a*/Delta %.3g, %s, %d positions): interpolation error %.1f %%"
-              % (t.kind, t.a_over_delta, t.ratio, t.u, "inside its sources" if t.distance() == 0
-                 else "%.2f outside its sources" % t.distance(), t.positions, 100 * t.worst()))
+              % (t.kind, t.a_over_delta, t.ratio, t.u, "inside its sources" if not any(t.distance())
+                 else "outside its sources by %.2f below, %.2f above in ln a*/Delta, %.2f beyond in ln a2/a1"
+                 % t.distance(), t.positions, 100 * t.worst()))
         print("  gap               " + " ".join("%6.3g" % g for g in t.gaps))
         for name, values in (("interpolated", t.interpolated), ("  +- positions", t.interpolated_std),
                              ("direct", t.direct), ("difference", t.added())):
             form = "%6.2f" if name.startswith(" ") else "%+6.2f"
             print("  %-16s " % name + " ".join(form % (100 * v) for v in values))
+
+
+def write_scene_table(out: str, radii: Sequence[float], a_over_delta: float, walls: bool = False,
+                      max_error: float = TOLERANCE) -> List[PairCoverage]:
+    """For a scene (as `coverage`): the shipped table with an interpolated block for each species pair and
+    wall it lacks whose measured error is within max_error, in `out` (for `pair_style fdm/subgrid calibration
+    out`). Returns the scene's coverage; the pairs still `refused` are not in the file (the pair style
+    refuses them at its start, as `fdmResistance coverage` does beforehand)."""
+    entries = coverage(radii, a_over_delta, walls)
+    targets = [(c.kind, c.a_over_delta, c.ratio) for c in entries if c.status != "calibrated"]
+    write_interpolated(out, targets, max_error=max_error)
+    return entries
