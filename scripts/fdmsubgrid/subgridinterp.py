@@ -14,10 +14,10 @@ fraction of that leading term the solver misses,
 which tends to 1 as x -> 0 (the solver resolves a finite resistance, the theory's diverges) and to 0
 beyond a few cells. Across the measured pair blocks (a1/Delta 3-5, a2/a1 1 and 1.4: u 1.5-2.92) Phi at a
 fixed x varies by a few hundredths and linearly with u (docs/resistance.md, "Sizes and resolutions outside
-the table"); in x alone, or at a fixed xi in (a1/Delta, a2/a1) as the resistance library interpolates
-inside its grid, the blocks collapse less well (held back one at a time, the pairs' worst error is 3.0 %
-against 2.1 %, and 2.8-3.0 % against 0.6-1.7 % at the end of the table, a1/Delta 3). Pairs and walls differ beyond the lubrication region (their far fields do): each kind is
-interpolated from its own blocks.
+the table"); at a fixed xi, linear in a1/Delta and a2/a1 as the resistance library interpolates inside its
+grid, the blocks collapse less well (held back one at a time, the pairs' worst error is 3.0 % against
+2.1 %, and 2.8-3.0 % against 0.6-1.7 % at the end of the table, a1/Delta 3). Pairs and walls differ beyond
+the lubrication region (their far fields do): each kind is interpolated from its own blocks.
 
 Interpolation. At every x the measured blocks' Phi (each from its fit, calibration.SqueezeCalibration.fit,
 and the theory at its measured gaps: `CollapsedBlock`) is fitted by a straight line in u (least squares)
@@ -27,8 +27,9 @@ call: the target's correction needs only the blocks' Phi.
 
     python3 -m fdmsubgrid.calibration --interpolate --a-over-delta 3 --ratios 2 --out my_calibration.dat
 
-writes the shipped table with the interpolated blocks added (each header marked `interpolated`); the
-pair style reads it with `pair_style fdm/subgrid calibration my_calibration.dat`.
+writes the shipped table with the interpolated blocks added whose measured error (`error_bound`) is within
+--max-error (default TOLERANCE), each header marked `interpolated`; the pair style reads it with
+`pair_style fdm/subgrid calibration my_calibration.dat`.
 """
 from __future__ import annotations
 
