@@ -61,7 +61,7 @@ import os
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import Dict, List, Sequence
+from typing import Callable, Dict, List, Sequence
 
 import numpy as np
 
@@ -166,21 +166,28 @@ class SqueezeCalibration:
 
     def table(self, fit: Dict[str, float]) -> List[tuple]:
         """(xi, xi * s_hat * taper) from TABLE_MIN_GAP to the first sign change of s_hat or TAPER_END
-        (the last row is 0)."""
-        rows = []
-        n = int(round(TABLE_POINTS_PER_DECADE * math.log10(TAPER_END / TABLE_MIN_GAP)))
-        for k in range(n + 1):
-            xi = TABLE_MIN_GAP * 10 ** (k / TABLE_POINTS_PER_DECADE)
-            s = self.correction(xi, fit) * taper(xi)
-            if s <= 0:
-                if rows:  # interpolate the zero crossing
-                    xp, sp = rows[-1][0], rows[-1][1] / rows[-1][0]
-                    t = sp / (sp - s)
-                    x0 = math.exp(math.log(xp) + t * (math.log(xi) - math.log(xp)))
-                    rows.append((x0, 0.0))
-                break
-            rows.append((xi, xi * s))
-        return rows
+        (the last row is 0): `correction_rows` of the fit's correction."""
+        return correction_rows(lambda xi: self.correction(xi, fit))
+
+
+def correction_rows(correction: Callable[[float], float]) -> List[tuple]:
+    """The rows (xi, xi * s_hat(xi) * taper(xi)) of a table block, s_hat = `correction` (units 6 pi eta a1,
+    not clipped): 20 per decade from TABLE_MIN_GAP to the first sign change of s_hat or TAPER_END, the zero
+    crossing interpolated in ln xi (the last row is 0)."""
+    rows = []
+    n = int(round(TABLE_POINTS_PER_DECADE * math.log10(TAPER_END / TABLE_MIN_GAP)))
+    for k in range(n + 1):
+        xi = TABLE_MIN_GAP * 10 ** (k / TABLE_POINTS_PER_DECADE)
+        s = correction(xi) * taper(xi)
+        if s <= 0:
+            if rows:  # interpolate the zero crossing
+                xp, sp = rows[-1][0], rows[-1][1] / rows[-1][0]
+                t = sp / (sp - s)
+                x0 = math.exp(math.log(xp) + t * (math.log(xi) - math.log(xp)))
+                rows.append((x0, 0.0))
+            break
+        rows.append((xi, xi * s))
+    return rows
 
 
 def taper(xi: float) -> float:
@@ -304,7 +311,8 @@ def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Seq
 
 def read_table(path: str) -> Dict[tuple, tuple]:
     """The blocks of a calibration table (write_table's format): {(kind, a/Delta, ratio): (header floats
-    after the row count, rows as an (n, 2) array of xi and xi * s_hat)}."""
+    after the row count, rows as an (n, 2) array of xi and xi * s_hat)}. An interpolated block's header
+    (subgridinterp.py) has the word `interpolated` instead of the fit's numbers: its header floats are []."""
     blocks = {}
     with open(path) as f:
         lines = [ln.split() for ln in f if ln.strip() and not ln.startswith("#")]
@@ -313,9 +321,15 @@ def read_table(path: str) -> Dict[tuple, tuple]:
         head = lines[k]
         n = int(head[3])
         rows = np.array([[float(x) for x in ln] for ln in lines[k + 1:k + 1 + n]])
-        blocks[(head[0], float(head[1]), float(head[2]))] = ([float(x) for x in head[4:]], rows)
+        blocks[(head[0], float(head[1]), float(head[2]))] = ([] if INTERPOLATED in head[4:]
+                                                             else [float(x) for x in head[4:]], rows)
         k += 1 + n
     return blocks
+
+
+# the word an interpolated block's header line carries after its row count (the resistance library reads
+# the first four words of a header only)
+INTERPOLATED = "interpolated"
 
 
 def write_block(f, c: SqueezeCalibration, fit: Dict[str, float], rows: List[tuple]) -> None:
@@ -396,6 +410,16 @@ def print_position_errors(path: str) -> None:
                                                for v in e[name]))
 
 
+def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False) -> list:
+    """For each species pair of a scene of these radii at a1/Delta = a_over_delta (a1 the smallest radius;
+    with walls also each radius against a wall): `calibrated` (in the table), `interpolated` (within 2 %
+    as measured on held-back blocks) or `refused`, with the interpolation's measured error, the command
+    that would measure the pair directly and its estimated core-seconds (subgridinterp.coverage,
+    subgridinterp.PairCoverage)."""
+    from . import subgridinterp
+    return subgridinterp.coverage(radii, a_over_delta, walls)
+
+
 def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--a-over-delta", type=float, nargs="+", default=[3.0, 4.0, 5.0])
@@ -420,7 +444,34 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                    "twist (pairtangential.py) at every --a-over-delta and --ratios")
     p.add_argument("--pair-tangential-from-raw", metavar="JSON", nargs="+", help="the tangential pair measurements "
                    "of earlier runs (pair_tangential_calibration.json beside a table, or pairtangential --out)")
+    p.add_argument("--interpolate", action="store_true", help="no run: the shipped table with the blocks it lacks "
+                   "for --a-over-delta x --ratios (and the walls at each a/Delta unless --no-wall; with "
+                   "--no-pairs the walls only) interpolated from the measured ones (subgridinterp.py), in --out")
+    p.add_argument("--max-error", type=float, default=0.02, help="with --interpolate: write only the blocks whose "
+                   "interpolation error, measured on held-back blocks in the same situation, is within this "
+                   "(default 0.02; inf also writes those no held-back test reaches)")
+    p.add_argument("--interpolation-errors", action="store_true", help="no run: the interpolation's error on "
+                   "every held-back block (each shipped block from the others, and the direct calibrations kept "
+                   "out of the table), per gap, averaged over the positions in the cell")
     args = p.parse_args(argv)
+    if args.interpolation_errors:
+        from . import subgridinterp
+        subgridinterp.print_errors()
+        return []
+    if args.interpolate:
+        if not args.out:
+            p.error("--interpolate needs --out")
+        from . import subgridinterp
+        targets = (([] if args.no_pairs else [("pair", ad, r) for ad in args.a_over_delta for r in args.ratios])
+                   + ([] if args.no_wall else [("wall", ad, 1.0) for ad in args.a_over_delta]))
+        done = subgridinterp.write_interpolated(args.out, targets, max_error=args.max_error)
+        for d in done:
+            print("%s a1/Delta %g a2/a1 %g: %s%s%s" % (
+                d["kind"], d["a_over_delta"], d["ratio"], d["status"],
+                "" if "error" not in d else ", held-back error %s" % (
+                    "not measured this far outside" if d["error"] is None else "%.1f %%" % (100 * d["error"])),
+                "" if "command" not in d else " (beyond --max-error %g; measure it: %s)" % (args.max_error, d["command"])))
+        return done
     if args.position_errors:
         print_position_errors(args.position_errors)
         return []

@@ -1,0 +1,221 @@
+"""Squeeze corrections outside the measured table (scripts/fdmsubgrid/subgridinterp.py): the interpolation's
+error against direct calibrations held back from it, from the stored measurements (no run), the table it
+writes as the resistance library reads it, and which species pairs of a scene are calibrated, interpolated
+or refused (docs/resistance.md, "Sizes and resolutions outside the table")."""
+import json
+import math
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import PROJECT
+from fdmsubgrid import calibration, subgridinterp
+
+HELD_BACK = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[0])
+
+
+@pytest.fixture(scope="module")
+def blocks():
+    return subgridinterp.load_blocks(os.path.join(PROJECT, subgridinterp.SHIPPED_JSON))
+
+
+@pytest.fixture(scope="module")
+def loo(blocks):
+    return {(t.kind, t.a_over_delta, t.ratio): t for t in subgridinterp.leave_one_out(blocks)}
+
+
+def test_collapse_reproduces_the_measured_correction(blocks):
+    """Phi of every block through (1) gives back the block's own correction at its measured gaps (the
+    variables change, nothing is lost), and Phi -> 1 at the smallest gap (the leading lubrication)."""
+    for b in blocks:
+        x = b.gaps * b.cells()
+        back = b.scale() * b.phi(x) / x
+        assert np.allclose(back, b.summary["correction"], rtol=1e-6, atol=1e-9), (b.kind, b.a_over_delta, b.ratio)
+        assert b.phi(np.array([x.min()]))[0] == pytest.approx(1.0, abs=2e-3)
+
+
+def test_each_shipped_block_from_the_others(loo):
+    """Leave one out: each shipped block interpolated from the other blocks of its kind, judged at its own
+    4 measured positions in the cell. The interpolation's error (position-averaged closing velocity with the
+    interpolated correction minus with the block's own) at every gap 1e-4 ... 1: pairs within 2.2 % (measured
+    2.1 %, a1/Delta 4, a2/a1 1.4 at xi 0.2), walls within 1.3 % (measured 1.2 %); against the theory the
+    interpolated correction is within 3.5 % (the direct calibrations' own reach 3.0 %) and, near contact
+    (xi <= 1e-3), where the correction carries the resistance, within 0.2 %."""
+    assert len(loo) == 9
+    for key, t in loo.items():
+        bound = 0.022 if t.kind == "pair" else 0.013
+        assert t.worst() < bound, (key, t.added())
+        assert np.max(np.abs(t.interpolated)) < 0.035, key
+        for g, e in zip(t.gaps, t.interpolated):
+            if g <= 1e-3:
+                assert abs(e) < 2e-3, (key, g, e)
+    # the end blocks of the table were extrapolated (below and above their sources)
+    assert loo[("pair", 3.0, 1.0)].distance()[0] > 0 and loo[("wall", 5.0, 1.0)].distance()[1] > 0
+
+
+def fixed_xi_leave_one_out(target, blocks):
+    """The target's correction from the other pairs at its own reduced gaps xi, a straight line in a1/Delta
+    and a2/a1 (least squares), as the resistance library interpolates inside its grid."""
+    others = [b for b in blocks if b.kind == "pair" and b is not target]
+    design = np.array([[1.0, b.a_over_delta, b.ratio] for b in others])
+    rows = []
+    for g in target.gaps:
+        s = [b.scale() * b.phi(np.array([g * b.cells()]))[0] / (g * b.cells()) for b in others]
+        c = np.linalg.lstsq(design, np.array(s), rcond=None)[0]
+        rows.append(c @ [1.0, target.a_over_delta, target.ratio])
+    err = subgridinterp.position_errors(target, np.array(rows)).mean(axis=0)
+    own = subgridinterp.position_errors(target, np.array(target.summary["correction"])).mean(axis=0)
+    return float(np.max(np.abs(err - own)))
+
+
+def test_the_collapse_is_what_makes_it_work(blocks, loo):
+    """The same leave-one-out at a fixed reduced gap xi, linear in a1/Delta and a2/a1: worse at the worst
+    pair (measured 3.0 % against 2.1 %) and at the ends of the table (a1/Delta 3: 2.8 % and 3.0 % against
+    0.6 % and 1.7 %)."""
+    pairs = [b for b in blocks if b.kind == "pair"]
+    fixed = {(b.a_over_delta, b.ratio): fixed_xi_leave_one_out(b, blocks) for b in pairs}
+    collapsed = {(b.a_over_delta, b.ratio): loo[("pair", b.a_over_delta, b.ratio)].worst() for b in pairs}
+    assert max(fixed.values()) > max(collapsed.values()) + 0.008
+    for key in ((3.0, 1.0), (3.0, 1.4)):
+        assert fixed[key] > 0.025 and collapsed[key] < 0.018, key
+
+
+def test_held_back_direct_calibration(blocks):
+    """a2/a1 = 2 at a1/Delta 3, calibrated directly (boxes 12 and 16 a1, 4 positions) and kept out of the
+    table, against its interpolation from the 6 shipped pair blocks, gap by gap (docs/data): the
+    interpolation's error within 1.6 % at every gap (measured 1.5 %), near contact within 0.2 % of the theory;
+    and the direct calibration's cost as the cost model estimates it, within a factor 1.6."""
+    with open(HELD_BACK) as f:
+        data = json.load(f)
+    s = data["calibrations"][0]
+    assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 3.0, 2.0)
+    assert len(s["velocities"]["12"]) == 4 and len(s["gaps"]) == 15
+    t = subgridinterp.held_back_measurements(blocks, [HELD_BACK])[0]
+    assert t.u == pytest.approx(2.0)     # a*/Delta inside the shipped pairs' 1.5 ... 2.92, a2/a1 beyond their 1.4
+    assert t.worst() < HELD_BACK_BOUND, t.added()
+    for g, e in zip(t.gaps, t.interpolated):
+        if g <= 1e-3:
+            assert abs(e) < 2e-3, (g, e)
+    model = subgridinterp.cost_model([b.summary for b in blocks])
+    estimate = subgridinterp.estimated_core_seconds("pair", 3.0, 2.0, model)
+    assert subgridinterp.calibration_boxes(2.0) == tuple(float(L) for L in s["boxes"])
+    assert 1 / 1.6 < estimate / data["core_seconds"] < 1.6
+
+
+# measured 1.5 % (at xi 0.07; docs/resistance.md, "Sizes and resolutions outside the table")
+HELD_BACK_BOUND = 0.016
+
+
+def test_interpolated_table_is_read_by_the_resistance_library(tmp_path, env):
+    """`--interpolate` writes the shipped table plus the blocks it lacks within --max-error; fdmResistance (the library the pair
+    style uses) reads it unchanged: the ratio-2 pair and the a/Delta 6 wall are covered, and its X21A is
+    -6 pi a1 s_hat of the written rows; near contact xi s_hat is the leading lubrication coefficient
+    2 lambda^2/(1 + lambda)^3."""
+    data = tmp_path / "dem" / "resistance" / "data"
+    data.mkdir(parents=True)
+    out = data / "subgrid_calibration.dat"
+    done = calibration.main(["--interpolate", "--a-over-delta", "3", "6", "--ratios", "2", "--max-error", "0.025",
+                             "--out", str(out)])
+    assert {(d["kind"], d["a_over_delta"], d["status"]) for d in done} == {
+        ("pair", 3.0, "interpolated"), ("pair", 6.0, "left out"), ("wall", 3.0, "in the table"),
+        ("wall", 6.0, "interpolated")}
+    # by default (2 %) the pair, measured at 2.1 %, is left out with the command that measures it
+    default = calibration.main(["--interpolate", "--a-over-delta", "3", "--ratios", "2", "--no-wall",
+                                "--out", str(tmp_path / "default.dat")])
+    assert default[0]["status"] == "left out" and default[0]["command"].startswith("python3 -m fdmsubgrid.calibration")
+    table = calibration.read_table(str(out))
+    shipped = calibration.read_table(os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat"))
+    assert set(shipped) < set(table)
+    head, rows = table[("pair", 3.0, 2.0)]
+    assert head == [] and rows[-1, 1] == 0.0 and np.all(rows[:-1, 1] > 0)
+    assert rows[0, 1] == pytest.approx(2 * 4 / 27, rel=1e-3)
+    with open(out) as f:
+        assert sum(1 for line in f if line.startswith("# interpolated")) == 2
+
+    def resistance(*args):
+        environment = dict(env, FDM_ROOT=str(tmp_path))
+        done = subprocess.run(["fdmResistance"] + [str(a) for a in args], env=environment, check=True,
+                              capture_output=True, text=True)
+        return json.loads(done.stdout)
+    covered = resistance("coverage", "--a1", 1, "--a2", 2, "--delta", 1 / 3, "--wall")
+    assert covered["pair"] and covered["wall"] and not covered["pair_tangential"]
+    assert resistance("coverage", "--a1", 2, "--delta", 1 / 3, "--wall")["wall"]
+    xi = 0.05
+    k = np.searchsorted(rows[:, 0], xi)
+    w = (math.log(xi) - math.log(rows[k - 1, 0])) / (math.log(rows[k, 0]) - math.log(rows[k - 1, 0]))
+    s_hat = ((1 - w) * rows[k - 1, 1] + w * rows[k, 1]) / xi
+    pair = resistance("pair", "--a1", 1, "--a2", 2, "--xi", xi, "--subgrid", "--calibrated", "--delta", 1 / 3)
+    assert pair["base"]["X21A"] == pytest.approx(-6 * math.pi * s_hat, rel=1e-6)
+
+
+def test_coverage_of_scenes(blocks, loo):
+    """coverage(): the shipped suspension (radii 1 and 1.4 at a1/Delta 3, walls) is calibrated throughout;
+    outside the table each species pair gets the interpolation's measured error for its situation and is
+    interpolated only within 2 %; what no held-back test reaches is refused, with the command that measures
+    it and its cost."""
+    shipped = calibration.coverage([1.0, 1.4, 1.0], 3.0, walls=True)
+    assert [(c.pair, c.kind, c.status) for c in shipped] == [
+        ((1.0, 1.0), "pair", "calibrated"), ((1.0, 1.4), "pair", "calibrated"), ((1.4, 1.4), "pair", "calibrated"),
+        ((1.0, math.inf), "wall", "calibrated"), ((1.4, math.inf), "wall", "calibrated")]
+    assert all(c.error is None for c in shipped)
+    scene = {(c.pair, c.kind): c for c in calibration.coverage([1.0, 2.0, 4.0], 3.0, walls=True)}
+    one_two = scene[((1.0, 2.0), "pair")]
+    assert (one_two.a_over_delta, one_two.ratio) == (3.0, 2.0)
+    # a2/a1 2 lies beyond the shipped ratios (ln(2/1.4) = 0.36 outside): only the held-back ratio-2
+    # calibration measured that far, and the pairs inside their sources bound it from below
+    ratio2 = subgridinterp.held_back_measurements(blocks, [HELD_BACK])[0]
+    assert ratio2.distance() == pytest.approx((0, 0, math.log(2 / 1.4)))
+    inside = max(t.worst() for t in loo.values() if t.kind == "pair" and not any(t.distance()))
+    assert one_two.error == pytest.approx(max(inside, ratio2.worst()))
+    assert one_two.status == ("interpolated" if one_two.error <= subgridinterp.TOLERANCE else "refused")
+    # a2/a1 3 lies farther beyond the ratios than any test: refused whatever the errors measured
+    assert calibration.coverage([1.0, 3.0], 3.0)[1].status == "refused"
+    assert calibration.coverage([1.0, 3.0], 3.0)[1].error is None
+    # the wall at a/Delta 6 (radius 2) lies 0.18 above the walls' 3 ... 5 in ln u: the wall a/Delta 5 from
+    # 3 and 4 lay 0.22 above its sources and was within 1.2 %; a/Delta 6.7 lies farther above than any test
+    wall = scene[((2.0, math.inf), "wall")]
+    assert wall.status == "interpolated" and wall.error < 0.013
+    assert calibration.coverage([1.0], 6.7, walls=True)[1].status == "refused"
+    # the pair 1-1.4 at a1/Delta 6 (a*/Delta 3.5) lies 0.18 above the pairs' a*/Delta, farther than the
+    # pair tests above their sources (0.15): refused, though the ratio-2 test lies 0.36 outside in ratio
+    assert calibration.coverage([1.0, 1.4], 6.0)[1].error is None
+    # radius 4 against a wall (a/Delta 12) and the pair (4, 4) at a1/Delta 12: farther than any test
+    for key in (((4.0, math.inf), "wall"), ((4.0, 4.0), "pair")):
+        c = scene[key]
+        assert c.status == "refused" and c.error is None, key
+        assert c.command.startswith("python3 -m fdmsubgrid.calibration --a-over-delta 12")
+        line = subgridinterp.refusal(c)
+        assert c.command in line and "core-seconds" in line and "\n" not in line
+    # the cost grows with the calibration's cells: a1/Delta 12 costs more than 3
+    assert scene[((4.0, 4.0), "pair")].core_seconds > 50 * scene[((1.0, 1.0), "pair")].core_seconds
+    with pytest.raises(ValueError, match="radii must be positive"):
+        calibration.coverage([0.0, 1.0], 3.0)
+
+
+def test_cost_model_against_the_measured_calibrations(blocks):
+    """The estimated cost of a direct calibration (a power of its cells through the shipped calibrations'
+    measured seconds) is within a factor 1.6 of each of them."""
+    model = subgridinterp.cost_model([b.summary for b in blocks])
+    for b in blocks:
+        estimate = subgridinterp.estimated_core_seconds(b.kind, b.a_over_delta, b.ratio, model)
+        assert 1 / 1.6 < estimate / b.summary["wall_seconds"] < 1.6, (b.kind, b.a_over_delta, b.ratio)
+
+
+def test_scene_table(tmp_path, env):
+    """write_scene_table: radii 1 and 2 at a1/Delta 3 between walls: the wall of the larger sphere (a/Delta 6,
+    measured 1.2 %) is added and read by the resistance library; the pairs 1-2 and 2-2 (2.1 %) are not."""
+    data = tmp_path / "dem" / "resistance" / "data"
+    data.mkdir(parents=True)
+    out = data / "subgrid_calibration.dat"
+    entries = subgridinterp.write_scene_table(str(out), [1.0, 2.0], 3.0, walls=True)
+    assert [c.status for c in entries] == ["calibrated", "refused", "refused", "calibrated", "interpolated"]
+    added = set(calibration.read_table(str(out))) - set(
+        calibration.read_table(os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat")))
+    assert added == {("wall", 6.0, 1.0)}
+    done = subprocess.run(["fdmResistance"] + [str(a) for a in ("coverage", "--a1", 2, "--a2", 2, "--delta", 1 / 3,
+                                                                "--wall")],
+                          env=dict(env, FDM_ROOT=str(tmp_path)), check=True, capture_output=True, text=True)
+    covered = json.loads(done.stdout)
+    assert covered["wall"] and not covered["pair"]
