@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from . import output, packing, profiles, rheology, sbm, shear, timeseries
+from . import output, packing, profiles, rheology, sbm, shear, suspension, timeseries
 
 CENTRAL_HALF_WIDTH = 1.0        # a1: the central slab of the migration series
 WALL_LAYER = sbm.LAYER_OVER_A1  # a1: the wall layers (the region the SBM leaves out)
@@ -132,13 +132,17 @@ MEASURED_FLUID_DT = 0.4
 DEFAULT_DT, DEFAULT_FLUID_EVERY = 0.05, 4
 
 
-def time_step_warning(dt: float, fluid_every: int) -> str | None:
+def time_step_warning(dt: float, fluid_every: int, sizes: packing.SizeDistribution | None = None) -> str | None:
     """A warning when the particle step dt or the fluid's step fluid_every*dt (in L_y/(2 U_c)) is beyond
-    what was measured good in the channel, else None."""
+    what was measured good in the channel (with the paper's radii 1 and 1.4; for other sizes the particle step
+    carried over by suspension.time_step_factor), else None."""
     beyond = []
-    if dt > MEASURED_PARTICLE_DT * (1 + 1e-9):
-        beyond.append("the particle step %g above %g (at 0.1 the bulk velocity of the dense core went 4 %% rms "
-                      "off, at 0.2 8 %%)" % (dt, MEASURED_PARTICLE_DT))
+    particle_dt = MEASURED_PARTICLE_DT if sizes is None else suspension.scaled_time_step(MEASURED_PARTICLE_DT, sizes)
+    if dt > particle_dt * (1 + 1e-9):
+        beyond.append("the particle step %g above %g (%sat 0.1 the bulk velocity of the dense core went 4 %% rms "
+                      "off, at 0.2 8 %%)" % (dt, particle_dt, "" if particle_dt == MEASURED_PARTICLE_DT else
+                                            "the measured %g times %.3g for these sizes, suspension.time_step_factor; "
+                                            % (MEASURED_PARTICLE_DT, suspension.time_step_factor(sizes))))
     if dt * fluid_every > MEASURED_FLUID_DT * (1 + 1e-9):
         beyond.append("the fluid's step %g (dt %g x fluid_every %d) above %g, not measured"
                       % (dt * fluid_every, dt, fluid_every, MEASURED_FLUID_DT))
