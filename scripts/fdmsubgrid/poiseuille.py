@@ -292,8 +292,9 @@ def sbm_comparison(material: sbm.MaterialFunctions, snapshots: list, channel: pr
 
 
 def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None) -> tuple[dict, dict]:
-    """The results of a run (a flat dict, the keys of cases/poiseuille/results.json) and what the figure
-    needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions)."""
+    """The results of a run (a flat dict, the keys of cases/poiseuille/results.json; `species` one dict per
+    species, profiles.species_summary with its phi_center in the central band |y - mid| < a1 in place of
+    phi_core) and what the figure needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions)."""
     material = material or sbm.MaterialFunctions.maron_pierce_power_law()
     run = shear.read_run(run_dir)
     sc = scales(run)
@@ -327,6 +328,12 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
 
     coarse = profiles.average_profiles(kept, channel)
     fine = profiles.average_profiles(kept, channel, y=channel.planes(0.02), errors=False)
+    # each species alone: phi(y) on the same bins, its volume fraction in the central band |y - mid| < a1
+    species = profiles.species_profiles(kept, channel, edges=coarse.edges,
+                                        h_layer=0.5 * channel.width - CENTRAL_HALF_WIDTH)
+    species_rows = profiles.species_summary(species, float(np.prod(run.box)))
+    for row in species_rows:   # the band is the channel's centre, not a Couette core
+        row["phi_center"], row["phi_center_err"] = row.pop("phi_core"), row.pop("phi_core_err")
     balance = momentum_balance(run_dir, run.eta, sc, channel, kept, coarse, t0)
     model, sbm_phi_rms, sbm_u_rms, phi_region = sbm_comparison(material, kept, channel, sc, coarse, fine)
     phi_m = material.phi_m
@@ -356,8 +363,10 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
         n_a2=int(np.sum(pack.types == 2)), dt=run.dt / sc.time_unit, steps=int(len(inner)),
         steps_planned=run.steps_planned, inner_iterations_mean=float(inner.mean()),
         inner_iterations_max=int(inner.max()), unconverged_steps=int(np.sum(steps["converged"] == 0)),
-        wall_seconds=wall_seconds, ranks=ranks, core_seconds=wall_seconds * ranks, springs=dict(run.springs))
-    figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, times=times, phi_center=phi_center,
+        wall_seconds=wall_seconds, ranks=ranks, core_seconds=wall_seconds * ranks, springs=dict(run.springs),
+        species=species_rows, species_profile_y=coarse.y.tolist())
+    figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, species=species, times=times,
+                  phi_center=phi_center,
                   phi_walls=phi_walls, model=model, start=t0, phi_m=phi_m, **balance["figure"])
     return results, figure
 
@@ -383,6 +392,10 @@ def plot(path: str, fig: dict) -> str:
     a = ax[0, 0]
     a.plot(ys(fine.y), fine.phi, ":", color="0.5", lw=0.8, label="simulation (fine)")
     a.errorbar(ys(coarse.y), coarse.phi, yerr=coarse.phi_error, fmt="o", ms=4, capsize=2, label="simulation (bins a1)")
+    if len(fig.get("species") or []) > 1:
+        for sp in fig["species"]:
+            a.errorbar(ys(sp.average.y), sp.average.phi, yerr=sp.average.phi_error, fmt="--.", ms=3, lw=0.8,
+                       capsize=1, label="type %d (a %g)" % (sp.type, sp.radius))
     a.plot(model.y, model.phi, "-", color="C3", label="SBM (Eqs. 62-63)")
     a.axhline(fig["phi_m"], color="0.7", lw=0.5, label="phi_m")
     a.set_xlabel("y*"), a.set_ylabel("phi"), a.legend(fontsize=8), a.set_title("volume fraction")

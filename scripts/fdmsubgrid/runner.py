@@ -9,9 +9,29 @@ import time
 
 from .environment import program, run_environment
 
+# the sub-grid calibration tables the runs of this process started with (fdmRun's record in each folder), for
+# the results file (fdmsubgrid.results: its `calibration`)
+_CALIBRATIONS: list = []
+
+
+def calibrations_run() -> list:
+    """{"table": absolute path or None, "sha256": ...} of every run this process ran (run), in order."""
+    return list(_CALIBRATIONS)
+
+
+def _remember_calibration(case_dir: str) -> None:
+    import json
+    from .checkpoint import CALIBRATION_STAMP
+    path = os.path.join(case_dir, CALIBRATION_STAMP)
+    if os.path.isfile(path):
+        with open(path) as f:
+            _CALIBRATIONS.append(json.load(f))
+
+
 def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     """Run fdmRun on case_dir; returns the wall time in seconds. Raises RuntimeError with the
-    end of fdmRun's report if the run fails."""
+    end of fdmRun's report if the run fails. Remembers the calibration table the run started with
+    (calibrations_run)."""
     cmd = [program("fdmRun"), "-f", str(np_fluid), "-d", str(np_dem)]
     if quiet:
         cmd.append("--quiet")
@@ -20,6 +40,7 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
                           env=run_environment())
     wall = time.time() - t0
+    _remember_calibration(case_dir)
     if proc.returncode != 0:
         raise RuntimeError("fdmRun %s failed (exit %d):\n%s" % (case_dir, proc.returncode, proc.stdout[-4000:]))
     return wall
