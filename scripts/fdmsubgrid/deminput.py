@@ -49,7 +49,7 @@ RECORD_EVERY_STEP = records_line(1)
 
 # the cut-off model's known error, what a scene outside the table gives up (docs/validation.md, "Squeeze
 # calibration": closing velocities at a position the calibration did not use, a/Delta 3-5)
-CUTOFF_MODEL_ERROR = "its squeeze up to 16 % off for pairs and 24 % for walls at a/Delta 3-5, docs/validation.md"
+CUTOFF_MODEL_ERROR = "squeeze up to 16 % off for pairs, 24 % for walls: docs/validation.md"
 
 
 def _calibration_command(a_over_delta: float, ratio: float | None) -> str:
@@ -71,7 +71,7 @@ def _coverage_summary(coverage: str) -> str:
     walls = re.findall(r"\(([\d.eE+-]+)\)", parts.get("walls", ""))
     def listed(values):
         return ", ".join(sorted(set(values), key=float)) or "none"
-    return ("pairs a1/Delta %s with a2/a1 %s, walls a/Delta %s, interpolated in between"
+    return ("pairs a1/Delta %s x a2/a1 %s and walls a/Delta %s (interpolated between)"
             % (listed(a for a, _ in pairs), listed(r for _, r in pairs), listed(walls)))
 
 
@@ -101,28 +101,29 @@ def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, mode
                 key = ("pair", round(a / delta, 6), round(b / a, 6))
                 if key not in seen:
                     seen.add(key)
-                    missing.append("no calibration for the pair of radii %g and %g at a1/Delta %.4g (a2/a1 %.4g): %s"
+                    missing.append("pair of radii %g and %g (a1/Delta %.4g, a2/a1 %.4g): %s"
                                    % (a, b, a / delta, b / a, _calibration_command(a / delta, b / a)))
             if walls and b == a and not r["wall"]:
                 key = ("wall", round(a / delta, 6))
                 if key not in seen:
                     seen.add(key)
-                    missing.append("no wall calibration for radius %g at a/Delta %.4g: %s"
+                    missing.append("radius %g at a wall (a/Delta %.4g): %s"
                                    % (a, a / delta, _calibration_command(a / delta, None)))
     if missing:
         table = r["table"]
         root = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
         shown = os.path.relpath(table, root) if os.path.abspath(table).startswith(root + os.sep) else table
-        missing.append("the table %s has %s" % (shown, _coverage_summary(r["coverage"])))
-        missing.append("or run the scene with --model cutoff (%s)" % CUTOFF_MODEL_ERROR)
+        missing.append("%s has %s" % (shown, _coverage_summary(r["coverage"])))
+        missing.append("or --model cutoff (%s)" % CUTOFF_MODEL_ERROR)
     return missing
 
 
 def refusal(who: str, missing: list[str]) -> str:
     """The message that refuses a scene uncalibrated() found lacking: one line per missing pair or wall
     (with its command) and the table's line, each on its own line."""
-    return "%s: the sub-grid calibration does not cover this scene (pair_style fdm/subgrid model calibrated):\n%s" % (
-        who, "\n".join("  " + line for line in missing))
+    lacking = sum(1 for line in missing if ": python3 -m fdmsubgrid.calibration" in line)
+    return "%s: the sub-grid calibration (model calibrated) lacks %d of this scene's pairs and walls:\n%s" % (
+        who, lacking, "\n".join("  " + line for line in missing))
 
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",
