@@ -41,6 +41,9 @@ def tiny_run_two_dem_ranks(couette, tmp_path_factory, env):
 def test_tiny_scene_runs_converged_and_integrates_phi_exactly(couette, tiny_run):
     r = tiny_run
     assert r["n_particles"] >= 15 and r["n_a1"] > 0 and r["n_a2"] > 0
+    # each species (atom type) reported: counts and core fractions adding up to the suspension's
+    assert [(s["type"], s["radius"], s["n"]) for s in r["species"]] == [(1, 1.0, r["n_a1"]), (2, 1.4, r["n_a2"])]
+    assert sum(s["phi_core"] for s in r["species"]) == pytest.approx(r["phi_core"], rel=1e-12)
     assert r["unconverged_steps"] == 0
     assert r["steps"] == 20
     snapshots, _ = output.record_snapshots(os.path.join(r["run_dir"], "dem", "particles.records"))

@@ -9,17 +9,20 @@
 
 Command line (prints a summary, writes the data file):
 
-    python3 -m fdmsubgrid.packing N PHI [--bidisperse] [--seed S] [--min-gap G] [--box-multiple D]
-                                 [--shake SWEEPS] [--walls y] -o FILE
+    python3 -m fdmsubgrid.packing N PHI [--bidisperse | --radii A... [--volume-fractions F...]] [--seed S]
+                                 [--min-gap G] [--box-multiple D] [--shake SWEEPS] [--walls y] -o FILE
 
     p = packing.channel_packing((10, 12, 8), phi=0.3, seed=1)        # any box, walls at y = 0 and L_y
                                                                      # (the Couette and Poiseuille cells)
+    sizes = packing.SizeDistribution.of([1, 1.2, 1.4], [0.4, 0.3, 0.3])   # any size distribution
+    p = packing.channel_packing((10, 12, 8), phi=0.3, sizes=sizes)   # species k is atom type k + 1
 
 Boxes are periodic, or wall-bounded along some axes (walls=(1,): planar walls at y = 0 and
 y = L, every sphere at least min_gap from them; LIGGGHTS boundary 'p f p'), for Couette cells.
 
-Method. Radii: all a1 (monodisperse) or the paper's bidisperse suspension (section 6: a1 = 1,
-a2 = 1.4 a1, the two populations occupying equal volumes, i.e. n1 a1^3 = n2 a2^3). The cubic box
+Method. Radii: all a1 (monodisperse), the paper's bidisperse suspension (section 6: a1 = 1,
+a2 = 1.4 a1, the two populations occupying equal volumes, i.e. n1 a1^3 = n2 a2^3), or any
+SizeDistribution (radii with their shares of the particle volume, one atom type each). The cubic box
 side follows from the target volume fraction phi (optionally rounded to a multiple of a mesh size,
 so that the same box can be meshed by blockMesh; phi is then recomputed). Centres are placed
 uniformly at random at their full size (overlapping), then the overlaps are removed by iterative
@@ -162,7 +165,8 @@ PAPER_SUSPENSION = SizeDistribution((1.0, A2_OVER_A1), (0.5, 0.5))
 
 class Packing:
     """N spheres in the box [0, L)^3, periodic except along the axes in walls (planar walls at 0 and
-    L there): positions (N, 3), radii (N,), types (N,) (1 for a1, 2 for a2), box (L, L, L), phi
+    L there): positions (N, 3), radii (N,), types (N,) (1 for a1, 2 for a2; species k + 1 of a
+    SizeDistribution), box (L, L, L), phi
     (actual volume fraction), min_gap (smallest surface gap, pairs and walls, measured),
     min_wall_gap, and the generator's statistics in info."""
 
@@ -463,17 +467,23 @@ def shake(x, radii, box, min_gap, sweeps, rng, max_step=None, walls=()):
 
 
 def random_packing(n, phi, bidisperse=False, seed=0, min_gap=1e-4, box_multiple=None, shake_sweeps=0,
-                   margin=0.5, a1=1.0, walls=()):
+                   margin=0.5, a1=1.0, walls=(), sizes=None):
     """A random packing of n spheres at volume fraction phi in a cube (see the module's docstring),
     periodic except along the axes in walls (e.g. walls=(1,): planar walls at y = 0 and y = L, for
     a Couette cell; every sphere at least min_gap from them too). min_gap: smallest surface gap
     required (units of length, a1 = 1 by default); box_multiple: round the box side to a multiple
     of this (a mesh size; phi changes slightly); shake_sweeps: hard-sphere Monte Carlo sweeps after
-    the relaxation. Deterministic for a seed."""
+    the relaxation; sizes: a SizeDistribution (n split by its volume fractions, species k of radius
+    a1 sizes.radii[k] as type k + 1) in place of bidisperse. Deterministic for a seed."""
     rng = np.random.default_rng(seed)
-    n1, n2 = counts(n, bidisperse)
-    radii = np.concatenate([np.full(n1, a1), np.full(n2, A2_OVER_A1 * a1)])
-    types = np.concatenate([np.ones(n1, dtype=int), 2 * np.ones(n2, dtype=int)])
+    if sizes is not None:
+        numbers = sizes.counts_for_number(n)
+        radii = np.concatenate([np.full(k, a1 * r) for k, r in zip(numbers, sizes.radii)])
+        types = np.concatenate([np.full(k, t + 1, dtype=int) for t, k in enumerate(numbers)])
+    else:
+        n1, n2 = counts(n, bidisperse)
+        radii = np.concatenate([np.full(n1, a1), np.full(n2, A2_OVER_A1 * a1)])
+        types = np.concatenate([np.ones(n1, dtype=int), 2 * np.ones(n2, dtype=int)])
     perm = rng.permutation(n)  # mix the two sizes in tag order
     radii, types = radii[perm], types[perm]
     side = box_side(radii, phi, box_multiple)
@@ -589,7 +599,8 @@ def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, 
 
 def write_data(path, p, density=1000.0, scale=1.0, title=None):
     """LIGGGHTS data file (read_data; atom_style sphere: id type diameter density x y z), box
-    [0, L)^3, one atom type per radius (1: a1, 2: a2). scale multiplies every length."""
+    [0, L)^3, one atom type per radius (1: a1, 2: a2; species k + 1 of a SizeDistribution). scale
+    multiplies every length."""
     ntypes = int(p.types.max())
     with open(path, "w") as f:
         if title is None:  # LIGGGHTS reads a short first line only
@@ -633,6 +644,10 @@ def main(argv=None):
     ap.add_argument("n", type=int, help="number of spheres")
     ap.add_argument("phi", type=float, help="target volume fraction")
     ap.add_argument("--bidisperse", action="store_true", help="a1 = 1, a2 = 1.4, equal volumes (paper section 6)")
+    ap.add_argument("--radii", type=float, nargs="+", default=None, help="any size distribution: the radii [a1] "
+                    "(with --volume-fractions, equal volumes if left out), one atom type each")
+    ap.add_argument("--volume-fractions", type=float, nargs="+", default=None,
+                    help="with --radii: each species' share of the particle volume, summing to 1")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--min-gap", type=float, default=1e-4, help="smallest surface gap [a1] (default 1e-4)")
     ap.add_argument("--box-multiple", type=float, default=None, help="round the box side to a multiple of this")
@@ -641,8 +656,16 @@ def main(argv=None):
     ap.add_argument("--density", type=float, default=1000.0)
     ap.add_argument("-o", "--output", default=None, help="LIGGGHTS data file to write")
     args = ap.parse_args(argv)
+    sizes = None
+    if args.radii is not None or args.volume_fractions is not None:
+        if args.radii is None or args.bidisperse:
+            ap.error("--volume-fractions goes with --radii, and --radii replaces --bidisperse")
+        try:
+            sizes = SizeDistribution.of(args.radii, args.volume_fractions)
+        except SizeDistributionError as e:
+            ap.error(str(e))
     p = random_packing(args.n, args.phi, args.bidisperse, args.seed, args.min_gap, args.box_multiple, args.shake,
-                       walls=tuple("xyz".index(c) for c in args.walls))
+                       walls=tuple("xyz".index(c) for c in args.walls), sizes=sizes)
     print(p.summary())
     if args.output:
         write_data(args.output, p, args.density)
