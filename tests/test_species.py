@@ -25,12 +25,12 @@ def couette():
 
 
 def pair_gaps(pack):
-    """Every pair's surface gap by brute force (minimum image along x and z), independent of the packing's
-    neighbour search."""
+    """Every pair's surface gap by brute force (minimum image along the periodic axes), independent of the
+    packing's neighbour search."""
     x, a, box = pack.positions, pack.radii, pack.box
     i, j = np.triu_indices(pack.n, 1)
     d = x[i] - x[j]
-    for axis in (0, 2):
+    for axis in (k for k in range(3) if k not in pack.walls):
         d[:, axis] -= box[axis] * np.round(d[:, axis] / box[axis])
     return np.linalg.norm(d, axis=1) - a[i] - a[j]
 
@@ -57,6 +57,10 @@ def test_a_distribution_packs_with_its_volume_fractions_and_no_overlap():
     assert pair_gaps(pack).min() >= 0.01 and pack.min_wall_gap >= 0.01
     assert np.all(pack.positions[:, 1] - pack.radii >= 0.01)
     assert np.all(box[1] - pack.positions[:, 1] - pack.radii >= 0.01)
+    # the periodic cube of python3 -m fdmsubgrid.packing too
+    cube = packing.random_packing(200, 0.4, seed=1, sizes=THREE)
+    assert pair_gaps(cube).min() >= 1e-4 * (1 - 1e-9)
+    assert {t: r for t, r, _, _ in cube.species()} == {1: 1.0, 2: 1.2, 3: 1.4}
     # a count of spheres (Table 8's N_P) is split by volume too
     numbers = THREE.counts_for_number(500)
     assert sum(numbers) == 500
