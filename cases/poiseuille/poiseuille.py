@@ -120,6 +120,20 @@ def main(argv: list[str] | None = None) -> dict:
 
     if args.paper:
         args.size = list(PAPER_SIZE)
+    pack = None
+    if args.from_records:
+        if args.radii is not None or args.volume_fractions is not None or args.distribution is not None:
+            p.error("--from-records takes its spheres' sizes from the records: --radii, --volume-fractions and "
+                    "--distribution go with a random packing")
+        try:
+            pack = poiseuille.packing_from_records(args.from_records, args.size)
+        except (OSError, ValueError) as e:
+            p.error("--from-records: %s" % e)
+        species = pack.species()
+        if sorted(a for _, a, _, _ in species) != list(packing.PAPER_SUSPENSION.radii):
+            # the records' own sizes set the springs and the time step (their shares as recorded)
+            args.radii = [a for _, a, _, _ in species]
+            args.volume_fractions = [share / sum(v for _, _, _, v in species) for _, _, _, share in species]
     sizes = case.size_distribution(p, args)
     try:
         suspension.check_resolution(sizes, args.a_over_delta)
@@ -142,12 +156,7 @@ def main(argv: list[str] | None = None) -> dict:
     grad, u_c = pressure_gradient(width)
     time_unit = width / (2 * u_c)
     dt = args.dt * time_unit
-    if args.from_records:
-        try:
-            pack = poiseuille.packing_from_records(args.from_records, args.size)
-        except (OSError, ValueError) as e:
-            p.error("--from-records: %s" % e)
-    else:
+    if pack is None:
         pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
                                        wall_gap=2 * suspension.ROUGHNESS, sizes=sizes)
     print("packing:", pack.summary())
