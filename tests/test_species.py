@@ -8,6 +8,7 @@ import hashlib
 import json
 import math
 import os
+import time
 
 import numpy as np
 import pytest
@@ -190,13 +191,13 @@ def test_results_record_the_calibration_table(env, tmp_path):
                               (cutoff, dict(table=None, sha256=None))):
         checkpoint.stamp(run_dir, os.path.join(run_dir, "dem", "in.couette"))     # as fdmRun does at the start
         out = os.path.join(run_dir, "results.json")
-        results.write_results(out, script, [], {}, [], dict(run_dir=run_dir), 0.0)
+        results.write_results(out, script, [], {}, [], dict(run_dir=run_dir), time.time())
         assert json.load(open(out))["calibration"] == [expected]
         assert results.read_results(out).calibration == [expected]
     # a run folder without fdmRun's record (an older run): nothing claimed
     bare = tmp_path / "bare"
     bare.mkdir()
-    results.write_results(str(bare / "results.json"), script, [], {}, [], dict(run_dir=str(bare)), 0.0)
+    results.write_results(str(bare / "results.json"), script, [], {}, [], dict(run_dir=str(bare)), time.time())
     assert results.read_results(str(bare / "results.json")).calibration == []
 
 

@@ -22,8 +22,8 @@ case's results (the validation report, `table8.py`, the notebooks) reads them th
 each run folder (CASE/.fdmRun-calibration, fdmsubgrid.checkpoint.stamp): its path relative to the project
 and the SHA-256 of its bytes; {"table": null, "sha256": null} for runs that read no table (`model cutoff`
 or `lubrication no`); an empty list when no run folder is known (a case that runs no coupled solver, or a
-run older than the record). The runs are those this process ran (fdmsubgrid.runner.run) and the folder
-named by the record's `run_dir` (a run analysed later). A file written before the key reads with an
+run older than the record). The runs are those this process started since the case began (fdmsubgrid.
+runner.run; write_results' `started`) and the folder named by the record's `run_dir` (a run analysed later). A file written before the key reads with an
 empty list.
 
 A ROW (`Row`) is one measured quantity in one configuration:
@@ -174,12 +174,13 @@ def scene_of(options: Any, script: Optional[str] = None) -> Dict[str, Any]:
     return files.relative_paths(scene, start)
 
 
-def calibration_of_runs(run_dirs: Iterable[str], root: str) -> List[Dict[str, Any]]:
+def calibration_of_runs(run_dirs: Iterable[str], root: str, since: float = -math.inf) -> List[Dict[str, Any]]:
     """The distinct sub-grid calibration tables the run folders started with (fdmRun's CASE/.fdmRun-calibration;
-    a folder without the record is left out), each {"table": path relative to root or None, "sha256": ...}."""
+    a folder without the record is left out) and those of the runs this process started at or after `since`
+    (fdmsubgrid.runner.calibrations_run), each {"table": path relative to root or None, "sha256": ...}."""
     from . import checkpoint, runner
     found: List[Dict[str, Any]] = []
-    identities = list(runner.calibrations_run())
+    identities = list(runner.calibrations_run(since))
     for run_dir in run_dirs:
         path = os.path.join(run_dir, checkpoint.CALIBRATION_STAMP)
         if os.path.isfile(path):
@@ -227,7 +228,7 @@ def write_results(path: str, script: str, argv: Optional[Sequence[str]], options
                     command=command_line(script, argv), commit=project_commit(os.path.dirname(os.path.abspath(script))),
                     date=date, wall_seconds=wall_seconds, scene=scene_of(options, script),
                     calibration=calibration_of_runs([data["run_dir"]] if isinstance(data.get("run_dir"), str) else [],
-                                                    project_root(script)),
+                                                    project_root(script), since=started),
                     rows=[asdict(row) for row in rows or []],
                     data={k: v for k, v in data.items() if k not in ("wall_seconds", "date")})
     files.write_json(path, document, default=json_value)
