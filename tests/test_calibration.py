@@ -171,13 +171,14 @@ def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
     assert case.uncalibrated([1.0, 2.0], 0.25, model="cutoff") == []
     # one sphere per scene (wallShear, channelShear): only each radius against the walls
     alone = case.uncalibrated([1.0, 1.4], 0.2, walls=True, pairs=False)
-    assert alone[0] == "no wall calibration for radius 1.4 at a/Delta 7" and len(alone) == 2
+    assert alone[0].startswith("radius 1.4 at a wall (a/Delta 7): python3 -m fdmsubgrid.calibration "
+                               "--a-over-delta 7 --no-pairs") and len(alone) == 3
     # one sphere of a radius has no pair with itself: a2/Delta = 5.6 alone is fine without walls, two are not
     assert case.uncalibrated([1.0, 1.0, 1.4], 0.25) == []
-    assert "the pair of radii 1.4 and 1.4" in case.uncalibrated([1.0, 1.4, 1.4], 0.25)[0]
+    assert "pair of radii 1.4 and 1.4" in case.uncalibrated([1.0, 1.4, 1.4], 0.25)[0]
     couette = load_case_module("couette")
     with pytest.raises(SystemExit) as refused:
         couette.main(["--a-over-delta", "4", "--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
-    assert "no wall calibration for radius 1.4 at a/Delta 5.6" in str(refused.value)
+    assert "radius 1.4 at a wall (a/Delta 5.6)" in str(refused.value)
     assert "--model cutoff" in str(refused.value)
     assert os.listdir(tmp_path) == []

@@ -1,5 +1,6 @@
 """cases/couette (paper 6.1) on a tiny scene: a bidisperse frictional suspension between walls at
 -U and +U, run by the real fdmFoam and fdmDEM (about 30 s), and the case's bad input."""
+import hashlib
 import json
 import os
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import PROJECT, assert_refused, load_case_module
-from fdmsubgrid import case, output, packing, profiles
+from fdmsubgrid import case, output, packing, profiles, results
 
 TINY = ["--phi", "0.25", "--size", "7", "11", "7", "--a-over-delta", "3", "--dt", "0.02", "--strain", "0.4",
         "--dump-every", "0.02", "--seed", "3"]
@@ -24,8 +25,7 @@ def couette():
 @pytest.fixture(scope="module")
 def tiny_run(couette, tmp_path_factory, env):
     work = tmp_path_factory.mktemp("couette")
-    results = couette.main(TINY + OUTPUTS + ["--workdir", str(work), "--out", str(work / "results.json")])
-    return results
+    return couette.main(TINY + OUTPUTS + ["--workdir", str(work), "--out", str(work / "results.json")])
 
 
 @pytest.fixture(scope="module")
@@ -41,6 +41,15 @@ def tiny_run_two_dem_ranks(couette, tmp_path_factory, env):
 def test_tiny_scene_runs_converged_and_integrates_phi_exactly(couette, tiny_run):
     r = tiny_run
     assert r["n_particles"] >= 15 and r["n_a1"] > 0 and r["n_a2"] > 0
+    # each species (atom type) reported: counts and core fractions adding up to the suspension's
+    assert [(s["type"], s["radius"], s["n"]) for s in r["species"]] == [(1, 1.0, r["n_a1"]), (2, 1.4, r["n_a2"])]
+    assert sum(s["phi_core"] for s in r["species"]) == pytest.approx(r["phi_core"], rel=1e-12)
+    # results.json names the calibration table the run started with (fdmRun's record) and its SHA-256
+    table = os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat")
+    with open(table, "rb") as f:
+        digest = hashlib.sha256(f.read()).hexdigest()
+    document = results.read_results(os.path.join(os.path.dirname(r["run_dir"]), "results.json"))
+    assert document.calibration == [dict(table="dem/resistance/data/subgrid_calibration.dat", sha256=digest)]
     assert r["unconverged_steps"] == 0
     assert r["steps"] == 20
     snapshots, _ = output.record_snapshots(os.path.join(r["run_dir"], "dem", "particles.records"))

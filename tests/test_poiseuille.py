@@ -43,6 +43,18 @@ def test_phi_integral_is_exact(small_run):
     assert small_run["phi_bulk_integral_max_error"] < 1e-10
 
 
+def test_each_species_is_reported(small_run):
+    """The paper's two species (atom types 1 and 2, radii 1 and 1.4): their counts, bulk fractions and central
+    fractions add up to the suspension's (the same band and snapshots), and each phi(y) has one value per bin."""
+    r = small_run
+    species = r["species"]
+    assert [(s["type"], s["radius"]) for s in species] == [(1, 1.0), (2, 1.4)]
+    assert sum(s["n"] for s in species) == r["n_particles"]
+    assert sum(s["phi_bulk"] for s in species) == pytest.approx(r["phi_bulk"], rel=1e-12)
+    assert sum(s["phi_center"] for s in species) == pytest.approx(r["phi_center"], rel=1e-12)
+    assert all(len(s["phi_profile"]) == len(r["species_profile_y"]) for s in species)
+
+
 def test_momentum_balance(small_run):
     """The walls carry the pressure gradient's whole force, tau_lo - tau_hi = |dP0/dx| L_y, to the
     solver's tolerance; and the shear stress of Eqs. 51-53 on the cell faces (fluid eta d<u>/dy from

@@ -325,7 +325,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
             missing = case.uncalibrated(RADII[args.radius], A1 / args.a_over_delta, walls=True, model=args.model,
                                         pairs=False)
             if missing:
-                raise ValueError("channelShear: " + "; ".join(missing))
+                raise ValueError(case.refusal("channelShear", missing))
     except ValueError as e:
         p.error(str(e))
     os.makedirs(args.workdir, exist_ok=True)

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""A frictional bidisperse suspension in plane Couette flow (paper section 6.1, Table 8, Eqs. 49-57).
+"""A frictional suspension in plane Couette flow (paper section 6.1, Table 8, Eqs. 49-57).
 
 Walls y = 0 and y = L_y move at -U and +U along x (nominal shear rate gamma_dot_0 = 2U/L_y = 1),
-x and z are periodic. The suspension: spheres of radii a1 = 1 and a2 = 1.4 a1 in equal volumes
-(phi_1 = phi_2 = phi_bulk/2), placed at random without overlap and clear of the walls
+x and z are periodic. The suspension: by default the paper's, spheres of radii a1 = 1 and a2 = 1.4 a1 in
+equal volumes (phi_1 = phi_2 = phi_bulk/2); any other with --radii and --volume-fractions (or --distribution
+lognormal MEDIAN SIGMA N), each species a LIGGGHTS atom type; placed at random without overlap and clear of the walls
 (fdmsubgrid.packing.channel_packing), frictional contact with h_r = 5e-3 a1 and mu_s = 0.5 (pairs and
 walls), sub-grid lubrication for pairs and walls, stresslets on. Units: a1 = 1 m, eta = 1 Pa s,
 gamma_dot_0 = 1 1/s (time = strain).
@@ -11,7 +12,9 @@ gamma_dot_0 = 1 1/s (time = strain).
 The contact springs follow the rules of docs/contact.md ("A recipe", fdmsubgrid.suspension), computed
 and printed, with the design load F_max = 6 pi a2^2 tau for the shear stress tau = eta gamma_dot_0
 eta_MP(phi) (the relative viscosity from the paper's Maron-Pierce fit, Eq. 55: alpha = 0.803,
-phi_m = 0.59); the scene (Table 8, the time-step limits, the springs, the run folder) is
+phi_m = 0.59), a2 the largest radius; the smallest sets the mesh (at least 2 cells, and a calibration for
+each of its pairs) and the time step (the default dt 0.02 shortened when a_max/a_min exceeds 1.4:
+fdmsubgrid.suspension.time_step_factor); the scene (Table 8, the time-step limits, the springs, the run folder) is
 fdmsubgrid.couettescene's, on fdmsubgrid.suspension.write_case, shared with cases/poiseuille.
 
   couette.py                         the small scene (about 40 spheres, 10 x 12 x 8 a1, a1/Delta = 3,
@@ -20,6 +23,8 @@ fdmsubgrid.couettescene's, on fdmsubgrid.suspension.write_case, shared with case
   couette.py --table8 0.27           writes the paper's Table 8 scene for phi_bulk = 0.27 (box, N_P, dt)
                                      and stops (run it with fdmRun, or --run)
   couette.py --phi 0.47 --write-only the scene written, not run (fdmRun, or timeStepWithoutFluid.py --run)
+  couette.py --radii 1 1.2 1.4 --volume-fractions 0.5 0.3 0.2
+                                     three species (any radii the mesh and the calibration cover)
   couette.py --help                  every option
 Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png here (docs/cases.md).
 """
@@ -37,6 +42,7 @@ from fdmsubgrid.couettescene import (A1, A2, ETA, FRICTION, MEASURED_DT_LIMITS, 
                                      time_step_warning, write_case, write_run)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+DEFAULT_DT = 0.02   # 1/gamma_dot_0, for the paper's radii (suspension.scaled_time_step carries it to others)
 
 
 def validation_rows(results: dict) -> list[Row]:
@@ -59,8 +65,8 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--size", type=float, nargs=3, default=[10.0, 12.0, 8.0], metavar=("LX", "LY", "LZ"),
                    help="box in units of a1 (walls normal to y); each a whole number of cells")
     p.add_argument("--a-over-delta", type=float, default=3.0, help="a1/Delta, mesh cells per small radius")
-    p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 (default 0.02; "
-                   "with --table8, Table 8's)")
+    p.add_argument("--dt", type=float, default=None, help="time step in units of 1/gamma_dot_0 (default 0.02, "
+                   "shortened for size ratios above 1.4; with --table8, Table 8's)")
     p.add_argument("--fluid-every", type=int, default=1, metavar="K",
                    help="solve the fluid every K-th particle step (its step K dt); the steps between hold its "
                    "force on each particle as a drag toward the velocity it gave (docs/dem.md, 'Particle steps "
@@ -89,6 +95,7 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None,
                    help="analyse this run folder as it stands (a resumed, stopped or running run) and write --out")
+    case.add_size_options(p)
     case.add_run_options(p, HERE, tol_lambda=1e-3, model=True)
     args = p.parse_args(argv)
     started = time.time()
@@ -105,6 +112,11 @@ def main(argv: list[str] | None = None) -> dict:
                                                 table8=table8), h_layer=args.h_layer,
                             write=results_writer(argv, args, started))
 
+    sizes = case.size_distribution(p, args)
+    try:
+        suspension.check_resolution(sizes, args.a_over_delta)
+    except ValueError as e:
+        p.error(str(e))
     n_particles = None
     phi = args.phi
     if args.table8 is not None:
@@ -114,7 +126,7 @@ def main(argv: list[str] | None = None) -> dict:
         _, _, size, n_particles, dt_paper = TABLE8[key]
         args.size, phi = list(size), key
         args.dt = dt_paper if args.dt is None else args.dt
-    dt = 0.02 if args.dt is None else args.dt
+    dt = suspension.scaled_time_step(DEFAULT_DT, sizes) if args.dt is None else args.dt
     delta = A1 / args.a_over_delta
     for L, name in zip(args.size, "xyz"):
         if abs(L / delta - round(L / delta)) > 1e-9 * L / delta:
@@ -130,7 +142,7 @@ def main(argv: list[str] | None = None) -> dict:
                             tol_lambda=args.tol_lambda, acceleration=args.acceleration, n_max=args.n_max,
                             text_dump=args.text_dump, model=args.model, fluid_every=args.fluid_every,
                             held_drag=args.held_drag, kn=args.kn, kt=args.kt, table8=args.table8 is not None,
-                            overwrite=args.overwrite)
+                            overwrite=args.overwrite, sizes=sizes)
     except (UncalibratedScene, FileExistsError) as e:
         raise SystemExit(str(e))
     run_dir, name, springs, scene = written["run_dir"], written["name"], written["springs"], written["scene"]

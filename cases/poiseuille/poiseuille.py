@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A frictional bidisperse suspension driven through a plane channel by a pressure gradient (paper
+"""A frictional suspension driven through a plane channel by a pressure gradient (paper
 section 6.2, Eqs. 58-63, Fig. 23): shear-induced migration toward the centre, its profiles, the momentum
 balance and the Suspension Balance Model.
 
@@ -8,13 +8,16 @@ Walls y = 0 and y = L_y at rest, x and z periodic, the uniform pressure gradient
 wall shear stress tau_w = |dP0/dx| L_y/2 are 1). Times in units of L_y/(2 U_c) (= 2 s). The suspension
 and its contact (h_r = 5e-3 a1, mu_s = 0.5, sub-grid lubrication, stresslets) as in cases/couette, the
 scene written by the same code (fdmsubgrid.suspension); the springs by docs/contact.md's rule for the
-wall shear stress tau_w.
+wall shear stress tau_w. The paper's radii 1 and 1.4 in equal volumes by default; any other size
+distribution with --radii and --volume-fractions (or --distribution lognormal MEDIAN SIGMA N), each species
+a LIGGGHTS atom type, the smallest setting the mesh and the time step (fdmsubgrid.suspension).
 
   poiseuille.py                 the small channel (8 x 12 x 8 a1, phi_bulk 0.45, a1/Delta = 3, 40 time
                                 units, the particles at dt 0.05, the fluid every 4th step): migration
                                 begins; about a minute
   poiseuille.py --duration 2    a few steps (the CI test)
   poiseuille.py --paper         writes the paper's (40, 40, 20) a1 channel (not run; --run runs it)
+  poiseuille.py --write-only    writes the scene and stops (fdmRun runs it)
   poiseuille.py --analyse RUN   the analysis of a run folder as it stands
   poiseuille.py --help          every option
 Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_poiseuille.png here (docs/cases.md).
@@ -31,7 +34,7 @@ from typing import Any, List, Optional, Sequence
 
 import numpy as np
 
-from fdmsubgrid import case, packing, poiseuille, sbm, suspension
+from fdmsubgrid import case, couettescene, packing, poiseuille, sbm, suspension
 from fdmsubgrid.results import Row, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -55,10 +58,11 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--paper", action="store_true", help="the paper's (40, 40, 20) a1 channel: written, not run "
                    "(with --run, run)")
     p.add_argument("--run", action="store_true", help="with --paper: run it too")
+    p.add_argument("--write-only", action="store_true", help="write the scene's folder and stop (run it with fdmRun)")
     p.add_argument("--a-over-delta", type=float, default=3.0, help="a1/Delta, mesh cells per small radius")
-    p.add_argument("--dt", type=float, default=poiseuille.DEFAULT_DT,
-                   help="particle time step in units of L_y/(2 U_c) (measured: docs/benchmarks.md, \"The channel's "
-                        "time step\")")
+    p.add_argument("--dt", type=float, default=None,
+                   help="particle time step in units of L_y/(2 U_c) (default %g, measured: docs/benchmarks.md, \"The "
+                        "channel's time step\"; shortened for size ratios above 1.4)" % poiseuille.DEFAULT_DT)
     p.add_argument("--duration", type=float, default=40.0, help="time to run, in units of L_y/(2 U_c)")
     p.add_argument("--seed", type=int, default=1, help="seed of the random packing")
     p.add_argument("--dump-every", type=float, default=0.5, help="time between two particle snapshots")
@@ -90,6 +94,7 @@ def main(argv: list[str] | None = None) -> dict:
                    help="start from the particles of the last block of this particle records file (dem/"
                         "particles.records of a run of the same channel, e.g. its dense core) instead of a "
                         "random packing; the contacts' tangential history and the fluid start afresh")
+    case.add_size_options(p)
     case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
     args = p.parse_args(argv)
     started = time.time()
@@ -115,6 +120,27 @@ def main(argv: list[str] | None = None) -> dict:
 
     if args.paper:
         args.size = list(PAPER_SIZE)
+    pack = None
+    if args.from_records:
+        if args.radii is not None or args.volume_fractions is not None or args.distribution is not None:
+            p.error("--from-records takes its spheres' sizes from the records: --radii, --volume-fractions and "
+                    "--distribution go with a random packing")
+        try:
+            pack = poiseuille.packing_from_records(args.from_records, args.size)
+        except (OSError, ValueError) as e:
+            p.error("--from-records: %s" % e)
+        species = pack.species()
+        if sorted(a for _, a, _, _ in species) != list(packing.PAPER_SUSPENSION.radii):
+            # the records' own sizes set the springs and the time step (their shares as recorded)
+            args.radii = [a for _, a, _, _ in species]
+            args.volume_fractions = [share / sum(v for _, _, _, v in species) for _, _, _, share in species]
+    sizes = case.size_distribution(p, args)
+    try:
+        suspension.check_resolution(sizes, args.a_over_delta)
+    except ValueError as e:
+        p.error(str(e))
+    if args.dt is None:
+        args.dt = suspension.scaled_time_step(poiseuille.DEFAULT_DT, sizes)
     delta = suspension.A1 / args.a_over_delta
     for L, name in zip(args.size, "xyz"):
         if abs(L / delta - round(L / delta)) > 1e-9 * L / delta:
@@ -130,22 +156,17 @@ def main(argv: list[str] | None = None) -> dict:
     grad, u_c = pressure_gradient(width)
     time_unit = width / (2 * u_c)
     dt = args.dt * time_unit
-    if args.from_records:
-        try:
-            pack = poiseuille.packing_from_records(args.from_records, args.size)
-        except (OSError, ValueError) as e:
-            p.error("--from-records: %s" % e)
-    else:
+    if pack is None:
         pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
-                                       wall_gap=2 * suspension.ROUGHNESS)
+                                       wall_gap=2 * suspension.ROUGHNESS, sizes=sizes)
     print("packing:", pack.summary())
     missing = case.uncalibrated(pack.radii, delta, walls=True, model=args.model)
     if missing:
-        raise SystemExit("poiseuille: " + "; ".join(missing))
+        raise SystemExit(case.refusal("poiseuille", missing))
     tau_w = abs(grad) * width / 2
-    springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt)
+    springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt, sizes)
     print(springs.describe(dt))
-    warning = poiseuille.time_step_warning(args.dt, args.fluid_every)
+    warning = poiseuille.time_step_warning(args.dt, args.fluid_every, sizes)
     if warning:
         print(warning, file=sys.stderr)
 
@@ -153,6 +174,7 @@ def main(argv: list[str] | None = None) -> dict:
                                                  "records" if args.from_records else "seed%d" % args.seed,
                                                  "_" + args.model,
                                                  "_fluidEvery%d" % args.fluid_every if args.fluid_every > 1 else "")
+    name += couettescene.sizes_tag(sizes)
     run_dir = os.path.join(args.workdir, name)
     if os.path.exists(run_dir):
         if not args.overwrite:
@@ -167,12 +189,13 @@ def main(argv: list[str] | None = None) -> dict:
                                   args.acceleration, args.n_max, write_every, model=args.model,
                                   grad_p0=(grad, 0.0, 0.0), name="in.poiseuille", fluid_every=K,
                                   held_drag=args.held_drag)
-    print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, channel %s a1, %d cells, dP0/dx = %.4g Pa/m (U_c = %g), "
+    print("wrote %s: %d spheres (%s), phi %.4f, channel %s a1, %d cells, dP0/dx = %.4g Pa/m (U_c = %g), "
           "%d steps of dt %g L_y/(2U_c), a snapshot every %d steps"
-          % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
+          % (run_dir, pack.n, couettescene.species_text(pack), pack.phi,
              " x ".join("%g" % v for v in args.size), scene["cells"], grad, u_c, steps, args.dt, every))
-    if args.paper and not args.run:
-        print("the paper's channel written, not run: fdmRun -f N -d M %s" % run_dir)
+    if (args.paper and not args.run) or args.write_only:
+        print("%s written, not run: fdmRun -f N -d M %s" % ("the paper's channel" if args.paper else "the scene",
+                                                            run_dir))
         return dict(run_dir=run_dir, **scene)
 
     case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)

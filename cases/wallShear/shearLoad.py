@@ -280,7 +280,7 @@ def check_split_options(p: argparse.ArgumentParser, args: argparse.Namespace, bo
     if corrected:
         missing = case.uncalibrated([1.0], 1.0 / args.a_over_delta, walls=True, model=args.model, pairs=False)
         if missing:
-            p.error("; ".join(missing))
+            p.error(case.refusal("shearLoad", missing))
 
 
 def main(argv: Sequence[str] | None = None) -> dict:

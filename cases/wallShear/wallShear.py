@@ -426,7 +426,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
         # one sphere at a time: each radius against the walls needs a calibration
         missing = case.uncalibrated(args.radius, A1 / args.a_over_delta, walls=True, model=args.model, pairs=False)
         if missing:
-            p.error("; ".join(missing))
+            p.error(case.refusal("wallShear", missing))
 
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()

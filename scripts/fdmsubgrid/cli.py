@@ -47,3 +47,48 @@ def add_run_options(parser, case_dir, tol_lambda, cutoff=False, model=False):
     parser.add_argument("--workdir", default=os.path.join(case_dir, "runs"), help="where the runs are written")
     parser.add_argument("--out", default=os.path.join(case_dir, "results.json"))
     parser.add_argument("--keep", action="store_true", help="keep the meshes and the fields of the runs")
+
+
+def add_size_options(parser) -> None:
+    """The size-distribution options of the suspension cases (couette, poiseuille): --radii with
+    --volume-fractions, or --distribution lognormal MEDIAN SIGMA N; size_distribution() reads them."""
+    parser.add_argument("--radii", type=float, nargs="+", default=None, metavar="A",
+                        help="the radii of the species in units of a1 (default 1 1.4, the paper's), each a LIGGGHTS "
+                             "atom type (1 the smallest); the mesh is --a-over-delta cells per a1, and the smallest "
+                             "radius must get at least 2 cells")
+    parser.add_argument("--volume-fractions", type=float, nargs="+", default=None, metavar="F",
+                        help="with --radii: each species' share of the particle volume (phi_k/phi_bulk), summing to "
+                             "1 (default: equal volumes)")
+    parser.add_argument("--distribution", nargs=4, default=None, metavar=("lognormal", "MEDIAN", "SIGMA", "N"),
+                        help="instead of --radii: a log-normal number distribution of radii (median MEDIAN a1, "
+                             "SIGMA the standard deviation of ln a) in N species (fdmsubgrid.packing."
+                             "SizeDistribution.lognormal)")
+
+
+def size_distribution(parser, args):
+    """The packing.SizeDistribution of add_size_options' options (the paper's by default); a bad value is a parser
+    error naming it. Sets args.radii and args.volume_fractions to the distribution's, so that the results file's
+    scene records what was packed."""
+    from . import packing
+    try:
+        if args.distribution is not None:
+            if args.radii is not None or args.volume_fractions is not None:
+                parser.error("--distribution replaces --radii and --volume-fractions: give one or the other")
+            kind, *values = args.distribution
+            if kind != "lognormal":
+                parser.error("--distribution %s: the named distribution is lognormal MEDIAN SIGMA N" % kind)
+            try:
+                median, sigma, n = float(values[0]), float(values[1]), float(values[2])
+            except ValueError:
+                parser.error("--distribution lognormal %s: MEDIAN, SIGMA and N must be numbers" % " ".join(values))
+            sizes = packing.SizeDistribution.lognormal(median, sigma, n)
+        elif args.radii is not None:
+            sizes = packing.SizeDistribution.of(args.radii, args.volume_fractions)
+        elif args.volume_fractions is not None:
+            sizes = packing.SizeDistribution.of(packing.PAPER_SUSPENSION.radii, args.volume_fractions)
+        else:
+            sizes = packing.PAPER_SUSPENSION
+    except packing.SizeDistributionError as e:
+        parser.error(str(e))
+    args.radii, args.volume_fractions = list(sizes.radii), list(sizes.volume_fractions)
+    return sizes

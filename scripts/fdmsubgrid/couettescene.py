@@ -4,7 +4,8 @@ the springs' rule, and the run folder (fluid/ + dem/) of one scene.
 
 Walls y = 0 and y = L_y move at -U and +U along x (nominal shear rate gamma_dot_0 = 2U/L_y = 1), x and z
 periodic; the bidisperse frictional suspension of fdmsubgrid.suspension. Units: a1 = 1 m, eta = 1 Pa s,
-gamma_dot_0 = 1 1/s (time = strain). docs/cases/couette.md.
+gamma_dot_0 = 1 1/s (time = strain). Any size distribution (packing.SizeDistribution, write_run's sizes; the
+paper's radii 1 and 1.4 in equal volumes by default). docs/cases/couette.md.
 
     pack = packing.channel_packing((10, 12, 8), phi=0.3, seed=1, min_gap=2 * ROUGHNESS, wall_gap=2 * ROUGHNESS)
     written = write_run("runs", pack, dt=0.02, strain=3.0)      # the case's defaults otherwise
@@ -95,9 +96,12 @@ def measured_reference(phi: float) -> float | None:
     return _nearest_denser(MEASURED_DT_LIMITS, phi)
 
 
-def largest_good_dt(phi: float) -> float:
+def largest_good_dt(phi: float, sizes: packing.SizeDistribution | None = None) -> float:
     """The largest time step [1/gamma_dot_0] measured good at measured_reference(phi); beyond the densest,
-    that row's limit scaled by eta_MP(densest)/eta_MP(phi)."""
+    that row's limit scaled by eta_MP(densest)/eta_MP(phi). For a size distribution other than the paper's
+    (the measured one), carried over by suspension.time_step_factor (the smallest sphere's contacts)."""
+    if sizes is not None and sizes != suspension.PAPER_SIZES:
+        return suspension.scaled_time_step(largest_good_dt(phi), sizes)
     reference = measured_reference(phi)
     if reference is not None:
         return MEASURED_DT_LIMITS[reference]
@@ -108,13 +112,17 @@ def largest_good_dt(phi: float) -> float:
     return round(math.floor(scaled / unit * (1 + 1e-12)) * unit, 12)   # rounded down to two digits
 
 
-def time_step_warning(phi: float, dt: float) -> str | None:
-    """A warning if dt exceeds largest_good_dt(phi), else None."""
-    limit = largest_good_dt(phi)
+def time_step_warning(phi: float, dt: float, sizes: packing.SizeDistribution | None = None) -> str | None:
+    """A warning if dt exceeds largest_good_dt(phi, sizes), else None."""
+    limit = largest_good_dt(phi, sizes)
     if dt <= limit * (1 + 1e-9):
         return None
     reference = measured_reference(phi)
-    if reference is not None:
+    if sizes is not None and sizes != suspension.PAPER_SIZES:
+        where = ("%g, the limit measured with the paper's radii 1 and 1.4 times %.3g for the radii %s (suspension."
+                 "time_step_factor: the smallest sphere's contacts)" % (limit, suspension.time_step_factor(sizes),
+                                                                      " ".join("%g" % r for r in sizes.radii)))
+    elif reference is not None:
         where = "the largest time step measured good at phi_bulk %g with these springs, %g" % (reference, limit)
     else:
         where = ("%g, the limit at phi_bulk %g scaled by the stress, 1/eta_MP(phi) (phi_bulk %.3g is denser "
@@ -125,11 +133,12 @@ def time_step_warning(phi: float, dt: float) -> str | None:
             % (dt, where, limit, max(1, int(round(dt / limit)))))
 
 
-def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None
-                   ) -> suspension.Springs:
+def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None,
+                   sizes: packing.SizeDistribution | None = None) -> suspension.Springs:
     """The springs by the rule of the module docstring (docs/contact.md) for the shear stress
-    eta gamma_dot_0 eta_MP(phi), unless given."""
-    return suspension.choose_springs(ETA * SHEAR_RATE * suspension.maron_pierce_viscosity(phi), dt, delta, kn, kt)
+    eta gamma_dot_0 eta_MP(phi) and the sizes (default the paper's), unless given."""
+    return suspension.choose_springs(ETA * SHEAR_RATE * suspension.maron_pierce_viscosity(phi), dt, delta, kn, kt,
+                                     sizes)
 
 
 def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
@@ -149,6 +158,12 @@ def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs,
     return scene
 
 
+def species_text(pack: packing.Packing) -> str:
+    """What a packing holds of each species, e.g. '21 of radius 1 (0.5 of the volume), 8 of radius 1.4 (0.5)'."""
+    return ", ".join("%d of radius %g (%.3g of the volume, type %d)" % (n, a, share, t)
+                     for t, a, n, share in pack.species())
+
+
 def table8_row(phi: float) -> dict:
     """The paper's Table 8 row of phi_bulk."""
     return dict(zip(("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi]))
@@ -158,15 +173,25 @@ class UncalibratedScene(ValueError):
     """The shipped sub-grid calibration does not cover the packing's radii at this mesh size."""
 
 
+def sizes_tag(sizes: packing.SizeDistribution | None) -> str:
+    """The part of a run folder's name that says its size distribution: empty for the paper's, else
+    '_r<radii>_f<volume fractions>' (e.g. _r1-1.2-1.4_f0.5-0.3-0.2)."""
+    if sizes is None or sizes == suspension.PAPER_SIZES:
+        return ""
+    return "_r%s_f%s" % ("-".join("%.4g" % r for r in sizes.radii), "-".join("%.3g" % f for f in sizes.volume_fractions))
+
+
 def run_name(phi: float, size, a_over_delta: float, dt: float, seed: int, acceleration: str = "anderson",
-             model: str = "calibrated", fluid_every: int = 1, table8: bool = False) -> str:
+             model: str = "calibrated", fluid_every: int = 1, table8: bool = False,
+             sizes: packing.SizeDistribution | None = None) -> str:
     """The run folder's name: the scene's phi_bulk (the packing's, or Table 8's row), box, mesh, step, seed and
-    the options that change the run."""
+    the options that change the run (the size distribution if not the paper's: sizes_tag)."""
     name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (phi, *size, a_over_delta, dt, seed,
                                                   ("" if acceleration == "anderson" else "_" + acceleration)
                                                   + "_" + model)
     if fluid_every > 1:
         name += "_fluidEvery%d" % fluid_every
+    name += sizes_tag(sizes)
     if table8:
         name = "table8_" + name
     return name
@@ -177,30 +202,33 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
               tol_lambda: float = 1e-3, acceleration: str = "anderson", n_max: int = 50, text_dump: bool = False,
               model: str = "calibrated", fluid_every: int = 1, held_drag: str = suspension.HELD_DRAG[0],
               kn: float | None = None, kt: float | None = None, table8: bool = False,
-              overwrite: bool = False) -> dict:
+              overwrite: bool = False, sizes: packing.SizeDistribution | None = None) -> dict:
     """One Couette scene written in workdir/<run_name>/ (fluid/ and dem/), printing the packing, the springs
     and a warning if dt is beyond the measured limit: the random packing of phi_bulk `phi` (or of
     n_particles spheres, a Table 8 row: table8 names the folder after it) in the box `size` (a1), the springs
     of choose_springs (kn, kt if given), strain/dt steps with a snapshot every dump_every and the fields every
     write_every strain units (on steps the fluid solves: multiples of fluid_every). The defaults are
-    cases/couette/couette.py's. UncalibratedScene if the calibration does not cover the packing's radii,
-    FileExistsError if the folder exists and not overwrite. Returns dict(run_dir, name, pack, springs,
+    cases/couette/couette.py's; sizes: the size distribution (packing.SizeDistribution, default the paper's).
+    SizeDistributionError if the mesh does not resolve the smallest sphere (suspension.check_resolution),
+    UncalibratedScene if the calibration does not cover the packing's radii (its message one line per missing
+    pair, deminput.refusal), FileExistsError if the folder exists and not overwrite. Returns dict(run_dir, name, pack, springs,
     dump_every_steps, scene) with the scene's description (write_case)."""
     delta = A1 / a_over_delta
+    suspension.check_resolution(sizes or suspension.PAPER_SIZES, a_over_delta)
     pack = packing.channel_packing(size, phi=None if n_particles else phi, n=n_particles, seed=seed,
-                                   min_gap=2 * ROUGHNESS, wall_gap=2 * ROUGHNESS)
+                                   min_gap=2 * ROUGHNESS, wall_gap=2 * ROUGHNESS, sizes=sizes)
     print("packing:", pack.summary())
     missing = deminput.uncalibrated(pack.radii, delta, walls=True, model=model)
     if missing:
-        raise UncalibratedScene("couette: " + "; ".join(missing))
-    springs = choose_springs(pack.phi, dt, delta, kn, kt)
+        raise UncalibratedScene(deminput.refusal("couette", missing))
+    springs = choose_springs(pack.phi, dt, delta, kn, kt, sizes)
     print(springs.describe(dt))
-    warning = time_step_warning(pack.phi, dt)
+    warning = time_step_warning(pack.phi, dt, sizes)
     if warning:
         print(warning, flush=True)
 
     name = run_name(pack.phi if n_particles is None else phi, size, a_over_delta, dt, seed, acceleration, model,
-                    fluid_every, table8)
+                    fluid_every, table8, sizes)
     run_dir = os.path.join(workdir, name)
     if os.path.exists(run_dir):
         if not overwrite:
@@ -212,7 +240,7 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
     write_every_steps = K * max(1, int(round(write_every / (SHEAR_RATE * dt * K))))
     scene = write_case(run_dir, pack, springs, a_over_delta, dt, strain, every, tol_lambda, acceleration, n_max,
                        write_every_steps, text_dump, model, fluid_every=fluid_every, held_drag=held_drag)
-    print("wrote %s: %d spheres (%d a1, %d a2), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot "
-          "every %d steps" % (run_dir, pack.n, np.sum(pack.types == 1), np.sum(pack.types == 2), pack.phi,
-                              " x ".join("%g" % v for v in size), scene["cells"], scene["steps"], dt, every))
+    print("wrote %s: %d spheres (%s), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot every %d steps"
+          % (run_dir, pack.n, species_text(pack), pack.phi, " x ".join("%g" % v for v in size), scene["cells"],
+             scene["steps"], dt, every))
     return dict(run_dir=run_dir, name=name, pack=pack, springs=springs, dump_every_steps=every, scene=scene)

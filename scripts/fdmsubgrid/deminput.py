@@ -47,34 +47,83 @@ def records_line(every: int) -> str:
 RECORD_EVERY_STEP = records_line(1)
 
 
+# the cut-off model's known error, what a scene outside the table gives up (docs/validation.md, "Squeeze
+# calibration": closing velocities at a position the calibration did not use, a/Delta 3-5)
+CUTOFF_MODEL_ERROR = "squeeze up to 16 % off for pairs, 24 % for walls: docs/validation.md"
+
+
+def _calibration_command(a_over_delta: float, ratio: float | None) -> str:
+    """The command that measures the calibration of one pair (a1/Delta, a2/a1) or, ratio None, one radius
+    against a wall (docs/resistance.md, "Squeeze calibration"; the header of the shipped table)."""
+    if ratio is None:
+        return ("python3 -m fdmsubgrid.calibration --a-over-delta %.6g --no-pairs --tangential --out TABLE"
+                % a_over_delta)
+    return ("python3 -m fdmsubgrid.calibration --a-over-delta %.6g --ratios %.6g --no-wall --pair-tangential "
+            "--out TABLE" % (a_over_delta, ratio))
+
+
+def _coverage_summary(coverage: str) -> str:
+    """`fdmResistance coverage`'s list of every tabulated block, summarised: the a/Delta and size ratios of the
+    pair squeeze and the a/Delta of the wall squeeze (interpolated in between)."""
+    import re
+    parts = {p.split(" ", 1)[0]: p for p in coverage.split("; ")}
+    pairs = re.findall(r"\(([\d.eE+-]+), ([\d.eE+-]+)\)", parts.get("pairs", ""))
+    walls = re.findall(r"\(([\d.eE+-]+)\)", parts.get("walls", ""))
+    def listed(values):
+        return ", ".join(sorted(set(values), key=float)) or "none"
+    return ("pairs a1/Delta %s x a2/a1 %s and walls a/Delta %s (interpolated between)"
+            % (listed(a for a, _ in pairs), listed(r for _, r in pairs), listed(walls)))
+
+
 def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, model: str = "calibrated",
                  pairs: bool = True) -> list[str]:
     """What the shipped calibration table lacks for a scene of these radii at mesh size delta (with
     walls: also each radius against a wall), in pair_style fdm/subgrid's default model (calibrated):
-    empty when the run can start, else one line per missing radius pair or wall, to refuse the scene
-    before it is launched (the pair style refuses it anyway at its start; `fdmResistance coverage`
-    makes the same test). radii: every particle's (a radius held by one particle has no pair with
-    itself, as in the pair style); pairs=False: the spheres are never in one scene together (one per
-    run), so only each radius against the walls counts; model cutoff needs nothing."""
+    empty when the run can start, else one line per missing (a1/Delta, a2/a1) pair or wall a/Delta, each
+    naming the command that would measure it, then a line with the table and what it covers and one with
+    the alternative (--model cutoff, with its known error), to refuse the scene before it is launched
+    (refusal() joins them; the pair style refuses it anyway at its start; `fdmResistance coverage` makes
+    the same test). radii: every particle's (a radius held by one particle has no pair with itself, as in
+    the pair style); pairs=False: the spheres are never in one scene together (one per run), so only each
+    radius against the walls counts; model cutoff needs nothing."""
     from collections import Counter
     from .theory import resistance
     if model != "calibrated":
         return []
     counts = Counter(float(r) for r in radii)
     sizes = sorted(counts)
-    missing = []
+    missing, seen = [], set()
+    r = {}
     for i, a in enumerate(sizes):
         for b in sizes[i:]:
             r = resistance("coverage", "--a1", a, "--a2", b, "--delta", delta, *(["--wall"] if walls and b == a else []))
             if pairs and not r["pair"] and (b != a or counts[a] > 1):
-                missing.append("no calibration for the pair of radii %g and %g at a1/Delta %g (a2/a1 %g)"
-                               % (a, b, a / delta, b / a))
+                key = ("pair", round(a / delta, 6), round(b / a, 6))
+                if key not in seen:
+                    seen.add(key)
+                    missing.append("pair of radii %g and %g (a1/Delta %.4g, a2/a1 %.4g): %s"
+                                   % (a, b, a / delta, b / a, _calibration_command(a / delta, b / a)))
             if walls and b == a and not r["wall"]:
-                missing.append("no wall calibration for radius %g at a/Delta %g" % (a, a / delta))
+                key = ("wall", round(a / delta, 6))
+                if key not in seen:
+                    seen.add(key)
+                    missing.append("radius %g at a wall (a/Delta %.4g): %s"
+                                   % (a, a / delta, _calibration_command(a / delta, None)))
     if missing:
-        missing.append("the table (%s) has %s; use --model cutoff for this scene" % (r["table"], r["coverage"]))
+        table = r["table"]
+        root = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+        shown = os.path.relpath(table, root) if os.path.abspath(table).startswith(root + os.sep) else table
+        missing.append("%s has %s" % (shown, _coverage_summary(r["coverage"])))
+        missing.append("or --model cutoff (%s)" % CUTOFF_MODEL_ERROR)
     return missing
 
+
+def refusal(who: str, missing: list[str]) -> str:
+    """The message that refuses a scene uncalibrated() found lacking: one line per missing pair or wall
+    (with its command) and the table's line, each on its own line."""
+    lacking = sum(1 for line in missing if ": python3 -m fdmsubgrid.calibration" in line)
+    return "%s: the sub-grid calibration (model calibrated) lacks %d of this scene's pairs and walls:\n%s" % (
+        who, lacking, "\n".join("  " + line for line in missing))
 
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",

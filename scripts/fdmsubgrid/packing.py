@@ -9,17 +9,20 @@
 
 Command line (prints a summary, writes the data file):
 
-    python3 -m fdmsubgrid.packing N PHI [--bidisperse] [--seed S] [--min-gap G] [--box-multiple D]
-                                 [--shake SWEEPS] [--walls y] -o FILE
+    python3 -m fdmsubgrid.packing N PHI [--bidisperse | --radii A... [--volume-fractions F...]] [--seed S]
+                                 [--min-gap G] [--box-multiple D] [--shake SWEEPS] [--walls y] -o FILE
 
     p = packing.channel_packing((10, 12, 8), phi=0.3, seed=1)        # any box, walls at y = 0 and L_y
                                                                      # (the Couette and Poiseuille cells)
+    sizes = packing.SizeDistribution.of([1, 1.2, 1.4], [0.4, 0.3, 0.3])   # any size distribution
+    p = packing.channel_packing((10, 12, 8), phi=0.3, sizes=sizes)   # species k is atom type k + 1
 
 Boxes are periodic, or wall-bounded along some axes (walls=(1,): planar walls at y = 0 and
 y = L, every sphere at least min_gap from them; LIGGGHTS boundary 'p f p'), for Couette cells.
 
-Method. Radii: all a1 (monodisperse) or the paper's bidisperse suspension (section 6: a1 = 1,
-a2 = 1.4 a1, the two populations occupying equal volumes, i.e. n1 a1^3 = n2 a2^3). The cubic box
+Method. Radii: all a1 (monodisperse), the paper's bidisperse suspension (section 6: a1 = 1,
+a2 = 1.4 a1, the two populations occupying equal volumes, i.e. n1 a1^3 = n2 a2^3), or any
+SizeDistribution (radii with their shares of the particle volume, one atom type each). The cubic box
 side follows from the target volume fraction phi (optionally rounded to a multiple of a mesh size,
 so that the same box can be meshed by blockMesh; phi is then recomputed). Centres are placed
 uniformly at random at their full size (overlapping), then the overlaps are removed by iterative
@@ -42,15 +45,128 @@ Lengths are in units of a1 (scale them with `scale`)."""
 import argparse
 import math
 import sys
+from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 
 A2_OVER_A1 = 1.4
 
 
+class SizeDistributionError(ValueError):
+    """Radii and volume fractions that do not make a suspension; the message names the value."""
+
+
+@dataclass(frozen=True)
+class SizeDistribution:
+    """The species of a suspension: radii (units of a1, strictly increasing; species k is LIGGGHTS atom type
+    k + 1) and the share of the particle volume each occupies (volume_fractions, each in (0, 1], summing to 1
+    within FRACTION_SUM_TOLERANCE). The paper's suspension is PAPER_SUSPENSION: radii 1 and 1.4, equal volumes.
+
+        SizeDistribution.of([1, 1.4, 2], [0.4, 0.3, 0.3])      # checked; SizeDistributionError otherwise
+        SizeDistribution.lognormal(1.2, 0.2, 3)                # a log-normal distribution in 3 species
+    """
+
+    radii: tuple
+    volume_fractions: tuple
+
+    FRACTION_SUM_TOLERANCE = 1e-6
+
+    @classmethod
+    def of(cls, radii: Sequence[float], volume_fractions: Sequence[float] | None = None) -> "SizeDistribution":
+        """The distribution of these radii and volume fractions (default: equal volumes), checked: the same
+        number of each, radii positive and distinct (sorted ascending with their fractions), fractions positive
+        and summing to 1. SizeDistributionError naming the offending value otherwise."""
+        radii = [float(r) for r in radii]
+        if not radii:
+            raise SizeDistributionError("size distribution: no radius given")
+        if volume_fractions is None:
+            volume_fractions = [1.0 / len(radii)] * len(radii)
+        fractions = [float(f) for f in volume_fractions]
+        if len(fractions) != len(radii):
+            raise SizeDistributionError("size distribution: %d radii (%s) but %d volume fractions (%s): one fraction "
+                                        "per radius" % (len(radii), " ".join("%g" % r for r in radii), len(fractions),
+                                                        " ".join("%g" % f for f in fractions)))
+        for r in radii:
+            if not (math.isfinite(r) and r > 0):
+                raise SizeDistributionError("size distribution: radius %g is not a positive length (units of a1)" % r)
+        for f in fractions:
+            if not (math.isfinite(f) and 0 < f <= 1):
+                raise SizeDistributionError("size distribution: volume fraction %g is not in (0, 1]" % f)
+        if len(set(radii)) != len(radii):
+            raise SizeDistributionError("size distribution: radius %g is given twice; give each radius once with the "
+                                        "sum of its volume fractions" % next(r for r in radii if radii.count(r) > 1))
+        total = math.fsum(fractions)
+        if abs(total - 1.0) > cls.FRACTION_SUM_TOLERANCE:
+            raise SizeDistributionError("size distribution: the volume fractions %s sum to %.9g, not 1: each is the "
+                                        "share of the particle volume (phi_k / phi_bulk)"
+                                        % (" ".join("%g" % f for f in fractions), total))
+        order = sorted(range(len(radii)), key=lambda k: radii[k])
+        return cls(tuple(radii[k] for k in order), tuple(fractions[k] for k in order))
+
+    @classmethod
+    def lognormal(cls, median: float, sigma: float, n_species: int, width: float = 2.0) -> "SizeDistribution":
+        """A log-normal number distribution of radii (median `median` a1, standard deviation `sigma` of ln a)
+        discretised into n_species: ln a from ln median - width sigma to ln median + width sigma cut into
+        n_species equal intervals, each species the geometric centre of its interval, holding the particle
+        volume of its interval (its probability times a^3, normalised). n_species 1: the median alone."""
+        if not (median > 0 and sigma >= 0 and int(n_species) == n_species and n_species >= 1):
+            raise SizeDistributionError("size distribution: lognormal needs MEDIAN > 0, SIGMA >= 0 and N >= 1 species, "
+                                        "got %g %g %g" % (median, sigma, n_species))
+        n_species = int(n_species)
+        if n_species == 1 or sigma == 0:
+            return cls.of([median], [1.0])
+        from scipy.stats import norm
+        edges = np.linspace(-width, width, n_species + 1)
+        probability = np.diff(norm.cdf(edges))
+        radii = median * np.exp(sigma * 0.5 * (edges[1:] + edges[:-1]))
+        volume = probability * radii ** 3
+        return cls.of([float(r) for r in radii], [float(v) for v in volume / volume.sum()])
+
+    @property
+    def n_species(self) -> int:
+        return len(self.radii)
+
+    @property
+    def smallest(self) -> float:
+        return self.radii[0]
+
+    @property
+    def largest(self) -> float:
+        return self.radii[-1]
+
+    def describe(self) -> str:
+        return ", ".join("radius %g (%.4g of the volume)" % (r, f) for r, f in zip(self.radii, self.volume_fractions))
+
+    def counts_for_volume(self, volume: float, phi: float, a1: float = 1.0) -> list[int]:
+        """The sphere count of each species filling the fraction phi of `volume`: n_k = round(f_k phi volume /
+        (4/3 pi (a1 r_k)^3)) (each species' volume within half a sphere of its share)."""
+        return [int(round(f * phi * volume / (4.0 / 3.0 * math.pi * (a1 * r) ** 3)))
+                for r, f in zip(self.radii, self.volume_fractions)]
+
+    def counts_for_number(self, n: int) -> list[int]:
+        """n spheres split so that the species' volumes follow the fractions: n_k = round(n w_k / sum w), w_k =
+        f_k / r_k^3, for every species but the first, which takes the rest."""
+        if self == PAPER_SUSPENSION:
+            return list(counts(n, True))
+        w = np.array(self.volume_fractions) / np.array(self.radii) ** 3
+        rest = [int(round(n * wk / w.sum())) for wk in w[1:]]
+        return [n - sum(rest)] + rest
+
+    def volume_tolerance(self, volume: float, phi: float, a1: float = 1.0) -> list[float]:
+        """How far each species' share of the particle volume may be from its fraction after rounding the
+        counts (counts_for_volume): half a sphere of that species over the particle volume phi volume."""
+        return [0.5 * 4.0 / 3.0 * math.pi * (a1 * r) ** 3 / (phi * volume) for r in self.radii]
+
+
+PAPER_SUSPENSION = SizeDistribution((1.0, A2_OVER_A1), (0.5, 0.5))
+"""The paper's suspension (section 6): radii a1 = 1 and a2 = 1.4 a1 in equal volumes."""
+
+
 class Packing:
     """N spheres in the box [0, L)^3, periodic except along the axes in walls (planar walls at 0 and
-    L there): positions (N, 3), radii (N,), types (N,) (1 for a1, 2 for a2), box (L, L, L), phi
+    L there): positions (N, 3), radii (N,), types (N,) (1 for a1, 2 for a2; species k + 1 of a
+    SizeDistribution), box (L, L, L), phi
     (actual volume fraction), min_gap (smallest surface gap, pairs and walls, measured),
     min_wall_gap, and the generator's statistics in info."""
 
@@ -77,6 +193,17 @@ class Packing:
     @property
     def phi(self):
         return float(np.sum(4.0 / 3.0 * math.pi * self.radii ** 3) / np.prod(self.box))
+
+    def species(self):
+        """[(type, radius, count, share of the particle volume), ...] by type: what the packing holds of each
+        species (a type holds one radius)."""
+        volumes = 4.0 / 3.0 * math.pi * self.radii ** 3
+        total = float(np.sum(volumes))
+        out = []
+        for t in np.unique(self.types):
+            mask = self.types == t
+            out.append((int(t), float(self.radii[mask][0]), int(np.sum(mask)), float(np.sum(volumes[mask])) / total))
+        return out
 
     def spheres(self):
         """[(x, y, z, a), ...] as fdmsubgrid.deminput.write_dem_input takes them."""
@@ -340,17 +467,23 @@ def shake(x, radii, box, min_gap, sweeps, rng, max_step=None, walls=()):
 
 
 def random_packing(n, phi, bidisperse=False, seed=0, min_gap=1e-4, box_multiple=None, shake_sweeps=0,
-                   margin=0.5, a1=1.0, walls=()):
+                   margin=0.5, a1=1.0, walls=(), sizes=None):
     """A random packing of n spheres at volume fraction phi in a cube (see the module's docstring),
     periodic except along the axes in walls (e.g. walls=(1,): planar walls at y = 0 and y = L, for
     a Couette cell; every sphere at least min_gap from them too). min_gap: smallest surface gap
     required (units of length, a1 = 1 by default); box_multiple: round the box side to a multiple
     of this (a mesh size; phi changes slightly); shake_sweeps: hard-sphere Monte Carlo sweeps after
-    the relaxation. Deterministic for a seed."""
+    the relaxation; sizes: a SizeDistribution (n split by its volume fractions, species k of radius
+    a1 sizes.radii[k] as type k + 1) in place of bidisperse. Deterministic for a seed."""
     rng = np.random.default_rng(seed)
-    n1, n2 = counts(n, bidisperse)
-    radii = np.concatenate([np.full(n1, a1), np.full(n2, A2_OVER_A1 * a1)])
-    types = np.concatenate([np.ones(n1, dtype=int), 2 * np.ones(n2, dtype=int)])
+    if sizes is not None:
+        numbers = sizes.counts_for_number(n)
+        radii = np.concatenate([np.full(k, a1 * r) for k, r in zip(numbers, sizes.radii)])
+        types = np.concatenate([np.full(k, t + 1, dtype=int) for t, k in enumerate(numbers)])
+    else:
+        n1, n2 = counts(n, bidisperse)
+        radii = np.concatenate([np.full(n1, a1), np.full(n2, A2_OVER_A1 * a1)])
+        types = np.concatenate([np.ones(n1, dtype=int), 2 * np.ones(n2, dtype=int)])
     perm = rng.permutation(n)  # mix the two sizes in tag order
     radii, types = radii[perm], types[perm]
     side = box_side(radii, phi, box_multiple)
@@ -379,67 +512,74 @@ but not at random from an overlap relaxation): refused at once."""
 def bidisperse_counts_for_volume(volume, phi, a1=1.0):
     """(n1, n2) for the paper's suspension (section 6: a2 = 1.4 a1, equal volumes of both sizes)
     filling the fraction phi of `volume`: n_k = round(phi volume / 2 / (4/3 pi a_k^3))."""
-    half = 0.5 * phi * volume
-    n1 = int(round(half / (4.0 / 3.0 * math.pi * a1 ** 3)))
-    n2 = int(round(half / (4.0 / 3.0 * math.pi * (A2_OVER_A1 * a1) ** 3)))
+    n1, n2 = PAPER_SUSPENSION.counts_for_volume(volume, phi, a1)
     return n1, n2
 
 
 def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, wall_axis=1, a1=1.0,
-                    attempts=3, max_sweeps=3000, margin=0.5):
-    """A random bidisperse packing (a2 = 1.4 a1, equal volumes) in the box [0, L_x] x [0, L_y] x
-    [0, L_z] of any shape, periodic except along wall_axis (planar walls at 0 and L there), for
-    Couette and Poiseuille cells.
+                    attempts=3, max_sweeps=3000, margin=0.5, sizes=None):
+    """A random packing of the size distribution `sizes` (a SizeDistribution; default PAPER_SUSPENSION, the
+    paper's a2 = 1.4 a1 in equal volumes) in the box [0, L_x] x [0, L_y] x [0, L_z] of any shape, periodic
+    except along wall_axis (planar walls at 0 and L there), for Couette and Poiseuille cells. Species k (radius
+    a1 sizes.radii[k]) is atom type k + 1.
 
-    box: (L_x, L_y, L_z); phi: the target volume fraction (the counts from
-    bidisperse_counts_for_volume, the actual phi is Packing.phi) or n: the total count (split by
-    counts(n, True), e.g. the N_P of Table 8). min_gap: smallest surface gap between spheres,
-    wall_gap: between a sphere and a wall (default min_gap). Tries `attempts` seeds (seed, seed +
-    1, ...) of at most max_sweeps relaxation sweeps each.
+    box: (L_x, L_y, L_z); phi: the target volume fraction (the counts from sizes.counts_for_volume, each
+    species' volume within half of one of its spheres of its share; the actual phi is Packing.phi) or n: the
+    total count (split by sizes.counts_for_number, e.g. the N_P of Table 8). min_gap: smallest surface gap
+    between spheres, wall_gap: between a sphere and a wall (default min_gap). Tries `attempts` seeds (seed,
+    seed + 1, ...) of at most max_sweeps relaxation sweeps each.
 
-    Raises ValueError for a box side smaller than a particle (diameter 2 a2 plus the wall gaps
-    across the walls) or too small for the minimum image (a periodic side below 2 (2 a2 + gaps)),
-    and for phi >= RANDOM_CLOSE_PACKING; PackingError naming phi, the box and the attempts when
-    the relaxation fails at every seed."""
+    Raises ValueError for a box side smaller than a particle (the largest diameter plus the wall gaps
+    across the walls) or too small for the minimum image (a periodic side below 2 (2 a_max + gaps)),
+    for phi >= RANDOM_CLOSE_PACKING and for a species that gets no sphere in this box; PackingError naming
+    phi, the box and the attempts when the relaxation fails at every seed."""
+    sizes = PAPER_SUSPENSION if sizes is None else sizes
     box = np.asarray(box, dtype=float)
     if box.shape != (3,) or np.any(box <= 0):
         raise ValueError("packing: the box must be three positive lengths, got %s" % (box,))
     wall_gap = min_gap if wall_gap is None else float(wall_gap)
-    a2 = A2_OVER_A1 * a1
+    a_max = sizes.largest * a1
+    a_min = sizes.smallest * a1
     text = " x ".join("%g" % b for b in box)
-    if box[wall_axis] < 2 * a2 + 2 * wall_gap or np.any(box < 2 * a2):
-        raise ValueError("packing: the box %s a1 is smaller than a particle: the large spheres have a diameter of "
-                         "%g a1 (and need %g a1 between the walls)" % (text, 2 * a2, 2 * a2 + 2 * wall_gap))
+    if box[wall_axis] < 2 * a_max + 2 * wall_gap or np.any(box < 2 * a_max):
+        raise ValueError("packing: the box %s a1 is smaller than a particle: the largest spheres have a diameter of "
+                         "%g a1 (and need %g a1 between the walls)" % (text, 2 * a_max, 2 * a_max + 2 * wall_gap))
     periodic_sides = np.delete(box, wall_axis)
-    needed = 2 * (2 * a2 + (1 + margin) * min_gap + 0.3 * a1)
+    needed = 2 * (2 * a_max + (1 + margin) * min_gap + 0.3 * a_min)
     if np.any(periodic_sides <= needed):
         raise ValueError("packing: the periodic sides of the box %s a1 must exceed %.3g a1 (twice the neighbour "
-                         "cut-off of the large spheres) for the minimum image to be unique" % (text, needed))
+                         "cut-off of the largest spheres) for the minimum image to be unique" % (text, needed))
     if (phi is None) == (n is None):
         raise ValueError("packing: give either phi or n")
     if n is None:
         if not 0 < phi < RANDOM_CLOSE_PACKING:
             raise ValueError("packing: phi = %g is not in (0, %g): no random packing of spheres reaches it"
                              % (phi, RANDOM_CLOSE_PACKING))
-        n1, n2 = bidisperse_counts_for_volume(float(np.prod(box)), phi, a1)
+        numbers = sizes.counts_for_volume(float(np.prod(box)), phi, a1)
     else:
-        n1, n2 = counts(int(n), True)
-    radii = np.concatenate([np.full(n1, a1), np.full(n2, a2)])
-    types = np.concatenate([np.ones(n1, dtype=int), 2 * np.ones(n2, dtype=int)])
-    if n1 + n2 == 0:
+        numbers = sizes.counts_for_number(int(n))
+    radii = np.concatenate([np.full(k, a1 * r) for k, r in zip(numbers, sizes.radii)])
+    types = np.concatenate([np.full(k, t + 1, dtype=int) for t, k in enumerate(numbers)])
+    total = int(sum(numbers))
+    if total == 0:
         raise ValueError("packing: phi = %g in the box %s a1 makes no sphere" % (phi, text))
+    empty = [r for r, k in zip(sizes.radii, numbers) if k == 0]
+    if empty:
+        raise ValueError("packing: the species of radius %s a1 gets no sphere in the box %s a1 (its volume share "
+                         "is below half a sphere): enlarge the box, raise phi or its volume fraction, or leave it out"
+                         % (", ".join("%g" % r for r in empty), text))
     phi_actual = float(np.sum(4.0 / 3.0 * math.pi * radii ** 3) / np.prod(box))
     if phi_actual >= RANDOM_CLOSE_PACKING:
         raise ValueError("packing: %d spheres in the box %s a1 make phi = %.4g, not below %g: no random packing "
-                         "reaches it" % (n1 + n2, text, phi_actual, RANDOM_CLOSE_PACKING))
+                         "reaches it" % (total, text, phi_actual, RANDOM_CLOSE_PACKING))
     failures = []
     for attempt in range(attempts):
         rng = np.random.default_rng(seed + attempt)
-        perm = rng.permutation(n1 + n2)  # mix the two sizes in tag order
+        perm = rng.permutation(total)  # mix the sizes in tag order
         r, t = radii[perm], types[perm]
-        x = rng.uniform(0.0, 1.0, (n1 + n2, 3)) * box
+        x = rng.uniform(0.0, 1.0, (total, 3)) * box
         # centres where the sphere fits between the walls
-        x[:, wall_axis] = r + 2 * wall_gap + rng.uniform(0.0, 1.0, n1 + n2) * (box[wall_axis] - 2 * r - 4 * wall_gap)
+        x[:, wall_axis] = r + 2 * wall_gap + rng.uniform(0.0, 1.0, total) * (box[wall_axis] - 2 * r - 4 * wall_gap)
         try:
             sweeps = relax_overlaps(x, r, box, min_gap, margin=margin, max_iterations=max_sweeps,
                                     walls=(wall_axis,), wall_gap=wall_gap)
@@ -451,14 +591,16 @@ def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, 
         if p.min_gap >= min(min_gap, wall_gap) and p.min_wall_gap >= wall_gap:
             return p
         failures.append("seed %d: minimum gap %g, wall gap %g" % (seed + attempt, p.min_gap, p.min_wall_gap))
-    raise PackingError("packing: phi = %.4g (%d + %d spheres) could not be packed in the box %s a1 with walls on "
+    raise PackingError("packing: phi = %.4g (%s spheres) could not be packed in the box %s a1 with walls on "
                        "axis %s: %d attempts of %d relaxation sweeps failed (%s); lower phi or enlarge the box"
-                       % (phi_actual, n1, n2, text, "xyz"[wall_axis], attempts, max_sweeps, "; ".join(failures)))
+                       % (phi_actual, " + ".join("%d" % k for k in numbers), text, "xyz"[wall_axis], attempts,
+                          max_sweeps, "; ".join(failures)))
 
 
 def write_data(path, p, density=1000.0, scale=1.0, title=None):
     """LIGGGHTS data file (read_data; atom_style sphere: id type diameter density x y z), box
-    [0, L)^3, one atom type per radius (1: a1, 2: a2). scale multiplies every length."""
+    [0, L)^3, one atom type per radius (1: a1, 2: a2; species k + 1 of a SizeDistribution). scale
+    multiplies every length."""
     ntypes = int(p.types.max())
     with open(path, "w") as f:
         if title is None:  # LIGGGHTS reads a short first line only
@@ -502,6 +644,10 @@ def main(argv=None):
     ap.add_argument("n", type=int, help="number of spheres")
     ap.add_argument("phi", type=float, help="target volume fraction")
     ap.add_argument("--bidisperse", action="store_true", help="a1 = 1, a2 = 1.4, equal volumes (paper section 6)")
+    ap.add_argument("--radii", type=float, nargs="+", default=None, help="any size distribution: the radii [a1] "
+                    "(with --volume-fractions, equal volumes if left out), one atom type each")
+    ap.add_argument("--volume-fractions", type=float, nargs="+", default=None,
+                    help="with --radii: each species' share of the particle volume, summing to 1")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--min-gap", type=float, default=1e-4, help="smallest surface gap [a1] (default 1e-4)")
     ap.add_argument("--box-multiple", type=float, default=None, help="round the box side to a multiple of this")
@@ -510,8 +656,16 @@ def main(argv=None):
     ap.add_argument("--density", type=float, default=1000.0)
     ap.add_argument("-o", "--output", default=None, help="LIGGGHTS data file to write")
     args = ap.parse_args(argv)
+    sizes = None
+    if args.radii is not None or args.volume_fractions is not None:
+        if args.radii is None or args.bidisperse:
+            ap.error("--volume-fractions goes with --radii, and --radii replaces --bidisperse")
+        try:
+            sizes = SizeDistribution.of(args.radii, args.volume_fractions)
+        except SizeDistributionError as e:
+            ap.error(str(e))
     p = random_packing(args.n, args.phi, args.bidisperse, args.seed, args.min_gap, args.box_multiple, args.shake,
-                       walls=tuple("xyz".index(c) for c in args.walls))
+                       walls=tuple("xyz".index(c) for c in args.walls), sizes=sizes)
     print(p.summary())
     if args.output:
         write_data(args.output, p, args.density)

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from . import output, packing, profiles, rheology, sbm, shear, timeseries
+from . import output, packing, profiles, rheology, sbm, shear, suspension, timeseries
 
 CENTRAL_HALF_WIDTH = 1.0        # a1: the central slab of the migration series
 WALL_LAYER = sbm.LAYER_OVER_A1  # a1: the wall layers (the region the SBM leaves out)
@@ -132,13 +132,17 @@ MEASURED_FLUID_DT = 0.4
 DEFAULT_DT, DEFAULT_FLUID_EVERY = 0.05, 4
 
 
-def time_step_warning(dt: float, fluid_every: int) -> str | None:
+def time_step_warning(dt: float, fluid_every: int, sizes: packing.SizeDistribution | None = None) -> str | None:
     """A warning when the particle step dt or the fluid's step fluid_every*dt (in L_y/(2 U_c)) is beyond
-    what was measured good in the channel, else None."""
+    what was measured good in the channel (with the paper's radii 1 and 1.4; for other sizes the particle step
+    carried over by suspension.time_step_factor), else None."""
     beyond = []
-    if dt > MEASURED_PARTICLE_DT * (1 + 1e-9):
-        beyond.append("the particle step %g above %g (at 0.1 the bulk velocity of the dense core went 4 %% rms "
-                      "off, at 0.2 8 %%)" % (dt, MEASURED_PARTICLE_DT))
+    particle_dt = MEASURED_PARTICLE_DT if sizes is None else suspension.scaled_time_step(MEASURED_PARTICLE_DT, sizes)
+    if dt > particle_dt * (1 + 1e-9):
+        beyond.append("the particle step %g above %g (%sat 0.1 the bulk velocity of the dense core went 4 %% rms "
+                      "off, at 0.2 8 %%)" % (dt, particle_dt, "" if particle_dt == MEASURED_PARTICLE_DT else
+                                            "the measured %g times %.3g for these sizes, suspension.time_step_factor; "
+                                            % (MEASURED_PARTICLE_DT, suspension.time_step_factor(sizes))))
     if dt * fluid_every > MEASURED_FLUID_DT * (1 + 1e-9):
         beyond.append("the fluid's step %g (dt %g x fluid_every %d) above %g, not measured"
                       % (dt * fluid_every, dt, fluid_every, MEASURED_FLUID_DT))
@@ -288,8 +292,9 @@ def sbm_comparison(material: sbm.MaterialFunctions, snapshots: list, channel: pr
 
 
 def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None) -> tuple[dict, dict]:
-    """The results of a run (a flat dict, the keys of cases/poiseuille/results.json) and what the figure
-    needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions)."""
+    """The results of a run (a flat dict, the keys of cases/poiseuille/results.json; `species` one dict per
+    species, profiles.species_summary with its phi_center in the central band |y - mid| < a1 in place of
+    phi_core) and what the figure needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions)."""
     material = material or sbm.MaterialFunctions.maron_pierce_power_law()
     run = shear.read_run(run_dir)
     sc = scales(run)
@@ -323,6 +328,12 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
 
     coarse = profiles.average_profiles(kept, channel)
     fine = profiles.average_profiles(kept, channel, y=channel.planes(0.02), errors=False)
+    # each species alone: phi(y) on the same bins, its volume fraction in the central band |y - mid| < a1
+    species = profiles.species_profiles(kept, channel, edges=coarse.edges,
+                                        h_layer=0.5 * channel.width - CENTRAL_HALF_WIDTH)
+    species_rows = profiles.species_summary(species, float(np.prod(run.box)))
+    for row in species_rows:   # the band is the channel's centre, not a Couette core
+        row["phi_center"], row["phi_center_err"] = row.pop("phi_core"), row.pop("phi_core_err")
     balance = momentum_balance(run_dir, run.eta, sc, channel, kept, coarse, t0)
     model, sbm_phi_rms, sbm_u_rms, phi_region = sbm_comparison(material, kept, channel, sc, coarse, fine)
     phi_m = material.phi_m
@@ -352,8 +363,10 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
         n_a2=int(np.sum(pack.types == 2)), dt=run.dt / sc.time_unit, steps=int(len(inner)),
         steps_planned=run.steps_planned, inner_iterations_mean=float(inner.mean()),
         inner_iterations_max=int(inner.max()), unconverged_steps=int(np.sum(steps["converged"] == 0)),
-        wall_seconds=wall_seconds, ranks=ranks, core_seconds=wall_seconds * ranks, springs=dict(run.springs))
-    figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, times=times, phi_center=phi_center,
+        wall_seconds=wall_seconds, ranks=ranks, core_seconds=wall_seconds * ranks, springs=dict(run.springs),
+        species=species_rows, species_profile_y=coarse.y.tolist())
+    figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, species=species, times=times,
+                  phi_center=phi_center,
                   phi_walls=phi_walls, model=model, start=t0, phi_m=phi_m, **balance["figure"])
     return results, figure
 
@@ -379,6 +392,10 @@ def plot(path: str, fig: dict) -> str:
     a = ax[0, 0]
     a.plot(ys(fine.y), fine.phi, ":", color="0.5", lw=0.8, label="simulation (fine)")
     a.errorbar(ys(coarse.y), coarse.phi, yerr=coarse.phi_error, fmt="o", ms=4, capsize=2, label="simulation (bins a1)")
+    if len(fig.get("species") or []) > 1:
+        for sp in fig["species"]:
+            a.errorbar(ys(sp.average.y), sp.average.phi, yerr=sp.average.phi_error, fmt="--.", ms=3, lw=0.8,
+                       capsize=1, label="type %d (a %g)" % (sp.type, sp.radius))
     a.plot(model.y, model.phi, "-", color="C3", label="SBM (Eqs. 62-63)")
     a.axhline(fig["phi_m"], color="0.7", lw=0.5, label="phi_m")
     a.set_xlabel("y*"), a.set_ylabel("phi"), a.legend(fontsize=8), a.set_title("volume fraction")

@@ -560,13 +560,69 @@ def average_profiles(snapshots: Sequence[Snapshot], channel: Channel, *, y: Arra
                           start_time=float(chosen[0].time))
 
 
+@dataclass(frozen=True)
+class SpeciesProfile:
+    """One species (LIGGGHTS atom type) of a run alone: its radius and count, its time-averaged profiles
+    (ProfileAverage of its spheres only, on the bins of the whole suspension: the species' phi add up to
+    the total, bin by bin) and its volume fraction in the core (Eq. 50 restricted to the species, the core of
+    the whole suspension's H_layer), averaged over the same snapshots, with its standard error (None with
+    fewer than 2 timeseries.MIN_BLOCKS snapshots)."""
+
+    type: int
+    radius: float
+    n: int
+    average: ProfileAverage
+    phi_core: float
+    phi_core_error: float | None
+
+
+def species_profiles(snapshots: Sequence[Snapshot], channel: Channel, *, h_layer: float | None = None,
+                     edges: ArrayLike | None = None, start_time: float = -math.inf) -> list[SpeciesProfile]:
+    """The profiles of each species of the snapshots with time >= start_time (SpeciesProfile, by type): bins
+    `edges` (default: those of average_profiles for the whole suspension, a1 = the smallest radius of all),
+    H_layer default 5 a1 likewise. A type holding two radii is an error (one radius per species)."""
+    chosen = [s for s in snapshots if s.time >= start_time]
+    if not chosen:
+        raise ValueError("no snapshot at or after start_time = %g" % start_time)
+    first = chosen[0]
+    h = _h_layer(first, h_layer)
+    ee = channel.bin_edges(float(first.radii.min())) if edges is None else np.asarray(edges, dtype=float)
+    out = []
+    for t in np.unique(first.types):
+        mask = first.types == t
+        radii = np.unique(first.radii[mask])
+        if len(radii) != 1:
+            raise ValueError("atom type %d holds the radii %s: a species is one radius" % (t, radii.tolist()))
+        parts = [s.select(s.types == t) for s in chosen]
+        average = average_profiles(parts, channel, edges=ee)
+        core = np.array([core_values(part, channel, h).phi for part in parts])
+        error = (float(timeseries.block_average(core).error) if len(core) >= 2 * timeseries.MIN_BLOCKS else None)
+        out.append(SpeciesProfile(type=int(t), radius=float(radii[0]), n=int(np.sum(mask)), average=average,
+                                  phi_core=float(core.mean()), phi_core_error=error))
+    return out
+
+
+def species_summary(species: Sequence[SpeciesProfile], volume: float) -> list[dict]:
+    """The species of species_profiles as JSON-ready dicts: type, radius, n, phi_bulk (its spheres' volume over
+    the box `volume`), phi_core with phi_core_err, and its phi profile (phi_profile, phi_profile_err, on the bins
+    of the whole suspension's profile)."""
+    def listed(v: NDArray | None) -> list | None:
+        return None if v is None else [None if not np.isfinite(x) else float(x) for x in v]
+    return [dict(type=sp.type, radius=sp.radius, n=sp.n,
+                 phi_bulk=sp.n * 4.0 / 3.0 * math.pi * sp.radius ** 3 / volume,
+                 phi_core=sp.phi_core, phi_core_err=sp.phi_core_error,
+                 phi_profile=listed(sp.average.phi), phi_profile_err=listed(sp.average.phi_error))
+            for sp in species]
+
+
 # ---- plots -------------------------------------------------------------------------------------
 
 def plot_profiles(path: str, channel: Channel, coarse: ProfileAverage, fine: ProfileAverage | None = None,
-                  title: str | None = None) -> str:
+                  title: str | None = None, species: Sequence[SpeciesProfile] | None = None) -> str:
     """PNG of phi(y), u_p(y) (flow component) and the particle shear stresses Sigma^h_12,
     Sigma^c_12, Sigma^p_12 (1 = flow, 2 = wall-normal axis): the fine profile as a line, the
-    coarse bins as points with error bars (standard errors). Returns path. The fluid's own shear
+    coarse bins as points with error bars (standard errors); with species (species_profiles, more than
+    one), each species' phi and u_p in its bins too. Returns path. The fluid's own shear
     stress (eta times the local fluid shear rate) is not included: these are the particle
     contributions of Eq. 51."""
     from matplotlib.figure import Figure
@@ -590,6 +646,12 @@ def plot_profiles(path: str, channel: Channel, coarse: ProfileAverage, fine: Pro
                                  (coarse.sigma_c, coarse.sigma_c_error, "c", "^")):
         ax[2].errorbar(coarse.y, data[:, xy], yerr=None if error is None else error[:, xy], fmt=mk, ms=4,
                        capsize=2, label="bins, " + lab)
+    if species is not None and len(species) > 1:
+        for sp in species:
+            label = "type %d (a %g)" % (sp.type, sp.radius)
+            ax[0].errorbar(sp.average.y, sp.average.phi, yerr=sp.average.phi_error, fmt="--.", ms=3, lw=0.8,
+                           capsize=1, label=label)
+            ax[1].plot(sp.average.y, sp.average.u_p[:, f], "--.", ms=3, lw=0.8, label=label)
     names = (r"$\phi$", r"$u_{p,%s}$" % axes_name[f],
              r"$\Sigma_{%s%s}$ (particles)" % (axes_name[f], axes_name[channel.wall_axis]))
     for a, name in zip(ax, names):

@@ -12,9 +12,19 @@ case's results (the validation report, `table8.py`, the notebooks) reads them th
       "date":         "YYYY-MM-DD",
       "wall_seconds": 123.4,
       "scene":        {...},                       # the scene's parameters: the script's options
+      "calibration":  [{"table": "dem/resistance/data/subgrid_calibration.dat", "sha256": "9f2c..."}],
+                                                   # the sub-grid calibration table(s) the case's runs read
       "rows":         [ROW, ...],                  # what the case measured, beside its reference
       "data":         {...}                        # the case's own numbers (profiles, series, per run)
     }
+
+`calibration` lists each distinct table the runs behind the file started with, as fdmRun recorded it in
+each run folder (CASE/.fdmRun-calibration, fdmsubgrid.checkpoint.stamp): its path relative to the project
+and the SHA-256 of its bytes; {"table": null, "sha256": null} for runs that read no table (`model cutoff`
+or `lubrication no`); an empty list when no run folder is known (a case that runs no coupled solver, or a
+run older than the record). The runs are those this process started since the case began (fdmsubgrid.
+runner.run; write_results' `started`) and the folder named by the record's `run_dir` (a run analysed later). A file written before the key reads with an
+empty list.
 
 A ROW (`Row`) is one measured quantity in one configuration:
 
@@ -58,7 +68,8 @@ from . import files
 SHAPE = "fdmsubgrid.results/1"
 
 # the document's own keys, beside `data`
-DOCUMENT_KEYS = ("shape", "case", "command", "commit", "date", "wall_seconds", "scene", "rows", "data")
+DOCUMENT_KEYS = ("shape", "case", "command", "commit", "date", "wall_seconds", "scene", "calibration", "rows",
+                 "data")
 
 # options that say where a case writes, not what it computes: left out of `scene`
 NOT_SCENE = ("out", "workdir", "keep")
@@ -113,6 +124,7 @@ class Results:
     wall_seconds: Optional[float]
     scene: Dict[str, Any] = field(default_factory=dict)
     rows: List[Row] = field(default_factory=list)
+    calibration: List[Dict[str, Any]] = field(default_factory=list)   # the module docstring
     data: Dict[str, Any] = field(default_factory=dict)
     shape: Optional[str] = SHAPE       # None: a file written before this shape (its numbers in data, no rows)
 
@@ -162,6 +174,26 @@ def scene_of(options: Any, script: Optional[str] = None) -> Dict[str, Any]:
     return files.relative_paths(scene, start)
 
 
+def calibration_of_runs(run_dirs: Iterable[str], root: str, since: float = -math.inf) -> List[Dict[str, Any]]:
+    """The distinct sub-grid calibration tables the run folders started with (fdmRun's CASE/.fdmRun-calibration;
+    a folder without the record is left out) and those of the runs this process started at or after `since`
+    (fdmsubgrid.runner.calibrations_run), each {"table": path relative to root or None, "sha256": ...}."""
+    from . import checkpoint, runner
+    found: List[Dict[str, Any]] = []
+    identities = list(runner.calibrations_run(since))
+    for run_dir in run_dirs:
+        path = os.path.join(run_dir, checkpoint.CALIBRATION_STAMP)
+        if os.path.isfile(path):
+            with open(path) as f:
+                identities.append(json.load(f))
+    for identity in identities:
+        table = identity.get("table")
+        entry = dict(table=None if table is None else os.path.relpath(table, root), sha256=identity.get("sha256"))
+        if entry not in found:
+            found.append(entry)
+    return found
+
+
 def json_value(value: Any) -> Any:
     """json.dumps' fallback: numpy scalars and arrays as Python numbers and lists."""
     if hasattr(value, "tolist"):
@@ -178,7 +210,8 @@ def write_results(path: str, script: str, argv: Optional[Sequence[str]], options
     sys.argv[1:]), options: its parsed options (the scene), rows: what it measured against its
     references, or the case's function that makes them from data (a record it cannot read, e.g. of a
     partial run, then gives a file without rows and a line on stderr rather than no file), data: its
-    own record, started: time.time() at its start. The document's wall_seconds is
+    own record, started: time.time() at its start. The document's calibration: the tables its runs read
+    (calibration_of_runs; the module docstring). The document's wall_seconds is
     data's own where it has one (a suspension's run, analysed later), else the time since started.
     Returns data, stamped with wall_seconds and date as the document has them (what main() returns)."""
     # a record that carries its own wall time (a suspension run's, analysed later) keeps it
@@ -194,6 +227,8 @@ def write_results(path: str, script: str, argv: Optional[Sequence[str]], options
     document = dict(shape=SHAPE, case=os.path.splitext(os.path.basename(script))[0],
                     command=command_line(script, argv), commit=project_commit(os.path.dirname(os.path.abspath(script))),
                     date=date, wall_seconds=wall_seconds, scene=scene_of(options, script),
+                    calibration=calibration_of_runs([data["run_dir"]] if isinstance(data.get("run_dir"), str) else [],
+                                                    project_root(script), since=started),
                     rows=[asdict(row) for row in rows or []],
                     data={k: v for k, v in data.items() if k not in ("wall_seconds", "date")})
     files.write_json(path, document, default=json_value)
@@ -216,7 +251,8 @@ def from_document(document: Dict[str, Any]) -> Results:
         raise KeyError("a results file has unknown key(s) %s" % ", ".join(unknown))
     return Results(case=document["case"], command=document["command"], commit=document["commit"],
                    date=document["date"], wall_seconds=document["wall_seconds"], scene=document["scene"],
-                   rows=[Row.from_dict(r) for r in document["rows"]], data=document["data"], shape=SHAPE)
+                   rows=[Row.from_dict(r) for r in document["rows"]], data=document["data"], shape=SHAPE,
+                   calibration=list(document.get("calibration", [])))
 
 
 def read_results(path: str) -> Results:

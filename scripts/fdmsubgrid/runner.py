@@ -9,9 +9,31 @@ import time
 
 from .environment import program, run_environment
 
+# the sub-grid calibration tables the runs of this process started with (fdmRun's record in each folder) and
+# when each run started, for the results file (fdmsubgrid.results: its `calibration`)
+_CALIBRATIONS: list = []
+
+
+def calibrations_run(since: float = float("-inf")) -> list:
+    """{"table": absolute path or None, "sha256": ...} of every run this process started (run) at or after the
+    time `since` (time.time(); a case passes its own start, so that a notebook's earlier runs do not count), in
+    order."""
+    return [identity for started, identity in _CALIBRATIONS if started >= since]
+
+
+def _remember_calibration(case_dir: str, started: float) -> None:
+    import json
+    from .checkpoint import CALIBRATION_STAMP
+    path = os.path.join(case_dir, CALIBRATION_STAMP)
+    if os.path.isfile(path):
+        with open(path) as f:
+            _CALIBRATIONS.append((started, json.load(f)))
+
+
 def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     """Run fdmRun on case_dir; returns the wall time in seconds. Raises RuntimeError with the
-    end of fdmRun's report if the run fails."""
+    end of fdmRun's report if the run fails. Remembers the calibration table the run started with
+    (calibrations_run)."""
     cmd = [program("fdmRun"), "-f", str(np_fluid), "-d", str(np_dem)]
     if quiet:
         cmd.append("--quiet")
@@ -20,6 +42,7 @@ def run(case_dir, np_fluid=1, np_dem=1, quiet=True, extra=()):
     proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
                           env=run_environment())
     wall = time.time() - t0
+    _remember_calibration(case_dir, t0)
     if proc.returncode != 0:
         raise RuntimeError("fdmRun %s failed (exit %d):\n%s" % (case_dir, proc.returncode, proc.stdout[-4000:]))
     return wall

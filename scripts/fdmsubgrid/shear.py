@@ -161,8 +161,9 @@ def minimum_gaps(snapshots: list[profiles.Snapshot], box: np.ndarray) -> tuple[f
 
 def analyse(run: ShearRun, wall_seconds: float | None = None, ranks: int | None = None,
             h_layer: float = H_LAYER, from_strain: float | None = None) -> tuple[dict, list]:
-    """The results of a run (a flat dict: docs/profiles.md lists the keys) and what the figure needs
-    ([channel, coarse profiles, fine profiles, snapshots]). The steady part starts where the MSER
+    """The results of a run (a flat dict: docs/profiles.md lists the keys; `species` one dict per species,
+    profiles.species_summary, its phi profile on the bins `species_profile_y`) and what the figure needs
+    ([channel, coarse profiles, fine profiles, snapshots, species profiles]). The steady part starts where the MSER
     rule puts the end of the transient (docs/profiles.md), or at from_strain if given; the run time
     is the step records' (run_seconds) unless given."""
     rate = run.shear_rate
@@ -207,6 +208,8 @@ def analyse(run: ShearRun, wall_seconds: float | None = None, ranks: int | None 
             gap_errors.append(rheology.relative_difference(gap, float(tau[k])))
     avg = profiles.average_profiles(snapshots, channel, start_time=r.start_time)
     fine = profiles.average_profiles(snapshots, channel, y=channel.planes(0.02), start_time=r.start_time, errors=False)
+    # each species alone (atom type): phi(y) on the same bins, its core volume fraction over the same window
+    species = profiles.species_profiles(snapshots, channel, h_layer=h_layer, edges=avg.edges, start_time=r.start_time)
     pair_gap, wall_gap = minimum_gaps(snapshots, box)
     strain = float(steps["time"][-1] * rate)
     inner = steps["innerIterations"]
@@ -231,11 +234,12 @@ def analyse(run: ShearRun, wall_seconds: float | None = None, ranks: int | None 
         unconverged_steps=int(np.sum(steps["converged"] == 0)),
         min_pair_gap=pair_gap, min_wall_gap=wall_gap,
         mean_particle_velocity=np.mean([s.velocities.mean(axis=0) for s in snapshots], axis=0).tolist(),
-        snapshots=len(snapshots), springs=dict(run.springs))
+        snapshots=len(snapshots), springs=dict(run.springs),
+        species=profiles.species_summary(species, float(np.prod(box))), species_profile_y=avg.y.tolist())
     res.update(balance.as_dict())
     res.update(stress_gap_rel_error_max=float(np.max(gap_errors)) if gap_errors else float("nan"),
                stress_gap_snapshots=len(gap_errors))
-    return res, [channel, avg, fine, snapshots]
+    return res, [channel, avg, fine, snapshots, species]
 
 
 def figure_path(out: str) -> str:
@@ -279,7 +283,7 @@ def report(run: ShearRun, out: str, extra: dict | None = None, wall_seconds: flo
     """analyse() the run, write `out` (the JSON summary, with `extra`; `write(out, results)`: a case writes
     its results file in the shape of fdmsubgrid.results) and the profile figure beside it (figure_path),
     print the summary unless quiet; returns the results."""
-    results, (channel, avg, fine, _) = analyse(run, wall_seconds, ranks, h_layer, from_strain)
+    results, (channel, avg, fine, _, species) = analyse(run, wall_seconds, ranks, h_layer, from_strain)
     results.update(extra or {})
     # the position update's counts (fdmRun's log.dem, every session): too many limited targets mean too large a dt
     log_dem = os.path.join(run.run_dir, "log.dem")
@@ -289,7 +293,7 @@ def report(run: ShearRun, out: str, extra: dict | None = None, wall_seconds: flo
     if warning and not quiet:
         print(warning)
     figure = figure_path(out)
-    profiles.plot_profiles(figure, channel, avg, fine)
+    profiles.plot_profiles(figure, channel, avg, fine, species=species)
     results["figure"] = os.path.basename(figure)
     write(out, results)
     if not quiet:
@@ -299,9 +303,14 @@ def report(run: ShearRun, out: str, extra: dict | None = None, wall_seconds: flo
 
 
 def print_summary(results: dict) -> None:
-    """The table of a run's results and its stress balance, as fdmProfiles prints it."""
+    """The table of a run's results, its species and its stress balance, as fdmProfiles prints it."""
     for k in SUMMARY_KEYS:
         print("%-30s %s" % (k, results[k]))
+    for sp in results.get("species") or []:
+        error = sp["phi_core_err"]
+        print("species type %d (radius %g, %d spheres): phi_bulk %.4f, phi_core %.4f%s"
+              % (sp["type"], sp["radius"], sp["n"], sp["phi_bulk"], sp["phi_core"],
+                 "" if error is None else " +- %.2g" % error))
     print("stress balance (Eq. 51 core against the walls, from strain %g, %d steps):"
           % (results["stress_balance_from_strain"], results["stress_balance_steps"]))
     print("  core  eta gamma_core + Sigma^h_12 + Sigma^c_12 = %.4g +- %.2g" % (results["stress_core"],

@@ -2,14 +2,16 @@
 springs by the rules of docs/contact.md and the fluid and particle inputs of a run, shared by the
 Couette (cases/couette, section 6.1) and Poiseuille (cases/poiseuille, section 6.2) cases.
 
-Units: a1 = 1 m, eta = 1 Pa s. The suspension: spheres of radii a1 and a2 = 1.4 a1 in equal volumes
-(fdmsubgrid.packing.channel_packing), frictional contact with h_r = 5e-3 a1 and mu_s = 0.5 (pairs and
+Units: a1 = 1 m, eta = 1 Pa s. The suspension: by default the paper's spheres of radii a1 and a2 = 1.4 a1 in
+equal volumes, or any size distribution (packing.SizeDistribution: radii in units of a1 with their shares of
+the particle volume, one LIGGGHTS atom type per species; fdmsubgrid.packing.channel_packing), frictional contact with h_r = 5e-3 a1 and mu_s = 0.5 (pairs and
 walls), sub-grid lubrication for pairs and walls, stresslets on. The walls are normal to y, x and z
 periodic; each wall moves along x at its own speed, and a uniform pressure gradient may drive the flow.
 
 The contact springs (docs/contact.md, "A recipe"):
-  F_max = 6 pi a2^2 tau                              the design load: the Stokes drag scale of the large
-                                                     sphere under the suspension's shear stress tau
+  F_max = 6 pi a_max^2 tau                           the design load: the Stokes drag scale of the largest
+                                                     sphere (a2 = 1.4 a1 in the paper's suspension) under
+                                                     the suspension's shear stress tau
                                                      (Couette: eta gamma_dot_0 eta_MP(phi), the relative
                                                      viscosity from the paper's Maron-Pierce fit, Eq. 55;
                                                      Poiseuille: the wall shear stress |dP0/dx| L_y/2)
@@ -18,11 +20,17 @@ The contact springs (docs/contact.md, "A recipe"):
                                                      Coulomb's law at the end of the step (docs/contact.md
                                                      2c) hold at any k_t dt/zeta_t (docs/benchmarks.md,
                                                      "Coulomb's law at the end of the step")
-with zeta_n, zeta_t the normal and slip resistances of a free a1-a1 pair at the gap h_r/2 (Stokes drag
-plus the sub-grid block at this a1/Delta, fdmResistance).
+with zeta_n, zeta_t the normal and slip resistances of a free pair of the smallest spheres at the gap h_r/2
+(Stokes drag plus the sub-grid block at this a1/Delta, fdmResistance).
+
+The smallest sphere sets the mesh and the time step (check_resolution, time_step_factor): the mesh must
+resolve it (a_min/Delta at least MIN_A_OVER_DELTA, and a calibration for each of its pairs), and the
+measured time steps (couettescene.MEASURED_DT_LIMITS, poiseuille.MEASURED_PARTICLE_DT, all measured with
+the paper's suspension) carry over with the relaxation time zeta_n/k_n of its contacts.
 """
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 
@@ -30,6 +38,7 @@ from . import contactstability, deminput, foamcase, output, packing, rheology, t
 
 A1 = 1.0
 A2 = packing.A2_OVER_A1 * A1
+PAPER_SIZES = packing.PAPER_SUSPENSION   # radii a1 and a2 = 1.4 a1 in equal volumes (section 6)
 ETA = 1.0
 ROUGHNESS = 5e-3 * A1         # h_r (section 6)
 FRICTION = 0.5                # mu_s (section 6)
@@ -63,7 +72,7 @@ class Springs:
 
     def describe(self, dt: float) -> str:
         return ("contact springs (docs/contact.md recipe): design load F_max = %.4g N, kn = 2 F_max/h_r = %.4g N/m, "
-                "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a1-a1 pair at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
+                "kt = %.4g N/m, mu_s = %g, h_r = %g a1; a pair of the smallest spheres at h_r/2: zeta_n = %.4g, zeta_t = %.4g N s/m; "
                 "explicit springs would need dt below (ab2) %.4g normal, %.4g tangential (the springs are implicit, "
                 "with Coulomb's law at the end of the step), dt = %g is %.2f of the smaller"
                 % (self.design_load, self.kn, self.kt, self.mu_s, self.h_r / A1, self.zeta_n, self.zeta_t,
@@ -71,12 +80,59 @@ class Springs:
                    dt / min(self.dt_limit_normal, self.dt_limit_tangential)))
 
 
+MIN_A_OVER_DELTA = 2.0
+"""The fewest mesh cells per radius of any sphere in a scene: the sub-grid model was measured for a/Delta 2 ... 20
+(docs/dem.md, "a/Delta"); below, the fictitious domain no longer resolves the sphere (the calibrated model
+needs more: the table's a/Delta, deminput.uncalibrated)."""
+
+
+def check_resolution(sizes: packing.SizeDistribution, a_over_delta: float) -> None:
+    """The smallest sphere sets the mesh: SizeDistributionError naming the radius unless every radius is at least
+    MIN_A_OVER_DELTA cells at a1/Delta = a_over_delta (Delta = a1/a_over_delta, a1 = 1 the unit of length)."""
+    cells = sizes.smallest * A1 * a_over_delta / A1
+    if cells < MIN_A_OVER_DELTA * (1 - 1e-9):
+        raise packing.SizeDistributionError(
+            "the radius %g a1 is %.3g mesh cells at a1/Delta %g, below the %g cells a sphere needs (docs/dem.md, "
+            "'a/Delta'): the smallest sphere sets the mesh: --a-over-delta %.3g or more"
+            % (sizes.smallest, cells, a_over_delta, MIN_A_OVER_DELTA, MIN_A_OVER_DELTA / sizes.smallest))
+
+
+def time_step_factor(sizes: packing.SizeDistribution) -> float:
+    """What the time steps measured with the paper's suspension (radii 1 and 1.4) become for `sizes`: the ratio of
+    the relaxation time zeta_n/k_n of the scene's stiffest contact to the measured one, at most 1.
+
+    Why: the particle step is limited by how fast a loaded contact closes against the lubrication of its gap
+    (the position update's gap targets, couettescene.MEASURED_DT_LIMITS). The smallest pair resists least
+    (zeta_n grows as a_min^2 at a given gap) and the springs are designed for the largest sphere's load (k_n =
+    2 F_max/h_r grows as a_max^2), so the time scale goes as (a_min/a_max)^2. A scene whose ratio a_max/a_min
+    is above 1.4 gets the measured steps shortened by this factor; one below keeps them (larger steps were not
+    measured). The paper's suspension: exactly 1."""
+    measured = (PAPER_SIZES.smallest / PAPER_SIZES.largest) ** 2
+    scene = (sizes.smallest / sizes.largest) ** 2
+    return min(1.0, scene / measured)
+
+
+def scaled_time_step(dt: float, sizes: packing.SizeDistribution) -> float:
+    """A measured time step dt carried to `sizes` (time_step_factor), rounded down to two digits (dt itself for
+    a factor of 1)."""
+    factor = time_step_factor(sizes)
+    if factor >= 1.0:
+        return dt
+    scaled = dt * factor
+    unit = 10.0 ** (math.floor(math.log10(scaled)) - 1)
+    return round(math.floor(scaled / unit * (1 + 1e-12)) * unit, 12)
+
+
 def choose_springs(stress: float, dt: float, delta: float, kn: float | None = None,
-                   kt: float | None = None) -> Springs:
-    """The springs by the rule of the module docstring for the shear stress `stress` [Pa], unless
-    given (fdmsubgrid.contactstability: the design load, the recipe's k_n, the explicit springs' limits)."""
-    design_load = contactstability.design_load(A2, stress)
-    zeta_n, zeta_t = theory.pair_mode_resistances(A1, A1, 0.5 * ROUGHNESS, delta, ETA)
+                   kt: float | None = None, sizes: packing.SizeDistribution | None = None) -> Springs:
+    """The springs by the rule of the module docstring for the shear stress `stress` [Pa] and the size distribution
+    `sizes` (default the paper's), unless given (fdmsubgrid.contactstability: the design load, the recipe's k_n,
+    the explicit springs' limits): the design load of the largest sphere, the resistances of a pair of the
+    smallest."""
+    sizes = PAPER_SIZES if sizes is None else sizes
+    design_load = contactstability.design_load(sizes.largest * A1, stress)
+    a_min = sizes.smallest * A1
+    zeta_n, zeta_t = theory.pair_mode_resistances(a_min, a_min, 0.5 * ROUGHNESS, delta, ETA)
     kn = contactstability.normal_stiffness(design_load, ROUGHNESS) if kn is None else kn
     # k_t independent of dt: until the return mapping of docs/contact.md 2c the rule was
     # min(k_n, 0.5 zeta_t/dt), which softened friction as dt grew (eta_s at phi 0.47 fell with dt)
