@@ -244,7 +244,7 @@ def couette_rows(path: str) -> list[dict]:
                             eta_s_err=float(row["eta_s_err"]), sigma22=float(row["Sigma_c_hat"][1]),
                             sigma22_err=float(row["Sigma_c_hat_err"][1]), source=where))
         except (KeyError, IndexError, TypeError, AttributeError) as e:
-            raise SBMError("%s: not a Couette results row (needs phi_core, eta_s, eta_s_err, Sigma_c_hat, "
+            raise SBMError("%s: not a Couette results file or row (needs phi_core, eta_s, eta_s_err, Sigma_c_hat, "
                            "Sigma_c_hat_err): missing %s" % (where, e)) from None
     return out
 
