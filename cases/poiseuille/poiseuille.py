@@ -78,8 +78,8 @@ def main(argv: list[str] | None = None) -> dict:
                    help="the SBM drawn beside the first with the material functions fitted to these Couette rows "
                         "(default: this project's Table 8, docs/data/validation_table8_fluidEvery.json: the "
                         "Maron-Pierce eta_s with its phi_m, Sigma_hat^c_22 a power law; 'none': not drawn)")
-    p.add_argument("--from-time", type=float, default=None, help="average from this time on (default: the end of "
-                   "the migration transient by the MSER rule)")
+    p.add_argument("--from-time", type=float, default=None, help="average from this time on (default: the steady "
+                   "window found from the data, 3 migration times on, fdmsubgrid.poiseuille.steady_window)")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None, help="analyse this run folder as it stands")
     p.add_argument("--compare", metavar="RUN_DIR", default=None, help="with --analyse: the rms and largest "

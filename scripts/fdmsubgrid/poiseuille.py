@@ -8,9 +8,12 @@ y* = (y - L_y/2)/L_y (Eq. 61).
 
 What `analyse` measures (docs/profiles.md, "Pressure-driven flow"):
 - the migration transient: phi in the central slab |y*| < a1/L_y (2 a1 wide) and in the wall layers
-  (within 2.5 a1 of either wall) at every particle snapshot, and the time scale tau of an exponential
-  approach fitted to the central series (migration_time); the steady part starts where the MSER rule
-  puts the end of the central series' transient (fdmsubgrid.timeseries), or at a given time;
+  (within 2.5 a1 of either wall) at every particle snapshot; the steady window found from the data
+  (steady_window: the time constant tau of the central series' exponential approach, fit_approach, the
+  window from 3 tau on, the series' trend over it flat within 2 error bars), or from a given time;
+- the central plateau (central_plateau: the width above phi 0.6 in bins of a1, with block errors), the
+  stresses across the channel (stress_profiles, contact_normal_stress) and the SBM with the material
+  functions fitted to this project's Table 8 rows (steady_results, sbm_differences);
 - the steady profiles, time-averaged with block-averaging errors: fine (planes every 0.02 a1) and coarse
   (bins of width a1, Eq. 60) phi(y) (Eq. 49) and u_p*(y) (Eqs. 59, 61), Sigma^c_yy(y) and Sigma_xy(y);
 - the momentum balance: in steady Stokes flow the total shear stress is exactly Sigma_xy(y) =
