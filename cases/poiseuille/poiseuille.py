@@ -23,6 +23,7 @@ L_y = 40 a1 (docs/validation.md, "Pressure-driven flow").
 """
 
 import argparse
+import math
 import os
 import shutil
 import sys
@@ -226,13 +227,23 @@ def compare(run_a: str, run_b: str, material=None, from_time=None, table8=None) 
     return out
 
 
-# The run's measures the report shows (rows of fdmsubgrid.results): key, quantity, a fraction shown in per cent
-MEASURES = (("phi_center", "φ at the centre plane", False),
-            ("u_center_star", "u_p*/(2 U_c) at the centre plane", False),
-            ("sbm_phi_rms_diff", "φ profile against the SBM (rms difference)", False),
-            ("sbm_u_rms_diff", "u_p* profile against the SBM (rms difference)", False),
-            ("shear_stress_linearity_rel_error", "shear stress against the linear profile (largest)", True),
-            ("wall_force_balance_rel_error", "force balance on the walls", True))
+# The run's measures the report shows (rows of fdmsubgrid.results): key, quantity, a fraction shown in per cent,
+# the key of its error bar (or None) and the paper's value
+MEASURES = (("phi_center", "φ at the centre plane", False, "phi_center_err", "Figs. 23–25"),
+            ("u_center_star", "u_p*/(2 U_c) at the centre plane", False, None, "Figs. 23–25"),
+            ("migration_time", "migration time (φ_center's exponential approach)", False, "migration_time_err", "—"),
+            ("plateau_width_over_a1", "central plateau above φ 0.6, width / a1", False, "plateau_width_over_a1_err",
+             "about 6 (Fig. 23)"),
+            ("plateau_phi", "central plateau's φ", False, "plateau_phi_err", "about 0.63 (Fig. 23)"),
+            ("sbm_phi_rms_diff", "φ profile against the SBM (rms difference)", False, None, "Figs. 23–25"),
+            ("sbm_u_rms_diff", "u_p* profile against the SBM (rms difference)", False, None, "Figs. 23–25"),
+            ("sbm_table8_phi_rms_diff", "φ profile against the SBM with the Table 8 rows (rms difference)", False,
+             None, "—"),
+            ("shear_stress_linearity_rel_error", "shear stress against the walls' line (largest, core)", True, None,
+             "—"),
+            ("shear_stress_exact_line_rel_error", "shear stress against (dP0/dx)(y − L_y/2) (largest, core)", True,
+             None, "—"),
+            ("wall_force_balance_rel_error", "force balance on the walls", True, None, "—"))
 
 
 # the steady state's keys the report prints (poiseuille.steady_results)
@@ -246,12 +257,18 @@ STEADY_KEYS = ("steady_detected", "steady_reason", "steady_from_mser", "migratio
 
 
 def validation_rows(results: dict) -> List[Row]:
-    """The run's measures (MEASURES) in one configuration; no tabulated reference (the paper's Figs. 23-25
-    are plots): the SBM's profiles are the comparison."""
-    config = "φ_bulk %g, channel %s a1, dt %g, averaged from t %g" % (
-        results["phi_bulk"], " × ".join("%g" % v for v in results["L"]), results["dt"], results["steady_from"])
-    return [Row(quantity, config, results[key], paper="Figs. 23–25", percent=percent)
-            for key, quantity, percent in MEASURES if results.get(key) is not None]
+    """The run's measures (MEASURES) in one configuration, with their error bars where they have one; no
+    tabulated reference (the paper's Figs. 23-25 are plots): the SBM's profiles are the comparison."""
+    config = "φ_bulk %g, channel %s a1, dt %g, averaged from t %g%s" % (
+        results["phi_bulk"], " × ".join("%g" % v for v in results["L"]), results["dt"], results["steady_from"],
+        "" if results.get("steady_detected", True) else " (not steady)")
+
+    def finite(v):
+        return v if v is not None and math.isfinite(v) else None
+
+    return [Row(quantity, config, finite(results[key]), paper=paper, percent=percent,
+                spread=finite(results.get(err)) if err else None)
+            for key, quantity, percent, err, paper in MEASURES if finite(results.get(key)) is not None]
 
 
 def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional[Sequence[str]] = None,
