@@ -79,6 +79,8 @@ def main(argv: list[str] | None = None) -> dict:
                    help="the SBM drawn beside the first with the material functions fitted to these Couette rows "
                         "(default: this project's Table 8, docs/data/validation_table8_fluidEvery.json: the "
                         "Maron-Pierce eta_s with its phi_m, Sigma_hat^c_22 a power law; 'none': not drawn)")
+    p.add_argument("--plateau-threshold", type=float, default=poiseuille.PLATEAU_THRESHOLD, metavar="PHI",
+                   help="the central plateau is where phi (bins of a1) is at least this (the paper's is about 0.63)")
     p.add_argument("--from-time", type=float, default=None, help="average from this time on (default: the steady "
                    "window found from the data, 3 migration times on, fdmsubgrid.poiseuille.steady_window)")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
@@ -120,7 +122,8 @@ def main(argv: list[str] | None = None) -> dict:
     if args.analyse and args.compare:
         return compare(args.analyse, args.compare, material, args.from_time, table8)
     if args.analyse:
-        return report(args.analyse, args.out, material, args.from_time, argv, args, started, table8)
+        return report(args.analyse, args.out, material, args.from_time, argv, args, started, table8,
+                      args.plateau_threshold)
 
     if args.paper:
         args.size = list(PAPER_SIZE)
@@ -185,7 +188,8 @@ def main(argv: list[str] | None = None) -> dict:
         return dict(run_dir=run_dir, **scene)
 
     case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
-    results = report(run_dir, args.out, material, args.from_time, argv, args, started, table8)
+    results = report(run_dir, args.out, material, args.from_time, argv, args, started, table8,
+                     args.plateau_threshold)
     if not args.keep:
         case.delete_fields(run_dir)
     return results
@@ -232,7 +236,7 @@ def compare(run_a: str, run_b: str, material=None, from_time=None, table8=None) 
 MEASURES = (("phi_center", "φ at the centre plane", False, "phi_center_err", "Figs. 23–25"),
             ("u_center_star", "u_p*/(2 U_c) at the centre plane", False, None, "Figs. 23–25"),
             ("migration_time", "migration time (φ_center's exponential approach)", False, "migration_time_err", "—"),
-            ("plateau_width_over_a1", "central plateau above φ 0.6, width / a1", False, "plateau_width_over_a1_err",
+            ("plateau_width_over_a1", "central plateau's width / a1 (φ above plateau_threshold, 0.6)", False, "plateau_width_over_a1_err",
              "about 6 (Fig. 23)"),
             ("plateau_phi", "central plateau's φ", False, "plateau_phi_err", "about 0.63 (Fig. 23)"),
             ("sbm_phi_rms_diff", "φ profile against the SBM (rms difference)", False, None, "Figs. 23–25"),
@@ -272,11 +276,12 @@ def validation_rows(results: dict) -> List[Row]:
 
 
 def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional[Sequence[str]] = None,
-           options: Any = None, started: Optional[float] = None, table8=None) -> dict:
+           options: Any = None, started: Optional[float] = None, table8=None,
+           plateau_threshold: float = poiseuille.PLATEAU_THRESHOLD) -> dict:
     """Analyse a run folder (fdmsubgrid.poiseuille.analyse), write `out` (fdmsubgrid.results: argv and
     options are the command's) and the figure beside it."""
     started = time.time() if started is None else started
-    results, fig = poiseuille.analyse(run_dir, material, from_time, table8)
+    results, fig = poiseuille.analyse(run_dir, material, from_time, table8, plateau_threshold)
     results.update(case="poiseuille", run=os.path.basename(os.path.normpath(run_dir)), run_dir=os.path.abspath(run_dir))
     figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_poiseuille.png")
     poiseuille.plot(figure, fig)

@@ -274,10 +274,13 @@ def sbm_comparison(material: sbm.MaterialFunctions, snapshots: list, channel: pr
 
 
 def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None,
-            table8: sbm.MaterialFunctions | None = None) -> tuple[dict, dict]:
+            table8: sbm.MaterialFunctions | None = None, plateau_threshold: float | None = None
+            ) -> tuple[dict, dict]:
     """The results of a run (a flat dict, the keys of cases/poiseuille/results.json) and what the figure
     needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions); table8: a
-    second set drawn beside them, fitted to this project's Table 8 rows (sbm.from_couette_results), or None."""
+    second set drawn beside them, fitted to this project's Table 8 rows (sbm.from_couette_results), or None;
+    plateau_threshold: the phi above which the central plateau is measured (central_plateau; default
+    PLATEAU_THRESHOLD, 0.6)."""
     material = material or sbm.MaterialFunctions.maron_pierce_power_law()
     run = shear.read_run(run_dir)
     sc = scales(run)
@@ -343,9 +346,13 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
         wall_seconds=wall_seconds, ranks=ranks, core_seconds=wall_seconds * ranks, springs=dict(run.springs))
     figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, times=times, phi_center=phi_center,
                   phi_walls=phi_walls, model=model, start=t0, phi_m=phi_m, **balance["figure"])
-    steady = steady_results(window, window_trend, from_time, central_plateau(kept, channel, coarse), balance,
+    plateau = central_plateau(kept, channel, coarse, PLATEAU_THRESHOLD if plateau_threshold is None else plateau_threshold)
+    steady = steady_results(window, window_trend, from_time, plateau, balance,
                             material, table8, kept, channel, sc, coarse, fine, float(pack.radii.min()))
-    results.update(steady["results"])
+    results.update(steady["results"], plateau_shear_rate=plateau_shear_rate(fine, plateau, sc),
+                   # the series the window was found from (to refit, or to set runs of several sizes side by side)
+                   series=dict(time=times.round(6).tolist(), phi_center=phi_center.round(6).tolist(),
+                               phi_wall_layer=phi_walls.round(6).tolist(), rms_change=rms_change.round(6).tolist()))
     figure.update(rms_change=rms_change, window=window, **steady["figure"])
     return results, figure
 
@@ -798,3 +805,16 @@ def contact_normal_stress(coarse: profiles.ProfileAverage, channel: profiles.Cha
     mean = float(np.sum(w * s) / np.sum(w))
     return dict(contact_normal_stress_core=mean, contact_normal_stress_core_err=float(1 / np.sqrt(np.sum(w))),
                 contact_normal_stress_core_chi2=float(np.sum(w * (s - mean) ** 2) / (len(s) - 1)))
+
+
+def plateau_shear_rate(fine: profiles.ProfileAverage, plateau: Plateau, sc: Scales) -> float:
+    """The mean |du_p*/dy*| (in 2 U_c/L_y) over the central plateau, from the fine profile of u_p: the
+    paper's 7e-4 against 0.2 at the walls (section 6.2). nan without a plateau."""
+    if not plateau.width > 0:
+        return math.nan
+    inside = (fine.y >= plateau.y_lo) & (fine.y <= plateau.y_hi)
+    u = fine.u_p[inside, 0] / (2 * sc.u_c)
+    y = fine.y[inside] / sc.width
+    if inside.sum() < 2:
+        return math.nan
+    return float(np.mean(np.abs(np.diff(u) / np.diff(y))))
