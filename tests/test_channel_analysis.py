@@ -204,3 +204,21 @@ def test_contact_normal_stress_uniformity():
     slope = -0.8 + 0.1 * (np.arange(12) - 5.5)
     assert poiseuille.contact_normal_stress(average_of(edges, np.ones(12), np.ones(12), slope, 0.05), ch,
                                             sc)["contact_normal_stress_core_chi2"] > 10
+
+
+def test_steady_window_of_the_shipped_small_channel_run():
+    """The real series of the L_y 12 a1 channel at its defaults to t = 300 (750 snapshots, shipped in its
+    results): the window refitted from them is the one recorded, and says what docs/validation.md says: tau
+    about 120 with an error bar near 40 % of it, 3 tau beyond the run (not steady), MSER's start in the stall
+    before the rise of t 180-230, and the rise still within 2 error bars of flat over the second half."""
+    from fdmsubgrid import results
+    path = os.path.join(PROJECT, "docs", "data", "validation_poiseuille_L12_fluidEvery4.json")
+    record = results.read_data(path)
+    s = record["series"]
+    w = poiseuille.steady_window(np.array(s["time"]), np.array(s["phi_center"]), np.array(s["rms_change"]))
+    assert w.center.tau == pytest.approx(record["migration_time"], rel=1e-4)
+    assert w.center.tau_err == pytest.approx(record["migration_time_err"], rel=1e-3)
+    assert 80 < w.center.tau < 170 and 0.2 < w.center.tau_err / w.center.tau < 0.6
+    assert not w.steady and "run longer" in w.reason and w.start_time == pytest.approx(150.4)
+    assert 120 < w.mser_start_time < 180
+    assert 0 < w.trend.slope < poiseuille.SLOPE_SIGMAS * w.trend.slope_err
