@@ -26,6 +26,7 @@ L_y = 40 a1 (docs/validation.md, "Pressure-driven flow").
 """
 
 import argparse
+import math
 import os
 import shutil
 import sys
@@ -38,6 +39,9 @@ from fdmsubgrid import case, couettescene, packing, poiseuille, sbm, suspension
 from fdmsubgrid.results import Row, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+PROJECT = os.path.dirname(os.path.dirname(HERE))
+# this project's Table 8 rows (docs/validation.md, "Suspensions in Couette flow"): the SBM's second material functions
+TABLE8 = os.path.join(PROJECT, "docs", "data", "validation_table8_fluidEvery.json")
 
 PAPER_SIZE = (40.0, 40.0, 20.0)       # (L_x, L_y, L_z)/a1, section 6.2
 PAPER_DT = 1e-3                       # L_y/(2 U_c)
@@ -75,8 +79,14 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--couette", nargs="+", default=None, metavar="RESULTS_JSON",
                    help="fit the SBM's material functions from these Couette results (default: the paper's "
                         "Maron-Pierce viscosity and Sigma_hat_22 = -0.8 (phi/phi_m)^2, fdmsubgrid.sbm)")
-    p.add_argument("--from-time", type=float, default=None, help="average from this time on (default: the end of "
-                   "the migration transient by the MSER rule)")
+    p.add_argument("--table8", nargs="+", default=[TABLE8], metavar="RESULTS_JSON",
+                   help="the SBM drawn beside the first with the material functions fitted to these Couette rows "
+                        "(default: this project's Table 8, docs/data/validation_table8_fluidEvery.json: the "
+                        "Maron-Pierce eta_s with its phi_m, Sigma_hat^c_22 a power law; 'none': not drawn)")
+    p.add_argument("--plateau-threshold", type=float, default=poiseuille.PLATEAU_THRESHOLD, metavar="PHI",
+                   help="the central plateau is where phi (bins of a1) is at least this (the paper's is about 0.63)")
+    p.add_argument("--from-time", type=float, default=None, help="average from this time on (default: the steady "
+                   "window found from the data, 3 migration times on, fdmsubgrid.poiseuille.steady_window)")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None, help="analyse this run folder as it stands")
     p.add_argument("--compare", metavar="RUN_DIR", default=None, help="with --analyse: the rms and largest "
@@ -99,6 +109,7 @@ def main(argv: list[str] | None = None) -> dict:
     args = p.parse_args(argv)
     started = time.time()
     material = sbm.from_couette_results(args.couette) if args.couette else None
+    table8 = table8_material(args.table8)
 
     if args.budget:
         try:
@@ -114,9 +125,10 @@ def main(argv: list[str] | None = None) -> dict:
                   b["first_step_seconds"], b["predicted_hours"]))
         return b
     if args.analyse and args.compare:
-        return compare(args.analyse, args.compare, material, args.from_time)
+        return compare(args.analyse, args.compare, material, args.from_time, table8)
     if args.analyse:
-        return report(args.analyse, args.out, material, args.from_time, argv, args, started)
+        return report(args.analyse, args.out, material, args.from_time, argv, args, started, table8,
+                      args.plateau_threshold)
 
     if args.paper:
         args.size = list(PAPER_SIZE)
@@ -199,20 +211,31 @@ def main(argv: list[str] | None = None) -> dict:
         return dict(run_dir=run_dir, **scene)
 
     case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
-    results = report(run_dir, args.out, material, args.from_time, argv, args, started)
+    results = report(run_dir, args.out, material, args.from_time, argv, args, started, table8,
+                     args.plateau_threshold)
     if not args.keep:
         case.delete_fields(run_dir)
     return results
 
 
-def compare(run_a: str, run_b: str, material=None, from_time=None) -> dict:
+def table8_material(paths: Sequence[str]):
+    """The SBM's material functions fitted to Couette rows (sbm.from_couette_results), the files named
+    relative to the project; None for 'none'."""
+    if [p.lower() for p in paths] == ["none"]:
+        return None
+    material = sbm.from_couette_results(paths)
+    material.describe["fitted_from"] = [os.path.relpath(os.path.abspath(p), PROJECT) for p in paths]
+    return material
+
+
+def compare(run_a: str, run_b: str, material=None, from_time=None, table8=None) -> dict:
     """The differences of the coarse (bins of a1) phi and u_p* profiles of two runs of one channel,
     averaged over the same window: from from_time, else from the later of their steady starts."""
-    analysed = [poiseuille.analyse(r, material, from_time) for r in (run_a, run_b)]
+    analysed = [poiseuille.analyse(r, material, from_time, table8) for r in (run_a, run_b)]
     if from_time is None:
         # the later steady start; the run that set it is already averaged from there
         from_time = max(res["steady_from"] for res, _ in analysed)
-        analysed = [a if a[0]["steady_from"] == from_time else poiseuille.analyse(r, material, from_time)
+        analysed = [a if a[0]["steady_from"] == from_time else poiseuille.analyse(r, material, from_time, table8)
                     for a, r in zip(analysed, (run_a, run_b))]
     (ra, fa), (rb, fb) = analysed
     if len(fa["coarse"].y) != len(fb["coarse"].y):
@@ -231,30 +254,57 @@ def compare(run_a: str, run_b: str, material=None, from_time=None) -> dict:
     return out
 
 
-# The run's measures the report shows (rows of fdmsubgrid.results): key, quantity, a fraction shown in per cent
-MEASURES = (("phi_center", "φ at the centre plane", False),
-            ("u_center_star", "u_p*/(2 U_c) at the centre plane", False),
-            ("sbm_phi_rms_diff", "φ profile against the SBM (rms difference)", False),
-            ("sbm_u_rms_diff", "u_p* profile against the SBM (rms difference)", False),
-            ("shear_stress_linearity_rel_error", "shear stress against the linear profile (largest)", True),
-            ("wall_force_balance_rel_error", "force balance on the walls", True))
+# The run's measures the report shows (rows of fdmsubgrid.results): key, quantity, a fraction shown in per cent,
+# the key of its error bar (or None) and the paper's value
+MEASURES = (("phi_center", "φ at the centre plane", False, "phi_center_err", "Figs. 23–25"),
+            ("u_center_star", "u_p*/(2 U_c) at the centre plane", False, None, "Figs. 23–25"),
+            ("migration_time", "migration time (φ_center's exponential approach)", False, "migration_time_err", "—"),
+            ("plateau_width_over_a1", "central plateau's width / a1 (φ above plateau_threshold, 0.6)", False, "plateau_width_over_a1_err",
+             "about 6 (Fig. 23)"),
+            ("plateau_phi", "central plateau's φ", False, "plateau_phi_err", "about 0.63 (Fig. 23)"),
+            ("sbm_phi_rms_diff", "φ profile against the SBM (rms difference)", False, None, "Figs. 23–25"),
+            ("sbm_u_rms_diff", "u_p* profile against the SBM (rms difference)", False, None, "Figs. 23–25"),
+            ("sbm_table8_phi_rms_diff", "φ profile against the SBM with the Table 8 rows (rms difference)", False,
+             None, "—"),
+            ("shear_stress_linearity_rel_error", "shear stress against the walls' line (largest, core)", True, None,
+             "—"),
+            ("shear_stress_exact_line_rel_error", "shear stress against (dP0/dx)(y − L_y/2) (largest, core)", True,
+             None, "—"),
+            ("wall_force_balance_rel_error", "force balance on the walls", True, None, "—"))
+
+
+# the steady state's keys the report prints (poiseuille.steady_results)
+STEADY_KEYS = ("steady_detected", "steady_reason", "steady_from_mser", "migration_time", "migration_time_err",
+               "migration_time_profile", "migration_time_profile_err", "phi_center_slope", "phi_center_slope_err",
+               "phi_center_window_change", "plateau_threshold", "plateau_width_over_a1", "plateau_width_over_a1_err",
+               "plateau_phi", "plateau_phi_err", "shear_stress_exact_line_rel_error",
+               "momentum_balance_core_within_5pct", "wall_force_balance_within_1pct", "sbm_table8_phi_m",
+               "sbm_table8_phi_rms_diff", "sbm_table8_phi_rms_diff_jammed", "sbm_table8_phi_rms_diff_outside_jammed",
+               "sbm_table8_u_rms_diff", "sbm_table8_jammed_width_over_a1")
 
 
 def validation_rows(results: dict) -> List[Row]:
-    """The run's measures (MEASURES) in one configuration; no tabulated reference (the paper's Figs. 23-25
-    are plots): the SBM's profiles are the comparison."""
-    config = "φ_bulk %g, channel %s a1, dt %g, averaged from t %g" % (
-        results["phi_bulk"], " × ".join("%g" % v for v in results["L"]), results["dt"], results["steady_from"])
-    return [Row(quantity, config, results[key], paper="Figs. 23–25", percent=percent)
-            for key, quantity, percent in MEASURES if results.get(key) is not None]
+    """The run's measures (MEASURES) in one configuration, with their error bars where they have one; no
+    tabulated reference (the paper's Figs. 23-25 are plots): the SBM's profiles are the comparison."""
+    config = "φ_bulk %g, channel %s a1, dt %g, averaged from t %g%s" % (
+        results["phi_bulk"], " × ".join("%g" % v for v in results["L"]), results["dt"], results["steady_from"],
+        "" if results.get("steady_detected", True) else " (not steady)")
+
+    def finite(v):
+        return v if v is not None and math.isfinite(v) else None
+
+    return [Row(quantity, config, finite(results[key]), paper=paper, percent=percent,
+                spread=finite(results.get(err)) if err else None)
+            for key, quantity, percent, err, paper in MEASURES if finite(results.get(key)) is not None]
 
 
 def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional[Sequence[str]] = None,
-           options: Any = None, started: Optional[float] = None) -> dict:
+           options: Any = None, started: Optional[float] = None, table8=None,
+           plateau_threshold: float = poiseuille.PLATEAU_THRESHOLD) -> dict:
     """Analyse a run folder (fdmsubgrid.poiseuille.analyse), write `out` (fdmsubgrid.results: argv and
     options are the command's) and the figure beside it."""
     started = time.time() if started is None else started
-    results, fig = poiseuille.analyse(run_dir, material, from_time)
+    results, fig = poiseuille.analyse(run_dir, material, from_time, table8, plateau_threshold)
     results.update(case="poiseuille", run=os.path.basename(os.path.normpath(run_dir)), run_dir=os.path.abspath(run_dir))
     figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_poiseuille.png")
     poiseuille.plot(figure, fig)
@@ -266,6 +316,9 @@ def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional
               "shear_stress_linearity_wall_layer_rel_error", "wall_force_balance_rel_error", "wall_shear_stress_asymmetry", "sbm_phi_rms_diff",
               "sbm_u_rms_diff", "inner_iterations_mean", "unconverged_steps", "wall_seconds"):
         print("%-45s %s" % (k, results[k]))
+    for k in STEADY_KEYS:
+        if k in results:
+            print("%-45s %s" % (k, results[k]))
     print("wrote %s and %s" % (out, figure))
     return results
 

@@ -8,9 +8,12 @@ y* = (y - L_y/2)/L_y (Eq. 61).
 
 What `analyse` measures (docs/profiles.md, "Pressure-driven flow"):
 - the migration transient: phi in the central slab |y*| < a1/L_y (2 a1 wide) and in the wall layers
-  (within 2.5 a1 of either wall) at every particle snapshot, and the time scale tau of an exponential
-  approach fitted to the central series (migration_time); the steady part starts where the MSER rule
-  puts the end of the central series' transient (fdmsubgrid.timeseries), or at a given time;
+  (within 2.5 a1 of either wall) at every particle snapshot; the steady window found from the data
+  (steady_window: the time constant tau of the central series' exponential approach, fit_approach, the
+  window from 3 tau on, the series' trend over it flat within 2 error bars), or from a given time;
+- the central plateau (central_plateau: the width above phi 0.6 in bins of a1, with block errors), the
+  stresses across the channel (stress_profiles, contact_normal_stress) and the SBM with the material
+  functions fitted to this project's Table 8 rows (steady_results, sbm_differences);
 - the steady profiles, time-averaged with block-averaging errors: fine (planes every 0.02 a1) and coarse
   (bins of width a1, Eq. 60) phi(y) (Eq. 49) and u_p*(y) (Eqs. 59, 61), Sigma^c_yy(y) and Sigma_xy(y);
 - the momentum balance: in steady Stokes flow the total shear stress is exactly Sigma_xy(y) =
@@ -37,7 +40,7 @@ import os
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import output, packing, profiles, rheology, sbm, shear, suspension, timeseries
 
@@ -186,26 +189,6 @@ def flow_rate(run_dir: str) -> tuple[NDArray, NDArray]:
     return np.asarray(steps["time"]) / sc.time_unit, np.asarray(steps["meanUx"]) / (2 * sc.u_c)
 
 
-def migration_time(times: NDArray, phi_center: NDArray) -> tuple[float, float, float]:
-    """(tau, its standard error, phi_inf) of phi_center(t) = phi_inf - (phi_inf - phi_0) exp(-t/tau)
-    fitted to the central series (scipy's curve_fit; nan if the fit fails: no rise, too short)."""
-    from scipy.optimize import curve_fit
-    t = np.asarray(times, dtype=float)
-    y = np.asarray(phi_center, dtype=float)
-    if len(t) < 8 or not y[-len(y) // 4:].mean() > y[0]:
-        return math.nan, math.nan, math.nan
-
-    def model(tt: NDArray, phi_inf: float, tau: float) -> NDArray:
-        return phi_inf - (phi_inf - y[0]) * np.exp(-(tt - t[0]) / tau)
-
-    try:
-        (phi_inf, tau), cov = curve_fit(model, t, y, p0=(y[-len(y) // 4:].mean(), 0.3 * (t[-1] - t[0])),
-                                        bounds=([y[0], 1e-6], [1.0, 1e3 * (t[-1] - t[0] + 1)]))
-    except (RuntimeError, ValueError):
-        return math.nan, math.nan, math.nan
-    return float(tau), float(np.sqrt(cov[1, 1])), float(phi_inf)
-
-
 def _layer_mask(y: NDArray, channel: profiles.Channel) -> NDArray:
     return (y - channel.y_lo < WALL_LAYER - 1e-9) | (channel.y_hi - y < WALL_LAYER - 1e-9)
 
@@ -248,8 +231,11 @@ def momentum_balance(run_dir: str, eta: float, sc: Scales, channel: profiles.Cha
         shear_stress_linearity_fine_wall_layer_rel_error=float(np.max(deviation[layer])),
         wall_force_balance_rel_error=abs(tau_lo - tau_hi - 2 * sc.tau_w) / (2 * sc.tau_w),
         wall_shear_stress_asymmetry=abs(tau_lo + tau_hi) / sc.tau_w,
+        shear_stress_exact_line_rel_error=exact_line_deviation(0.5 * (edges[1:] + edges[:-1]), coarse_total, sc,
+                                                               channel, ~coarse_layer),
         figure=dict(faces=y_faces, total=total, fluid=fluid, particle=particle, line=line(y_faces),
-                    coarse_total=coarse_total))
+                    coarse_total=coarse_total, coarse_line=line(0.5 * (edges[1:] + edges[:-1])),
+                    coarse_layer=coarse_layer))
 
 
 def jammed_width(coarse: profiles.ProfileAverage, y_mid: float, phi_m: float) -> float:
@@ -291,10 +277,15 @@ def sbm_comparison(material: sbm.MaterialFunctions, snapshots: list, channel: pr
     return model, float(np.sqrt(np.mean(dphi ** 2))), float(np.sqrt(np.mean(du ** 2))), phi_region
 
 
-def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None) -> tuple[dict, dict]:
+def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None,
+            table8: sbm.MaterialFunctions | None = None, plateau_threshold: float | None = None
+            ) -> tuple[dict, dict]:
     """The results of a run (a flat dict, the keys of cases/poiseuille/results.json; `species` one dict per
     species, profiles.species_summary with its phi_center in the central band |y - mid| < a1 in place of
-    phi_core) and what the figure needs. material: the SBM's material functions (default the paper's, sbm.MaterialFunctions)."""
+    phi_core) and what the figure needs. material: the SBM's material functions (default the paper's,
+    sbm.MaterialFunctions); table8: a second set drawn beside them, fitted to this project's Table 8 rows
+    (sbm.from_couette_results), or None; plateau_threshold: the phi above which the central plateau is
+    measured (central_plateau; default PLATEAU_THRESHOLD, 0.6)."""
     material = material or sbm.MaterialFunctions.maron_pierce_power_law()
     run = shear.read_run(run_dir)
     sc = scales(run)
@@ -314,17 +305,19 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
                                  + profiles.volume_fraction(s, channel, channel.y_hi - WALL_LAYER, channel.y_hi))
                           for s in snapshots])
     phi_integral = np.array([profiles.volume_fraction(s, channel) for s in snapshots])
+    # the steady window from the data (steady_window: the migration's approach fitted, phi_center's trend
+    # over the window checked), unless a start is given
+    rms_change, _ = profile_change([profiles.profiles_in_bins(s, channel).phi for s in snapshots])
+    window = steady_window(times, phi_center, rms_change)
     if from_time is not None:
         start = int(np.searchsorted(times, from_time - 1e-9))
         steady_detected = True
-    elif len(snapshots) >= 4 * timeseries.MIN_BLOCKS:
-        tr = timeseries.detect_transient(phi_center, times)
-        start, steady_detected = tr.start, tr.steady
     else:
-        start, steady_detected = len(snapshots) // 2, False
+        start, steady_detected = window.start, window.steady
     start = min(start, len(snapshots) - MIN_SNAPSHOTS)
     t0 = float(times[start])
     kept = snapshots[start:]
+    window_trend = trend(times[start:], phi_center[start:])
 
     coarse = profiles.average_profiles(kept, channel)
     fine = profiles.average_profiles(kept, channel, y=channel.planes(0.02), errors=False)
@@ -349,8 +342,6 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
         phi_center=float(np.mean(phi_center[start:])),
         phi_center_err=float(timeseries.block_average(phi_center[start:]).error) if len(kept) >= 2 * timeseries.MIN_BLOCKS else math.nan,
         phi_center_initial=float(phi_center[0]),
-        **dict(zip(("migration_time", "migration_time_err", "phi_center_fit_inf"),
-                   migration_time(times, phi_center))),
         phi_wall_layer=float(np.mean(phi_walls[start:])),
         phi_sbm_region=phi_region,
         jammed_width_over_a1=jammed_width(coarse, mid, phi_m), phi_m=phi_m,
@@ -368,6 +359,14 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
     figure = dict(channel=channel, scales=sc, coarse=coarse, fine=fine, species=species, times=times,
                   phi_center=phi_center,
                   phi_walls=phi_walls, model=model, start=t0, phi_m=phi_m, **balance["figure"])
+    plateau = central_plateau(kept, channel, coarse, PLATEAU_THRESHOLD if plateau_threshold is None else plateau_threshold)
+    steady = steady_results(window, window_trend, from_time, plateau, balance,
+                            material, table8, kept, channel, sc, coarse, fine, float(pack.radii.min()))
+    results.update(steady["results"], plateau_shear_rate=plateau_shear_rate(fine, plateau, sc),
+                   # the series the window was found from (to refit, or to set runs of several sizes side by side)
+                   series=dict(time=times.round(6).tolist(), phi_center=phi_center.round(6).tolist(),
+                               phi_wall_layer=phi_walls.round(6).tolist(), rms_change=rms_change.round(6).tolist()))
+    figure.update(rms_change=rms_change, window=window, **steady["figure"])
     return results, figure
 
 
@@ -387,8 +386,8 @@ def plot(path: str, fig: dict) -> str:
         return np.asarray(u) / (2 * sc.u_c)
 
     coarse, fine, model = fig["coarse"], fig["fine"], fig["model"]
-    f = Figure(figsize=(12, 8.5))
-    ax = f.subplots(2, 2)
+    f = Figure(figsize=(17, 8.5))
+    ax = f.subplots(2, 3)
     a = ax[0, 0]
     a.plot(ys(fine.y), fine.phi, ":", color="0.5", lw=0.8, label="simulation (fine)")
     a.errorbar(ys(coarse.y), coarse.phi, yerr=coarse.phi_error, fmt="o", ms=4, capsize=2, label="simulation (bins a1)")
@@ -419,6 +418,420 @@ def plot(path: str, fig: dict) -> str:
     a.plot(ys(fig["faces"]), fig["particle"] / sc.tau_w, "-", lw=0.8, label="particles (Eq. 53)")
     a.plot(ys(fig["faces"]), fig["line"] / sc.tau_w, "k--", lw=0.8, label="walls' stress + (dP0/dx) y")
     a.set_xlabel("y*"), a.set_ylabel("Sigma_xy / tau_w"), a.legend(fontsize=8), a.set_title("momentum balance")
+    plot_steady(ax, fig)
     f.tight_layout()
     f.savefig(path, dpi=110)
     return path
+
+
+# ---- the steady state, the central plateau, the stresses across the channel (issue 48) -------------------
+
+STEADY_AFTER_TAUS = 3.0   # the window starts 3 migration times after the first snapshot: e^-3 = 5 % of the rise left
+PLATEAU_THRESHOLD = 0.6   # the central plateau: the region around the centre where phi (bins of a1) >= this
+PLATEAU_BLOCKS = 8        # the plateau width's error: from the widths of this many consecutive blocks of the window
+SLOPE_SIGMAS = 2.0        # phi_center has stopped rising when its slope over the window is below 2 error bars
+CORE_LINE_TOLERANCE = 0.05   # the shear stress within 5 % of tau_w of the exact line in the core
+WALL_FORCE_TOLERANCE = 0.01  # the walls carry the pressure gradient's force within 1 %
+
+
+def _inefficiency(residuals: NDArray) -> float:
+    """Samples per independent sample of a correlated series (>= 1): n/n_eff of its block average."""
+    r = np.asarray(residuals, dtype=float)
+    if len(r) < 2 * timeseries.MIN_BLOCKS:
+        return 1.0
+    return max(1.0, len(r) / float(timeseries.block_average(r).n_eff))
+
+
+@dataclass(frozen=True)
+class Approach:
+    """x(t) = plateau - (plateau - initial) exp(-(t - t0)/tau) fitted to a series (t0 its first time);
+    the standard errors from the fit's covariance scaled by the residuals' statistical inefficiency (the
+    samples are correlated in time: the plain least-squares errors would be too small by sqrt(g)).
+    ok False (and nan values) when the fit fails or the series does not approach a plateau."""
+
+    tau: float
+    tau_err: float
+    plateau: float
+    plateau_err: float
+    initial: float
+    t0: float
+    inefficiency: float
+    ok: bool
+
+    def __call__(self, t: ArrayLike) -> NDArray:
+        return self.plateau - (self.plateau - self.initial) * np.exp(-(np.asarray(t, dtype=float) - self.t0) / self.tau)
+
+
+def fit_approach(times: ArrayLike, x: ArrayLike, plateau_min: float = -math.inf) -> Approach:
+    """The exponential approach of a series to its plateau (Approach: plateau, initial value and time
+    constant tau fitted, scipy's curve_fit), rising or falling; the plateau held >= plateau_min (e.g. 0
+    for an rms). tau is bounded by 10 times the series' duration: a longer one is no approach (ok False)."""
+    from scipy.optimize import curve_fit
+    t = np.asarray(times, dtype=float)
+    y = np.asarray(x, dtype=float)
+    nan = Approach(math.nan, math.nan, math.nan, math.nan, math.nan, float(t[0]) if len(t) else math.nan, math.nan, False)
+    if len(t) < MIN_SNAPSHOTS or not np.all(np.isfinite(y)):
+        return nan
+    span = float(t[-1] - t[0])
+    tail = float(y[-max(2, len(y) // 4):].mean())
+    t0 = float(t[0])
+
+    def model(tt: NDArray, plateau: float, initial: float, tau: float) -> NDArray:
+        return plateau - (plateau - initial) * np.exp(-(tt - t0) / tau)
+
+    try:
+        p, cov = curve_fit(model, t, y, p0=(max(tail, plateau_min + 1e-9 * abs(tail)), float(y[:max(2, len(y) // 20)].mean()),
+                                            0.25 * span),
+                           bounds=([plateau_min, -np.inf, 1e-6 * span], [np.inf, np.inf, 10 * span]))
+    except (RuntimeError, ValueError):
+        return nan
+    g = _inefficiency(y - model(t, *p))
+    err = np.sqrt(np.diag(cov) * g)
+    if not (np.all(np.isfinite(err)) and p[2] < 10 * span * (1 - 1e-6)):
+        return nan
+    return Approach(tau=float(p[2]), tau_err=float(err[2]), plateau=float(p[0]), plateau_err=float(err[0]),
+                    initial=float(p[1]), t0=t0, inefficiency=g, ok=True)
+
+
+def profile_change(profiles_phi: ArrayLike, final_fraction: float = 0.25) -> tuple[NDArray, NDArray]:
+    """(rms change of each profile against the final profile (T,), the final profile (n,)) of a series of
+    phi profiles (T, n) (e.g. bins of a1 of every snapshot): the final profile the mean of the last
+    final_fraction of the series. Its approach to its noise floor measures the migration of the whole
+    profile, not of the centre alone."""
+    p = np.asarray(profiles_phi, dtype=float)
+    if p.ndim != 2 or len(p) < 2:
+        raise ValueError("profile_change needs (T, n) profiles with T >= 2, got shape %s" % (p.shape,))
+    final = p[-max(1, int(round(final_fraction * len(p)))):].mean(axis=0)
+    return np.sqrt(np.mean((p - final) ** 2, axis=1)), final
+
+
+@dataclass(frozen=True)
+class Trend:
+    """The least-squares slope of a series over a window, its standard error (the plain one times the
+    square root of the residuals' statistical inefficiency), and the change slope x duration."""
+
+    slope: float
+    slope_err: float
+    change: float
+    change_err: float
+    n: int
+
+
+def trend(times: ArrayLike, x: ArrayLike) -> Trend:
+    """The linear trend of x(t) (at least 3 samples)."""
+    t = np.asarray(times, dtype=float)
+    y = np.asarray(x, dtype=float)
+    if len(t) < 3:
+        raise ValueError("a trend needs at least 3 samples, got %d" % len(t))
+    tc = t - t.mean()
+    sxx = float(np.sum(tc * tc))
+    slope = float(np.sum(tc * (y - y.mean())) / sxx)
+    res = y - y.mean() - slope * tc
+    err = math.sqrt(float(np.sum(res * res)) / (len(t) - 2) / sxx * _inefficiency(res))
+    span = float(t[-1] - t[0])
+    return Trend(slope=slope, slope_err=err, change=slope * span, change_err=err * span, n=len(t))
+
+
+@dataclass(frozen=True)
+class SteadyWindow:
+    """The steady window of a channel run found from its data (steady_window): start index and time, the
+    approaches fitted to phi_center(t) and to the profile's rms change, the trend of phi_center over the
+    window; steady True when both fits succeeded, the window holds MIN_SNAPSHOTS and phi_center's slope
+    there is within SLOPE_SIGMAS error bars of zero. reason: why not, else ''."""
+
+    start: int
+    start_time: float
+    center: Approach
+    profile: Approach
+    trend: Trend
+    mser_start_time: float
+    steady: bool
+    reason: str
+
+
+def steady_window(times: ArrayLike, phi_center: ArrayLike, rms_change: ArrayLike,
+                  after_taus: float = STEADY_AFTER_TAUS) -> SteadyWindow:
+    """The steady window: from after_taus migration times (tau of phi_center's approach, fit_approach)
+    after the first snapshot to the end, checked by phi_center's trend over it (not rising, nor falling,
+    beyond SLOPE_SIGMAS error bars). The approach of the profile's rms change to its floor (>= 0) is
+    fitted too and reported. MSER's start (on phi_center) is reported beside it: it can stop at a stall
+    before a further rise. Not steady (reason given) when the fit fails, when the run ends before
+    after_taus migration times with MIN_SNAPSHOTS to spare, or when the trend is significant; the window
+    is then the later of MSER's start and the run's second half (averages of the latest part)."""
+    t = np.asarray(times, dtype=float)
+    pc = np.asarray(phi_center, dtype=float)
+    center, prof = fit_approach(t, pc), fit_approach(t, rms_change, plateau_min=0.0)
+    mser = (timeseries.detect_transient(pc, t).start_time if len(pc) >= 4 * timeseries.MIN_BLOCKS else math.nan)
+    fallback = max(len(t) // 2, int(np.searchsorted(t, mser - 1e-9)) if math.isfinite(mser) else 0)
+    reason = ""
+    if not center.ok:
+        start = fallback
+        reason = "no exponential approach fitted to phi_center(t)"
+    else:
+        start = int(np.searchsorted(t, t[0] + after_taus * center.tau - 1e-9))
+        if start > len(t) - MIN_SNAPSHOTS:
+            reason = ("the run ends %.4g after its first snapshot, before %g migration times (%.4g +- %.2g): run longer"
+                      % (t[-1] - t[0], after_taus, after_taus * center.tau, after_taus * center.tau_err))
+            start = fallback
+    start = min(start, max(0, len(t) - MIN_SNAPSHOTS))
+    tr = trend(t[start:], pc[start:])
+    if not reason and abs(tr.slope) > SLOPE_SIGMAS * tr.slope_err:
+        reason = ("phi_center %s over the window (slope %.3g +- %.3g per time unit, a change of %.3g): not steady"
+                  % ("still rises" if tr.slope > 0 else "falls", tr.slope, tr.slope_err, tr.change))
+    return SteadyWindow(start=start, start_time=float(t[start]), center=center, profile=prof, trend=tr,
+                        mser_start_time=float(mser), steady=not reason, reason=reason)
+
+
+def plateau_width(y: ArrayLike, phi: ArrayLike, y_mid: float, threshold: float = PLATEAU_THRESHOLD
+                  ) -> tuple[float, float, float]:
+    """(width, y_lo, y_hi) of the central region where the piecewise-linear profile through (y, phi)
+    (e.g. the bin centres of a1 and their phi) is >= threshold: the crossings on either side of y_mid
+    interpolated linearly; (0, nan, nan) if phi at y_mid is below the threshold. Ends at the outermost
+    points if the profile never falls below it."""
+    yy = np.asarray(y, dtype=float)
+    p = np.asarray(phi, dtype=float)
+    if np.interp(y_mid, yy, p) < threshold:
+        return 0.0, math.nan, math.nan
+
+    def crossing(order: NDArray) -> float:
+        # walk from the centre outward along `order` (indices of points beyond y_mid, nearest first)
+        prev_y, prev_p = y_mid, float(np.interp(y_mid, yy, p))
+        for k in order:
+            if p[k] < threshold:
+                return prev_y + (threshold - prev_p) * (yy[k] - prev_y) / (p[k] - prev_p)
+            prev_y, prev_p = yy[k], p[k]
+        return prev_y
+
+    up = np.where(yy > y_mid)[0]
+    down = np.where(yy < y_mid)[0][::-1]
+    hi, lo = crossing(up), crossing(down)
+    return float(hi - lo), float(lo), float(hi)
+
+
+@dataclass(frozen=True)
+class Plateau:
+    """The central plateau over the steady window: width (of the time-averaged profile in bins of a1)
+    and its standard error from the widths of PLATEAU_BLOCKS consecutive blocks of the window; bounds
+    (y_lo, y_hi); phi its mean volume fraction (exact average over the bounds) with the block-averaging
+    error; threshold."""
+
+    width: float
+    width_err: float
+    y_lo: float
+    y_hi: float
+    phi: float
+    phi_err: float
+    threshold: float
+    block_widths: tuple
+
+
+def central_plateau(snapshots: list, channel: profiles.Channel, coarse: profiles.ProfileAverage,
+                    threshold: float = PLATEAU_THRESHOLD, blocks: int = PLATEAU_BLOCKS) -> Plateau:
+    """The central plateau (Plateau) of the snapshots of the steady window, on coarse's bins."""
+    width, lo, hi = plateau_width(coarse.y, coarse.phi, channel.y_mid, threshold)
+    n = len(snapshots)
+    nb = min(blocks, n)
+    widths = []
+    for part in np.array_split(np.arange(n), nb):
+        block = profiles.average_profiles([snapshots[k] for k in part], channel, edges=coarse.edges, errors=False)
+        widths.append(plateau_width(block.y, block.phi, channel.y_mid, threshold)[0])
+    width_err = float(np.std(widths, ddof=1) / math.sqrt(nb)) if nb > 1 else math.nan
+    if width > 0:
+        series = np.array([profiles.volume_fraction(s, channel, lo, hi) for s in snapshots])
+        phi = float(series.mean())
+        phi_err = (float(timeseries.block_average(series).error) if n >= 2 * timeseries.MIN_BLOCKS else math.nan)
+    else:
+        phi, phi_err = math.nan, math.nan
+    return Plateau(width=width, width_err=width_err, y_lo=lo, y_hi=hi, phi=phi, phi_err=phi_err,
+                   threshold=threshold, block_widths=tuple(float(w) for w in widths))
+
+
+def exact_line_deviation(y: ArrayLike, total: ArrayLike, sc: Scales, channel: profiles.Channel,
+                         core: ArrayLike) -> float:
+    """The largest |Sigma_xy(y) - (dP0/dx)(y - L_y/2)|/tau_w over the points y where `core` is True:
+    the shear stress against the exact line of a symmetric steady state (zero at the centre plane)."""
+    yy = np.asarray(y, dtype=float)
+    dev = np.abs(np.asarray(total, dtype=float) - sc.grad * (yy - channel.y_mid)) / sc.tau_w
+    c = np.asarray(core, dtype=bool)
+    return float(np.max(dev[c])) if c.any() else math.nan
+
+
+def stress_profiles(coarse: profiles.ProfileAverage, balance: dict, sc: Scales, channel: profiles.Channel) -> dict:
+    """The stresses across the channel in the bins of a1, over tau_w, with their block-averaging errors:
+    the particles' hydrodynamic (fluid + sub-grid stresslets) and contact parts of Eq. 53, xy and yy, the
+    fluid's eta d<u>/dy, their total, the exact line (dP0/dx)(y - L_y/2) and the line through the walls'
+    own stresses (momentum_balance). y_star = (y - L_y/2)/L_y."""
+    xy, yy = profiles.component(0, 1), profiles.component(1, 1)
+
+    def col(a, k):
+        return (np.asarray(a)[:, k] / sc.tau_w).tolist() if a is not None else None
+
+    mids = coarse.y
+    fluid = balance["coarse_total"] - coarse.sigma_p[:, xy]
+    return dict(
+        y_star=((mids - channel.y_mid) / sc.width).tolist(),
+        sigma_h_xy=col(coarse.sigma_h, xy), sigma_h_xy_err=col(coarse.sigma_h_error, xy),
+        sigma_c_xy=col(coarse.sigma_c, xy), sigma_c_xy_err=col(coarse.sigma_c_error, xy),
+        sigma_h_yy=col(coarse.sigma_h, yy), sigma_h_yy_err=col(coarse.sigma_h_error, yy),
+        sigma_c_yy=col(coarse.sigma_c, yy), sigma_c_yy_err=col(coarse.sigma_c_error, yy),
+        fluid_xy=(fluid / sc.tau_w).tolist(), total_xy=(balance["coarse_total"] / sc.tau_w).tolist(),
+        total_xy_err=col(coarse.sigma_p_error, xy),
+        exact_line=(sc.grad * (mids - channel.y_mid) / sc.tau_w).tolist(),
+        walls_line=(balance["coarse_line"] / sc.tau_w).tolist())
+
+
+def sbm_differences(model: sbm.SBMProfile, coarse: profiles.ProfileAverage, channel: profiles.Channel,
+                    sc: Scales) -> dict:
+    """The SBM against the coarse profiles in the bins of a1 inside the region it is solved over (2.5 a1
+    from the walls): the rms difference of phi over all of them, over those inside the model's jammed zone
+    (their centres at |y*| < y_jammed, where the model holds phi = phi_m) and over the others, and of u*
+    (the model averaged over each bin, u* weighted by phi as Eq. 59). nan where no bin is."""
+    region = (channel.y_lo + WALL_LAYER, channel.y_hi - WALL_LAYER)
+    inside = (coarse.edges[:-1] >= region[0] - 1e-9) & (coarse.edges[1:] <= region[1] + 1e-9)
+    model_phi, model_u = [], []
+    for a, b in zip(coarse.edges[:-1], coarse.edges[1:]):
+        phi, u = model.at(np.clip(np.linspace(a - channel.y_mid, b - channel.y_mid, 201) / sc.width,
+                                  -model.y_edge, model.y_edge))
+        model_phi.append(np.mean(phi))
+        model_u.append(np.sum(phi * u) / np.sum(phi))
+    dphi = coarse.phi - np.array(model_phi)
+    du = coarse.u_p[:, 0] / (2 * sc.u_c) - np.array(model_u)
+    jammed = np.abs((coarse.y - channel.y_mid) / sc.width) < model.y_jammed
+
+    def rms(d: NDArray, mask: NDArray) -> float:
+        return float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+
+    return dict(phi_rms_diff=rms(dphi, inside), phi_rms_diff_jammed=rms(dphi, inside & jammed),
+                phi_rms_diff_outside_jammed=rms(dphi, inside & ~jammed), u_rms_diff=rms(du, inside),
+                bins_compared=int(inside.sum()), bins_jammed=int((inside & jammed).sum()))
+
+
+def steady_results(window: SteadyWindow, window_trend: Trend, from_time: float | None, plateau: Plateau,
+                   balance: dict, material: sbm.MaterialFunctions, table8: sbm.MaterialFunctions | None,
+                   kept: list, channel: profiles.Channel, sc: Scales, coarse: profiles.ProfileAverage,
+                   fine: profiles.ProfileAverage, a1: float) -> dict:
+    """The results' keys of the steady state (docs/cases/poiseuille.md): the window and how it was found,
+    the migration times, phi_center's trend over the window, the central plateau, the exact line and the
+    two tolerances of the momentum balance, the stresses across the channel, and the SBM with the
+    material functions fitted to Table 8 (table8, if given) beside the one of `material`. Returns
+    {"results": ..., "figure": ...}."""
+    c, p = window.center, window.profile
+    res = dict(
+        steady_method="from_time" if from_time is not None else "fit",
+        steady_after_taus=STEADY_AFTER_TAUS, steady_reason=window.reason if from_time is None else "",
+        steady_from_fit=window.start_time, steady_from_mser=window.mser_start_time,
+        migration_time=c.tau, migration_time_err=c.tau_err, phi_center_fit_inf=c.plateau,
+        phi_center_fit_inf_err=c.plateau_err, migration_time_profile=p.tau, migration_time_profile_err=p.tau_err,
+        phi_center_slope=window_trend.slope, phi_center_slope_err=window_trend.slope_err,
+        phi_center_window_change=window_trend.change, phi_center_window_change_err=window_trend.change_err,
+        phi_center_stopped_rising=bool(window_trend.slope <= SLOPE_SIGMAS * window_trend.slope_err),
+        plateau_threshold=plateau.threshold, plateau_width_over_a1=plateau.width / a1,
+        plateau_width_over_a1_err=plateau.width_err / a1,
+        plateau_y_star=[(v - channel.y_mid) / sc.width for v in (plateau.y_lo, plateau.y_hi)],
+        plateau_phi=plateau.phi, plateau_phi_err=plateau.phi_err,
+        plateau_block_widths_over_a1=[w / a1 for w in plateau.block_widths],
+        momentum_balance_core_within_5pct=bool(balance["shear_stress_exact_line_rel_error"] <= CORE_LINE_TOLERANCE),
+        walls_line_core_within_5pct=bool(balance["shear_stress_linearity_rel_error"] <= CORE_LINE_TOLERANCE),
+        wall_force_balance_within_1pct=bool(balance["wall_force_balance_rel_error"] <= WALL_FORCE_TOLERANCE),
+        stress_profile=stress_profiles(coarse, balance["figure"], sc, channel),
+        **contact_normal_stress(coarse, channel, sc))
+    fig = dict(plateau=plateau, window_trend=window_trend)
+    if table8 is not None:
+        model, _, _, _ = sbm_comparison(table8, kept, channel, sc, coarse, fine)
+        diff = sbm_differences(model, coarse, channel, sc)
+        res.update({"sbm_table8_" + k: v for k, v in diff.items()})
+        res.update(sbm_table8_material=table8.describe, sbm_table8_phi_m=table8.phi_m,
+                   sbm_table8_jammed_width_over_a1=2 * model.y_jammed * sc.width / a1,
+                   sbm_table8_u_center_star=float(model.at(0.0)[1]),
+                   sbm_table8_phi_edge=model.phi_edge,
+                   # Eq. 62b's first integral: Sigma^c_22 = Sigma_hat_22 |Sigma_xy| = -2 C tau_w, uniform
+                   sbm_table8_contact_normal_stress=-2 * model.invariant)
+        fig.update(model_table8=model, table8_phi_m=table8.phi_m)
+    return dict(results=res, figure=fig)
+
+
+def plot_steady(ax, fig: dict) -> None:
+    """The steady state's parts of the figure (plot's 2 x 3 axes): the SBM with the Table 8 material
+    functions and the central plateau on the phi and u_p* panels, the fit of phi_center's approach and the
+    window on the migration panel, the exact line on the momentum balance, the particles' hydrodynamic and
+    contact stresses across the channel (xy and yy, bins of a1 with error bars), and the profile's rms
+    change against its final profile with its fitted approach."""
+    sc: Scales = fig["scales"]
+    ch: profiles.Channel = fig["channel"]
+    coarse = fig["coarse"]
+    window: SteadyWindow = fig["window"]
+    plateau: Plateau = fig["plateau"]
+    ys = (coarse.y - ch.y_mid) / sc.width
+    model = fig.get("model_table8")
+    if model is not None:
+        ax[0, 0].plot(model.y, model.phi, "--", color="C2", label="SBM, Table 8 rows (phi_m %.3f)" % fig["table8_phi_m"])
+        ax[0, 1].plot(model.y, model.u, "--", color="C2", label="SBM, Table 8 rows")
+    ax[0, 0].axhline(plateau.threshold, color="C1", lw=0.6, ls=":", label="plateau threshold %g" % plateau.threshold)
+    if plateau.width > 0:
+        ax[0, 0].axvspan((plateau.y_lo - ch.y_mid) / sc.width, (plateau.y_hi - ch.y_mid) / sc.width, color="C1",
+                         alpha=0.12, label="plateau %.2f +- %.2f wide, phi %.3f" % (plateau.width, plateau.width_err, plateau.phi))
+    for a in ax[0, 0], ax[0, 1]:
+        a.legend(fontsize=7)
+    a = ax[1, 0]
+    t = fig["times"]
+    if window.center.ok:
+        a.plot(t, window.center(t), "k-", lw=0.8, label="fit: tau %.3g +- %.2g" % (window.center.tau, window.center.tau_err))
+    a.axvspan(fig["start"], t[-1], color="C2", alpha=0.1,
+              label="window (%s)" % ("steady" if window.steady else "not steady"))
+    a.axvline(window.mser_start_time, color="C3", ls=":", lw=0.8, label="MSER start")
+    a.legend(fontsize=7)
+    a = ax[1, 1]
+    a.plot(ys, sc.grad * (coarse.y - ch.y_mid) / sc.tau_w, "-", color="C3", lw=0.8, label="exact (dP0/dx)(y - L_y/2)")
+    if coarse.sigma_p_error is not None:
+        a.errorbar(ys, fig["coarse_total"] / sc.tau_w, yerr=coarse.sigma_p_error[:, profiles.component(0, 1)] / sc.tau_w,
+                   fmt="none", ecolor="C0", capsize=2)
+    a.legend(fontsize=7)
+    a = ax[0, 2]
+    xy, yy = profiles.component(0, 1), profiles.component(1, 1)
+    for data, err, k, name, mk in ((coarse.sigma_h, coarse.sigma_h_error, xy, "hydrodynamic xy", "o"),
+                                   (coarse.sigma_c, coarse.sigma_c_error, xy, "contact xy", "s"),
+                                   (coarse.sigma_h, coarse.sigma_h_error, yy, "hydrodynamic yy", "v"),
+                                   (coarse.sigma_c, coarse.sigma_c_error, yy, "contact yy", "^")):
+        a.errorbar(ys, data[:, k] / sc.tau_w, yerr=None if err is None else err[:, k] / sc.tau_w, fmt=mk + "-",
+                   ms=4, lw=0.6, capsize=2, label=name)
+    a.axhline(0, color="0.7", lw=0.5)
+    a.set_xlabel("y*"), a.set_ylabel("Sigma^p / tau_w (Eq. 53, bins a1)"), a.legend(fontsize=7)
+    a.set_title("particle stresses across the channel")
+    a = ax[1, 2]
+    a.plot(t, fig["rms_change"], lw=0.8, label="rms of phi(y) - final phi(y), bins a1")
+    if window.profile.ok:
+        a.plot(t, window.profile(t), "k-", lw=0.8, label="fit: tau %.3g +- %.2g" % (window.profile.tau, window.profile.tau_err))
+    a.set_xlabel("t 2U_c/L_y"), a.set_ylabel("rms change of phi"), a.legend(fontsize=7)
+    a.set_title("the profile's approach")
+
+
+def contact_normal_stress(coarse: profiles.ProfileAverage, channel: profiles.Channel, sc: Scales) -> dict:
+    """The particles' contact normal stress along y, Sigma^c_yy/tau_w, over the bins of a1 of the region the
+    SBM is solved in (2.5 a1 from the walls): its mean with the error of that mean (the bins' errors
+    combined as independent), and chi^2 per degree of freedom of a uniform profile (the SBM's steady
+    state, no particle flux, has it uniform: about 1 when it is). nan without error bars."""
+    yy = profiles.component(1, 1)
+    inside = ((coarse.edges[:-1] >= channel.y_lo + WALL_LAYER - 1e-9)
+              & (coarse.edges[1:] <= channel.y_hi - WALL_LAYER + 1e-9))
+    s = coarse.sigma_c[inside, yy] / sc.tau_w
+    if coarse.sigma_c_error is None or inside.sum() < 2:
+        return dict(contact_normal_stress_core=float(np.mean(s)) if len(s) else math.nan,
+                    contact_normal_stress_core_err=math.nan, contact_normal_stress_core_chi2=math.nan)
+    e = coarse.sigma_c_error[inside, yy] / sc.tau_w
+    w = 1.0 / e ** 2
+    mean = float(np.sum(w * s) / np.sum(w))
+    return dict(contact_normal_stress_core=mean, contact_normal_stress_core_err=float(1 / np.sqrt(np.sum(w))),
+                contact_normal_stress_core_chi2=float(np.sum(w * (s - mean) ** 2) / (len(s) - 1)))
+
+
+def plateau_shear_rate(fine: profiles.ProfileAverage, plateau: Plateau, sc: Scales) -> float:
+    """The mean |du_p*/dy*| (in 2 U_c/L_y) over the central plateau, from the fine profile of u_p: the
+    paper's 7e-4 against 0.2 at the walls (section 6.2). nan without a plateau."""
+    if not plateau.width > 0:
+        return math.nan
+    inside = (fine.y >= plateau.y_lo) & (fine.y <= plateau.y_hi)
+    u = fine.u_p[inside, 0] / (2 * sc.u_c)
+    y = fine.y[inside] / sc.width
+    if inside.sum() < 2:
+        return math.nan
+    return float(np.mean(np.abs(np.diff(u) / np.diff(y))))

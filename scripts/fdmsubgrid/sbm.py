@@ -228,28 +228,44 @@ def fit_contact_power_law(phi: ArrayLike, sigma22: ArrayLike, sigma22_err: Array
     return float(np.sum(w * y / s) / np.sum(w * w)), float(n)
 
 
-def from_couette_results(paths: Sequence[str], phi_m: float | None = None) -> MaterialFunctions:
-    """The material functions fitted from Couette results files (cases/couette results.json, fdmProfiles'
-    profiles.json, docs/validation_table8_*.json: phi_core, eta_s, Sigma_c_hat [xx, yy, zz] with their
-    errors, at top level or under "mser_window"). eta_s: the Maron-Pierce fit (Eq. 55) with three rows or
-    more, else alpha fitted with phi_m held (phi_m, default the paper's 0.592); Sigma_hat_22: the power law
-    (fit_contact_power_law)."""
-    rows = []
-    for path in paths:
-        data = results.read_data(path)   # a case's results file (either shape) or fdmProfiles' summary
-        data = data.get("mser_window", data)
+def couette_rows(path: str) -> list[dict]:
+    """The Couette rows of one results file: a row's own file (cases/couette results.json, fdmProfiles'
+    profiles.json, docs/data/validation_table8_*_phi*.json: phi_core, eta_s, Sigma_c_hat [xx, yy, zz] with
+    their errors, at top level or under "mser_window") is one row; a Table 8 summary (table8.py's, e.g.
+    docs/data/validation_table8_fluidEvery.json: a "rows" list of them) is all its rows."""
+    data = results.read_data(path)   # a case's results file (either shape) or fdmProfiles' summary
+    rows = data["rows"] if isinstance(data.get("rows"), list) and "phi_core" not in data else [data]
+    out = []
+    for k, row in enumerate(rows):
+        row = row.get("mser_window", row) if isinstance(row, dict) else row
+        where = path if len(rows) == 1 else "%s, row %d" % (path, k)
         try:
-            rows.append((float(data["phi_core"]), float(data["eta_s"]), float(data["eta_s_err"]),
-                         float(data["Sigma_c_hat"][1]), float(data["Sigma_c_hat_err"][1])))
-        except (KeyError, IndexError, TypeError) as e:
-            raise SBMError("%s: not a Couette results file (needs phi_core, eta_s, eta_s_err, Sigma_c_hat, "
-                           "Sigma_c_hat_err): missing %s" % (path, e)) from None
+            out.append(dict(phi_core=float(row["phi_core"]), eta_s=float(row["eta_s"]),
+                            eta_s_err=float(row["eta_s_err"]), sigma22=float(row["Sigma_c_hat"][1]),
+                            sigma22_err=float(row["Sigma_c_hat_err"][1]), source=where))
+        except (KeyError, IndexError, TypeError, AttributeError) as e:
+            raise SBMError("%s: not a Couette results file or row (needs phi_core, eta_s, eta_s_err, Sigma_c_hat, "
+                           "Sigma_c_hat_err): missing %s" % (where, e)) from None
+    return out
+
+
+def from_couette_results(paths: Sequence[str], phi_m: float | None = None) -> MaterialFunctions:
+    """The material functions fitted from Couette results files (couette_rows: a row's own file or a
+    Table 8 summary holding all its rows). eta_s: the Maron-Pierce fit (Eq. 55) with three rows or more,
+    phi_m included (its fitted value and error in `describe`), else alpha fitted with phi_m held (phi_m,
+    default the paper's 0.592); Sigma_hat_22 = Sigma^c_22/Sigma_xy, the contact normal stress along the
+    gradient that Eq. (62b) uses: the power law (fit_contact_power_law)."""
+    rows = [row for path in paths for row in couette_rows(path)]
     if not rows:
         raise SBMError("no Couette results files given")
-    phi, eta, eta_err, s22, s22_err = (np.array(c) for c in zip(*rows))
+    phi, eta, eta_err, s22, s22_err = (np.array([r[k] for r in rows]) for k in
+                                       ("phi_core", "eta_s", "eta_s_err", "sigma22", "sigma22_err"))
+    extra = {}
     if len(rows) >= 3 and phi_m is None:
         fit = rheology.fit_maron_pierce(phi, eta, eta_err)
         alpha, phi_m = fit.alpha, fit.phi_m
+        extra = dict(alpha_err=fit.alpha_error, phi_m_err=fit.phi_m_error, maron_pierce_chi2=fit.chi2,
+                     maron_pierce_dof=fit.dof)
     else:
         phi_m = PAPER_PHI_M if phi_m is None else phi_m
         if np.any(phi >= phi_m):
@@ -258,7 +274,8 @@ def from_couette_results(paths: Sequence[str], phi_m: float | None = None) -> Ma
         alpha = float(np.sum(g * eta / eta_err ** 2) / np.sum(g * g / eta_err ** 2))
     k, n = fit_contact_power_law(phi, s22, s22_err, phi_m)
     material = MaterialFunctions.maron_pierce_power_law(alpha, phi_m, k, n)
-    material.describe.update(fitted_from=list(paths))
+    material.describe.update(fitted_from=list(paths), rows_phi_core=[float(v) for v in phi],
+                             phi_core_max=float(phi.max()), **extra)
     return material
 
 
