@@ -1,9 +1,9 @@
 """The direct solver for box meshes (FFTBox, fluid/boxSolvers) inside fdmFoam, for p and U (the cases'
 linear_solver "FFTBox-all"; their default leaves U to symGaussSeidel): on every kind of box the
 cases write it solves the real OpenFOAM matrices to round-off in one iteration (the residual is
-OpenFOAM's own, of the matrix it was given), the coupled answer is the iterative solvers' one, and
-where it cannot solve (walls on two pairs of faces, a decomposed mesh) it says why and the fallback
-gives the same answer. The box solve as a preconditioner of OpenFOAM's PCG (`preconditioner FFTBox;`)
+OpenFOAM's own, of the matrix it was given), serial or decomposed over processors, the coupled answer
+is the iterative solvers' one, and where it cannot solve (walls on two pairs of faces, a decomposed
+fully periodic box) it says why and the fallback gives the same answer. The box solve as a preconditioner of OpenFOAM's PCG (`preconditioner FFTBox;`)
 is what the solver runs, and falls back to DIC with its reason. The separable solve itself is tested
 without OpenFOAM in fluid/tests/test_separable_box_solver.cpp."""
 import os
@@ -106,13 +106,32 @@ def test_walls_on_two_pairs_of_faces_fall_back_with_the_reason(tmp_path, env):
     assert_same_motion(fallback, iterative)
 
 
-def test_a_decomposed_mesh_falls_back_and_keeps_the_serial_answer(tmp_path, env):
+@pytest.mark.parametrize("np_fluid", [2, 3])
+def test_a_decomposed_box_is_solved_directly_and_keeps_the_serial_answer(tmp_path, env, np_fluid):
+    """fdmRun -f N: each processor transforms a slab of planes across the walls (3 processors: slabs of
+    5, 5 and 6 of the 16 planes, whatever way fdmRun split the mesh); p and U are solved in one
+    iteration to round-off and the sphere moves as in the serial run."""
     name = "moving walls across y"
-    log, parallel = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox", np_fluid=2)
-    assert "FFTBox: p is solved by GAMG (the fallback): the mesh is decomposed over 2 processors" in log, \
-        log[-3000:]
-    _, serial = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox")
+    log, parallel = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all", np_fluid=np_fluid)
+    for field in ("p", "Ux"):
+        assert ("FFTBox: %s solved directly on 16 x 16 x 16 cells, walls across y, decomposed over %d processors"
+                % (field, np_fluid)) in log, log[-3000:]
+    solves = [m.groups() for m in SOLVE.finditer(log)]
+    assert len(solves) > 40 and {s[0] for s in solves} == {"FFTBox"}, log[-3000:]
+    # one iteration, or none where the start is already within the tolerance 1e-10
+    assert {s[4] for s in solves} <= {"0", "1"}
+    assert max(float(s[3]) for s in solves if s[4] == "1") < 1e-12
+    _, serial = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox-all")
     assert_same_motion(parallel, serial)
+
+
+def test_a_decomposed_periodic_box_falls_back_with_the_reason(tmp_path, env):
+    """(Only the message: the fully periodic box driven by a mean gradient has no steady flow to compare;
+    the fallback's answer is compared where it has one, above.)"""
+    name = "periodic"
+    log, _ = run_free_sphere(tmp_path, name, BOXES[name], "FFTBox", np_fluid=2)
+    assert ("FFTBox: p is solved by GAMG (the fallback): the mesh is decomposed over 2 processors and is periodic "
+            "along every axis: FFTBox solves a decomposed box only with walls across one axis") in log, log[-3000:]
 
 
 def pcg_preconditioned_by_fftbox(fv_solution):

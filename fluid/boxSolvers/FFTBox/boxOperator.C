@@ -1,7 +1,9 @@
 #include "boxOperator.H"
 #include "boxLattice.H"
 #include "OStringStream.H"
+#include <algorithm>
 #include <array>
+#include <complex>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -31,6 +33,57 @@ struct planeStatistics
         return count ? (max - min)/Foam::max(mag(mean()), VSMALL) : 0;
     }
 };
+
+
+//- The statistics of every processor's part of a decomposed box combined
+void combine(List<planeStatistics>& planes)
+{
+    scalarList sum(planes.size()), lowest(planes.size()), highest(planes.size()), count(planes.size());
+    forAll(planes, i)
+    {
+        sum[i] = planes[i].sum;
+        lowest[i] = planes[i].min;
+        highest[i] = planes[i].max;
+        count[i] = planes[i].count;
+    }
+    Pstream::listCombineGather(sum, plusEqOp<scalar>());
+    Pstream::listCombineScatter(sum);
+    Pstream::listCombineGather(lowest, minEqOp<scalar>());
+    Pstream::listCombineScatter(lowest);
+    Pstream::listCombineGather(highest, maxEqOp<scalar>());
+    Pstream::listCombineScatter(highest);
+    Pstream::listCombineGather(count, plusEqOp<scalar>());
+    Pstream::listCombineScatter(count);
+    forAll(planes, i)
+    {
+        planes[i].sum = sum[i];
+        planes[i].min = lowest[i];
+        planes[i].max = highest[i];
+        planes[i].count = label(count[i] + 0.5);
+    }
+}
+
+
+//- The processor holding plane p (planeStart: the first plane of each, and
+//  the number of planes last)
+label planeOwner(const labelList& planeStart, const label p)
+{
+    return label(std::upper_bound(planeStart.begin(), planeStart.end(), p) - planeStart.begin()) - 1;
+}
+
+//- Exchange of contiguous values between every pair of processors; what a
+//  processor sends itself is copied
+template<class T>
+void exchange
+(
+    const List<List<T>>& send,
+    const labelList& recvSizes,
+    List<List<T>>& recv
+)
+{
+    Pstream::exchange<List<T>, T>(send, recvSizes, recv);
+    recv[Pstream::myProcNo()] = send[Pstream::myProcNo()];
+}
 
 separableReading readSeparable
 (
@@ -72,13 +125,24 @@ separableReading readSeparable
         {
             continue;
         }
-        const int a = lattice.patchAxis()[patchi];
+        const labelList& axes = lattice.patchFaceAxis()[patchi];
+        // a processor face across the walls lies above or below its cell
+        const labelList& offsets = lattice.patchFaceOffset()[patchi];
         const labelUList& cells = interfaces[patchi].interface().faceCells();
         const scalarField& coeffs = bouCoeffs[patchi];
         forAll(cells, facei)
         {
-            faces[a][lattice.plane(cells[facei])].add(-coeffs[facei]);
+            const int a = axes[facei];
+            const label key = lattice.plane(cells[facei]) + (a == w ? offsets[facei] : 0);
+            faces[a][key].add(-coeffs[facei]);
             rowSum[cells[facei]] -= coeffs[facei];
+        }
+    }
+    if (lattice.decomposed())
+    {
+        for (int a = 0; a < 3; ++a)
+        {
+            combine(faces[a]);
         }
     }
 
@@ -106,16 +170,25 @@ separableReading readSeparable
         }
     }
     List<planeStatistics> sums(nPlanes);
-    if (nonZero == 1)
+    const label nonZeroAll = lattice.decomposed() ? returnReduce(nonZero, sumOp<label>()) : nonZero;
+    if (nonZeroAll == 1)
     {
-        reading.referenceCell = last;
-        reading.referenceDelta = rowSum[last];
+        reading.reference = true;
+        if (nonZero == 1)
+        {
+            reading.referenceCell = last;
+            reading.referenceDelta = rowSum[last];
+        }
     }
     else
     {
         forAll(rowSum, celli)
         {
             sums[lattice.plane(celli)].add(rowSum[celli]);
+        }
+        if (lattice.decomposed())
+        {
+            combine(sums);
         }
         forAll(rowSum, celli)
         {
@@ -146,6 +219,10 @@ separableReading readSeparable
         }
         reading.M.diag[p] = d;
     }
+    if (lattice.decomposed())
+    {
+        reduce(reading.departure, maxOp<scalar>());
+    }
     return reading;
 }
 
@@ -161,18 +238,70 @@ Foam::boxSolve::boxOperator::boxOperator
     const bool measurePlans
 )
 :
-    solver
-    (
-        new fdm::separableBoxSolver(lattice.n(), lattice.wallAxis(), measurePlans)
-    )
+    decomposed(lattice.decomposed())
 {
     const List<std::array<long, 3>>& ijk = lattice.ijk();
-    index.resize(ijk.size());
+    if (!decomposed)
+    {
+        solver.reset(new fdm::separableBoxSolver(lattice.n(), lattice.wallAxis(), measurePlans));
+        index.resize(ijk.size());
+        forAll(ijk, celli)
+        {
+            index[celli] = solver->index(ijk[celli][0], ijk[celli][1], ijk[celli][2]);
+        }
+        work.resize(ijk.size());
+        return;
+    }
+
+    // slabs of planes across the walls, ranges of in-plane modes: as even
+    // as the numbers allow
+    const label nProcs = Pstream::nProcs(), me = Pstream::myProcNo();
+    const int w = lattice.wallAxis();
+    const long planes = lattice.n()[w];
+    planeStart.setSize(nProcs + 1);
+    forAll(planeStart, proci)
+    {
+        planeStart[proci] = label(long(proci)*planes/nProcs);
+    }
+    solver.reset
+    (
+        new fdm::separableBoxSolver
+        (
+            lattice.n(), w, measurePlans, planeStart[me], planeStart[me + 1]
+        )
+    );
+    modeStart.setSize(nProcs + 1);
+    forAll(modeStart, proci)
+    {
+        modeStart[proci] = std::size_t(proci)*solver->modesPerPlane()/nProcs;
+    }
+
+    // where each cell's value goes, and where what arrives goes
+    List<DynamicList<label>> cells(nProcs), positions(nProcs);
     forAll(ijk, celli)
     {
-        index[celli] = solver->index(ijk[celli][0], ijk[celli][1], ijk[celli][2]);
+        const label p = label(ijk[celli][w]);
+        const label owner = planeOwner(planeStart, p);
+        cells[owner].append(celli);
+        positions[owner].append
+        (
+            label
+            (
+                std::size_t(p - planeStart[owner])*solver->cellsPerPlane()
+              + solver->inPlaneIndex(ijk[celli][0], ijk[celli][1], ijk[celli][2])
+            )
+        );
     }
-    work.resize(ijk.size());
+    sendCells.setSize(nProcs);
+    labelListList sendPositions(nProcs);
+    forAll(cells, proci)
+    {
+        sendCells[proci].transfer(cells[proci]);
+        sendPositions[proci].transfer(positions[proci]);
+    }
+    labelList recvSizes;
+    Pstream::exchangeSizes(sendPositions, recvSizes);
+    exchange(sendPositions, recvSizes, slabPositions);
 }
 
 
@@ -221,12 +350,145 @@ void Foam::boxSolve::boxOperator::keep
 }
 
 
+void Foam::boxSolve::boxOperator::solveDecomposed
+(
+    solveScalarField& z,
+    const scalarField& b
+)
+{
+    typedef std::complex<double> complex;
+    const label nProcs = Pstream::nProcs(), me = Pstream::myProcNo();
+    const std::size_t modes = solver->modesPerPlane();
+    const label planes = planeStart[nProcs];
+    const label myPlanes = planeStart[me + 1] - planeStart[me];
+    const std::size_t myModes = modeStart[me + 1] - modeStart[me];
+    auto width = [this](const label proci) { return modeStart[proci + 1] - modeStart[proci]; };
+    List<scalarList> send(nProcs), recv(nProcs);
+    labelList recvSizes(nProcs);
+
+    // 1. the cells' values to the slabs
+    forAll(send, proci)
+    {
+        const labelList& cells = sendCells[proci];
+        send[proci].setSize(cells.size());
+        forAll(cells, i)
+        {
+            send[proci][i] = b[cells[i]];
+        }
+        recvSizes[proci] = slabPositions[proci].size();
+    }
+    exchange(send, recvSizes, recv);
+    double* slab = solver->planeValues();
+    forAll(recv, proci)
+    {
+        const labelList& at = slabPositions[proci];
+        forAll(at, i)
+        {
+            slab[at[i]] = recv[proci][i];
+        }
+    }
+    solver->forwardPlanes();
+
+    // 2. the slabs' spectra to ranges of modes (each processor all the
+    //    planes of its modes), solved
+    const complex* spectra = solver->planeSpectra();
+    forAll(send, proci)
+    {
+        const std::size_t m0 = modeStart[proci], n = width(proci);
+        send[proci].setSize(label(2*n*myPlanes));
+        for (label p = 0; p < myPlanes; ++p)
+        {
+            const double* from = reinterpret_cast<const double*>(spectra + modes*p + m0);
+            std::copy(from, from + 2*n, send[proci].begin() + 2*n*p);
+        }
+        recvSizes[proci] = label(2*myModes*(planeStart[proci + 1] - planeStart[proci]));
+    }
+    exchange(send, recvSizes, recv);
+    std::vector<complex> y(myModes*planes);
+    double* yValues = reinterpret_cast<double*>(y.data());
+    forAll(recv, proci)
+    {
+        std::copy(recv[proci].begin(), recv[proci].end(), yValues + 2*myModes*planeStart[proci]);
+    }
+    solver->solveModes(y.data(), modeStart[me], modeStart[me + 1]);
+
+    // 3. back to the slabs
+    forAll(send, proci)
+    {
+        const label first = planeStart[proci], count = planeStart[proci + 1] - first;
+        send[proci].setSize(label(2*myModes*count));
+        std::copy(yValues + 2*myModes*first, yValues + 2*myModes*(first + count), send[proci].begin());
+        recvSizes[proci] = label(2*width(proci)*myPlanes);
+    }
+    exchange(send, recvSizes, recv);
+    complex* spectraBack = solver->planeSpectra();
+    forAll(recv, proci)
+    {
+        const std::size_t m0 = modeStart[proci], n = width(proci);
+        for (label p = 0; p < myPlanes; ++p)
+        {
+            double* to = reinterpret_cast<double*>(spectraBack + modes*p + m0);
+            std::copy(recv[proci].begin() + 2*n*p, recv[proci].begin() + 2*n*(p + 1), to);
+        }
+    }
+    solver->backwardPlanes();
+
+    // 4. the slabs' values back to the cells
+    forAll(send, proci)
+    {
+        const labelList& at = slabPositions[proci];
+        send[proci].setSize(at.size());
+        forAll(at, i)
+        {
+            send[proci][i] = slab[at[i]];
+        }
+        recvSizes[proci] = sendCells[proci].size();
+    }
+    exchange(send, recvSizes, recv);
+    forAll(recv, proci)
+    {
+        const labelList& cells = sendCells[proci];
+        forAll(cells, i)
+        {
+            z[cells[i]] = recv[proci][i];
+        }
+    }
+}
+
+
 void Foam::boxSolve::boxOperator::precondition
 (
     solveScalarField& z,
     const solveScalarField& r
 )
 {
+    if (decomposed)
+    {
+        // as separableBoxSolver::solveWithReference, over the processors
+        scalarField b(r);
+        scalar sum = 0;
+        if (reading.reference)
+        {
+            sum = gSum(r);
+            if (reading.referenceCell >= 0)
+            {
+                b[reading.referenceCell] -= sum;
+            }
+        }
+        solveDecomposed(z, b);
+        if (reading.reference)
+        {
+            scalar shift = 0;
+            if (reading.referenceCell >= 0)
+            {
+                shift = sum/reading.referenceDelta - z[reading.referenceCell];
+            }
+            reduce(shift, sumOp<scalar>());
+            z += shift;
+        }
+        return;
+    }
+
     // in the solver's order
     std::vector<double>& w = work;
     forAll(r, celli)
@@ -314,7 +576,13 @@ Foam::boxSolve::boxOperator* Foam::boxSolve::prepare
     }
     boxOperator& op = *slot;
 
-    if (!op.sameMatrix(matrix, bouCoeffs, interfaces))
+    bool same = op.sameMatrix(matrix, bouCoeffs, interfaces);
+    if (lattice->decomposed())
+    {
+        // read (collectively) where any processor's part changed
+        reduce(same, andOp<bool>());
+    }
+    if (!same)
     {
         op.keep
         (
@@ -341,7 +609,7 @@ Foam::boxSolve::boxOperator* Foam::boxSolve::prepare
         reason = e.what();
         return nullptr;
     }
-    if (reading.referenceCell >= 0 && !op.solver->singular())
+    if (reading.reference && !op.solver->singular())
     {
         reason = "one row alone does not sum to zero but the rest is not a Laplacian";
         return nullptr;
@@ -351,7 +619,7 @@ Foam::boxSolve::boxOperator* Foam::boxSolve::prepare
         Info<< "FFTBox: " << fieldName << " " << how << " on "
             << lattice->description().c_str() << " (departure from the box "
             << reading.departure
-            << (reading.referenceCell >= 0 ? ", pressure reference solved exactly" : "")
+            << (reading.reference ? ", pressure reference solved exactly" : "")
             << ")" << endl;
     }
     return &op;

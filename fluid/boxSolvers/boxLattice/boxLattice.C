@@ -1,6 +1,8 @@
 #include "boxLattice.H"
 #include "volMesh.H"
 #include "cyclicFvPatch.H"
+#include "processorFvPatch.H"
+#include "processorCyclicFvPatch.H"
 #include "emptyFvPatch.H"
 #include "boundBox.H"
 #include "OStringStream.H"
@@ -22,37 +24,21 @@ namespace
 
 void Foam::boxLattice::recognise(const fvMesh& mesh)
 {
-    OStringStream why;
-
-    if (Pstream::parRun())
-    {
-        why << "the mesh is decomposed over " << Pstream::nProcs()
-            << " processors and FFTBox solves a whole box on one processor";
-        reason_ = why.str();
-        return;
-    }
-
+    // Collective first (every processor of a decomposed mesh takes part):
+    // the cell size, the box and the number of cells of the whole mesh
     const scalarField& V = mesh.V();
-    if (V.empty())
+    const label nCells = returnReduce(V.size(), sumOp<label>());
+    if (nCells == 0)
     {
         reason_ = "the mesh has no cells";
         return;
     }
     const scalar delta = Foam::cbrt(gMax(V));
-    forAll(V, celli)
-    {
-        if (mag(V[celli] - pow3(delta)) > 1e-6*pow3(delta))
-        {
-            why << "cell " << celli << " has volume " << V[celli]
-                << ", not that of a cube of side " << delta
-                << " (the mesh is not a uniform Cartesian one)";
-            reason_ = why.str();
-            return;
-        }
-    }
+    const boundBox bounds(mesh.points(), true);
 
-    const boundBox bounds(mesh.points(), false);
-    for (int a = 0; a < 3; ++a)
+    std::array<bool, 3> periodic{{false, false, false}}, walled{{false, false, false}};
+    OStringStream why;
+    for (int a = 0; a < 3 && reason_.empty(); ++a)
     {
         const scalar cells = bounds.span()[a]/delta;
         n_[a] = long(std::round(cells));
@@ -61,21 +47,108 @@ void Foam::boxLattice::recognise(const fvMesh& mesh)
             why << "the extent along " << axisName(a) << " is "
                 << cells << " cells, not a whole number";
             reason_ = why.str();
-            return;
         }
     }
-    if (long(V.size()) != n_[0]*n_[1]*n_[2])
+    if (reason_.empty() && long(nCells) != n_[0]*n_[1]*n_[2])
     {
-        why << V.size() << " cells do not fill a box of " << n_[0] << " x "
+        why << nCells << " cells do not fill a box of " << n_[0] << " x "
             << n_[1] << " x " << n_[2];
         reason_ = why.str();
+    }
+    if (reason_.empty())
+    {
+        recogniseLocal(mesh, delta, bounds, periodic, walled);
+    }
+
+    // Every processor's part must be one: the first reason found is the
+    // reason of all (the fallback is then taken everywhere alike)
+    if (decomposed_)
+    {
+        List<string> reasons(Pstream::nProcs());
+        reasons[Pstream::myProcNo()] = reason_;
+        Pstream::gatherList(reasons);
+        Pstream::scatterList(reasons);
+        forAll(reasons, proci)
+        {
+            if (!reasons[proci].empty())
+            {
+                OStringStream first;
+                first << "on processor " << proci << ": " << reasons[proci].c_str();
+                reason_ = first.str();
+                return;
+            }
+        }
+        for (int a = 0; a < 3; ++a)
+        {
+            periodic[a] = returnReduce(periodic[a], orOp<bool>());
+            walled[a] = returnReduce(walled[a], orOp<bool>());
+        }
+    }
+    else if (!reason_.empty())
+    {
         return;
     }
 
-    // every lattice site holds one cell
+    wallAxis_ = -1;
+    for (int a = 0; a < 3; ++a)
+    {
+        if (periodic[a] && walled[a])
+        {
+            why << "axis " << axisName(a) << " has both cyclic and wall faces";
+            reason_ = why.str();
+            return;
+        }
+        if (walled[a])
+        {
+            if (wallAxis_ >= 0)
+            {
+                why << "walls across " << axisName(wallAxis_) << " and "
+                    << axisName(a) << ": FFTBox solves boxes with walls on at"
+                    << " most one pair of faces";
+                reason_ = why.str();
+                return;
+            }
+            wallAxis_ = a;
+        }
+    }
+    if (decomposed_ && wallAxis_ < 0)
+    {
+        why << "the mesh is decomposed over " << Pstream::nProcs()
+            << " processors and is periodic along every axis: FFTBox solves"
+            << " a decomposed box only with walls across one axis";
+        reason_ = why.str();
+    }
+}
+
+
+bool Foam::boxLattice::recogniseLocal
+(
+    const fvMesh& mesh,
+    const scalar delta,
+    const boundBox& bounds,
+    std::array<bool, 3>& periodic,
+    std::array<bool, 3>& walled
+)
+{
+    OStringStream why;
+    const scalarField& V = mesh.V();
+    forAll(V, celli)
+    {
+        if (mag(V[celli] - pow3(delta)) > 1e-6*pow3(delta))
+        {
+            why << "cell " << celli << " has volume " << V[celli]
+                << ", not that of a cube of side " << delta
+                << " (the mesh is not a uniform Cartesian one)";
+            reason_ = why.str();
+            return false;
+        }
+    }
+
+    // every lattice site holds one cell (here; the count above makes it
+    // every site of the box)
     const vectorField& C = mesh.cellCentres();
     ijk_.setSize(C.size());
-    List<bool> filled(C.size(), false);
+    std::vector<bool> filled(std::size_t(n_[0])*n_[1]*n_[2], false);
     forAll(C, celli)
     {
         for (int a = 0; a < 3; ++a)
@@ -89,7 +162,7 @@ void Foam::boxLattice::recognise(const fvMesh& mesh)
         {
             why << "two cells share the lattice site of cell " << celli;
             reason_ = why.str();
-            return;
+            return false;
         }
         filled[site] = true;
     }
@@ -115,15 +188,16 @@ void Foam::boxLattice::recognise(const fvMesh& mesh)
             why << "internal face " << facei << " does not join two lattice"
                 << " neighbours";
             reason_ = why.str();
-            return;
+            return false;
         }
         faceAxis_[facei] = static_cast<unsigned char>(axis);
     }
 
     // patches: cyclic pairs make an axis periodic, uncoupled patches on the
-    // box's faces are walls
-    std::array<bool, 3> periodic{{false, false, false}}, walled{{false, false, false}};
-    patchAxis_.setSize(mesh.boundary().size(), -1);
+    // box's faces are walls, processor patches join the parts of a
+    // decomposed box
+    patchFaceAxis_.setSize(mesh.boundary().size());
+    patchFaceOffset_.setSize(mesh.boundary().size());
     forAll(mesh.boundary(), patchi)
     {
         const fvPatch& patch = mesh.boundary()[patchi];
@@ -135,9 +209,37 @@ void Foam::boxLattice::recognise(const fvMesh& mesh)
         {
             why << "patch " << patch.name() << " is empty (a 2-D mesh)";
             reason_ = why.str();
-            return;
+            return false;
         }
-        if (isA<cyclicFvPatch>(patch))
+        if (isA<processorFvPatch>(patch))
+        {
+            // each face normal to an axis (a split within a plane makes a
+            // staircase of faces normal to different axes)
+            const vectorField nf(patch.nf());
+            labelList& axes = patchFaceAxis_[patchi];
+            labelList& offsets = patchFaceOffset_[patchi];
+            axes.setSize(nf.size());
+            offsets.setSize(nf.size());
+            forAll(nf, facei)
+            {
+                const vector m = cmptMag(nf[facei]);
+                const int a = (m.x() >= m.y() && m.x() >= m.z()) ? 0 : (m.y() >= m.z() ? 1 : 2);
+                if (m[a] < 1 - 1e-6)
+                {
+                    why << "face " << facei << " of processor patch "
+                        << patch.name() << " is not normal to an axis";
+                    reason_ = why.str();
+                    return false;
+                }
+                axes[facei] = a;
+                offsets[facei] = (nf[facei][a] > 0) ? 0 : -1;
+                if (isA<processorCyclicFvPatch>(patch))
+                {
+                    periodic[a] = true;
+                }
+            }
+        }
+        else if (isA<cyclicFvPatch>(patch))
         {
             const cyclicFvPatch& cyc = refCast<const cyclicFvPatch>(patch);
             const labelUList& mine = cyc.faceCells();
@@ -168,11 +270,12 @@ void Foam::boxLattice::recognise(const fvMesh& mesh)
                     why << "cyclic patch " << patch.name() << " does not join"
                         << " opposite faces of the box";
                     reason_ = why.str();
-                    return;
+                    return false;
                 }
                 axis = faceAxis;
             }
-            patchAxis_[patchi] = axis;
+            patchFaceAxis_[patchi] = labelList(mine.size(), axis);
+            patchFaceOffset_[patchi] = labelList(mine.size(), 0);
             periodic[axis] = true;
         }
         else if (patch.coupled())
@@ -180,7 +283,7 @@ void Foam::boxLattice::recognise(const fvMesh& mesh)
             why << "patch " << patch.name() << " is a coupled patch of type "
                 << patch.type() << " (only cyclic pairs are periodic axes)";
             reason_ = why.str();
-            return;
+            return false;
         }
         else
         {
@@ -200,29 +303,7 @@ void Foam::boxLattice::recognise(const fvMesh& mesh)
             }
         }
     }
-
-    wallAxis_ = -1;
-    for (int a = 0; a < 3; ++a)
-    {
-        if (periodic[a] && walled[a])
-        {
-            why << "axis " << axisName(a) << " has both cyclic and wall faces";
-            reason_ = why.str();
-            return;
-        }
-        if (walled[a])
-        {
-            if (wallAxis_ >= 0)
-            {
-                why << "walls across " << axisName(wallAxis_) << " and "
-                    << axisName(a) << ": FFTBox solves boxes with walls on at"
-                    << " most one pair of faces";
-                reason_ = why.str();
-                return;
-            }
-            wallAxis_ = a;
-        }
-    }
+    return true;
 }
 
 
@@ -232,7 +313,8 @@ Foam::boxLattice::boxLattice(const fvMesh& mesh)
 :
     reason_(),
     n_{{0, 0, 0}},
-    wallAxis_(-1)
+    wallAxis_(-1),
+    decomposed_(Pstream::parRun())
 {
     recognise(mesh);
 }
@@ -269,6 +351,10 @@ Foam::string Foam::boxLattice::description() const
     else
     {
         s << "walls across " << axisName(wallAxis_);
+    }
+    if (decomposed_)
+    {
+        s << ", decomposed over " << Pstream::nProcs() << " processors";
     }
     return s.str();
 }

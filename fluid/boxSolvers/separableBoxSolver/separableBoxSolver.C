@@ -35,7 +35,9 @@ fdm::separableBoxSolver::separableBoxSolver
 (
     const std::array<long, 3>& n,
     int wallAxis,
-    bool measurePlans
+    bool measurePlans,
+    long planeBegin,
+    long planeEnd
 )
 :
     n_(n),
@@ -45,6 +47,8 @@ fdm::separableBoxSolver::separableBoxSolver
     nPlanes_(1),
     nSlow_(1),
     nFast_(1),
+    planeBegin_(0),
+    planeEnd_(0),
     nCells_(0),
     nModes_(0),
     factorised_(false),
@@ -94,10 +98,39 @@ fdm::separableBoxSolver::separableBoxSolver
         nModes_ = std::size_t(n[2])*n[1]*(n[0]/2 + 1);
     }
 
-    real_ = static_cast<double*>(fftw_malloc(sizeof(double)*nCells_));
+    if (planeEnd < 0)
+    {
+        planeEnd = nPlanes_;
+    }
+    if (planeBegin < 0 || planeBegin > planeEnd || planeEnd > nPlanes_)
+    {
+        throw std::invalid_argument
+        (
+            "separableBoxSolver: planes [" + std::to_string(planeBegin) + ", "
+          + std::to_string(planeEnd) + ") are not within the "
+          + std::to_string(nPlanes_) + " planes across the walls"
+        );
+    }
+    if (wall_ < 0 && planeEnd - planeBegin != nPlanes_)
+    {
+        throw std::invalid_argument
+        (
+            "separableBoxSolver: a fully periodic box is solved whole"
+            " (its parts need a wall axis)"
+        );
+    }
+    planeBegin_ = planeBegin;
+    planeEnd_ = planeEnd;
+    const long localPlanes = planeEnd_ - planeBegin_;
+
+    // the buffers of the planes transformed here (at least one element:
+    // fftw_malloc(0) may return nullptr)
+    const std::size_t localCells = std::size_t(nSlow_*nFast_)*localPlanes;
+    const std::size_t localModes = nModes_*localPlanes;
+    real_ = static_cast<double*>(fftw_malloc(sizeof(double)*std::max<std::size_t>(localCells, 1)));
     spectrum_ = reinterpret_cast<std::complex<double>*>
     (
-        fftw_malloc(sizeof(fftw_complex)*nModes_*nPlanes_)
+        fftw_malloc(sizeof(fftw_complex)*std::max<std::size_t>(localModes, 1))
     );
     if (!real_ || !spectrum_)
     {
@@ -110,26 +143,31 @@ fdm::separableBoxSolver::separableBoxSolver
     const unsigned flags = measurePlans ? FFTW_MEASURE : FFTW_ESTIMATE;
     if (wall_ >= 0)
     {
+        cosSlow_ = cosines(nSlow_);
+        cosFast_ = cosines(nFast_);
+        if (localPlanes == 0)
+        {
+            // a processor without planes of its own: nothing to transform
+            return;
+        }
         // one 2-D transform per plane across the walls
         const int dims[2] = {int(nSlow_), int(nFast_)};
         const int realPerPlane = int(nSlow_*nFast_);
         const int modesPerPlane = int(nModes_);
         forward_ = fftw_plan_many_dft_r2c
         (
-            2, dims, int(nPlanes_),
+            2, dims, int(localPlanes),
             real_, nullptr, 1, realPerPlane,
             spec, nullptr, 1, modesPerPlane,
             flags
         );
         backward_ = fftw_plan_many_dft_c2r
         (
-            2, dims, int(nPlanes_),
+            2, dims, int(localPlanes),
             spec, nullptr, 1, modesPerPlane,
             real_, nullptr, 1, realPerPlane,
             flags
         );
-        cosSlow_ = cosines(nSlow_);
-        cosFast_ = cosines(nFast_);
     }
     else
     {
@@ -169,6 +207,17 @@ std::size_t fdm::separableBoxSolver::index(long i, long j, long k) const
           + std::size_t(nFast_)*(ijk[slow_] + std::size_t(nSlow_)*ijk[wall_]);
     }
     return std::size_t(i) + std::size_t(n_[0])*(j + std::size_t(n_[1])*k);
+}
+
+
+std::size_t fdm::separableBoxSolver::inPlaneIndex(long i, long j, long k) const
+{
+    const long ijk[3] = {i, j, k};
+    if (wall_ >= 0)
+    {
+        return std::size_t(ijk[fast_]) + std::size_t(nFast_)*ijk[slow_];
+    }
+    return index(i, j, k);
 }
 
 
@@ -333,56 +382,107 @@ void fdm::separableBoxSolver::solve(const double* b, double* x)
     {
         throw std::logic_error("separableBoxSolver::solve before setCoefficients");
     }
+    if (planeEnd_ - planeBegin_ != nPlanes_)
+    {
+        throw std::logic_error
+        (
+            "separableBoxSolver::solve on a part of the box (planes "
+          + std::to_string(planeBegin_) + " to " + std::to_string(planeEnd_)
+          + "): solve in parts"
+        );
+    }
     std::copy(b, b + nCells_, real_);
-    fftw_execute(static_cast<fftw_plan>(forward_));
-
-    std::complex<double>* y = spectrum_;
+    forwardPlanes();
     if (wall_ < 0)
     {
         for (std::size_t m = 0; m < nModes_; ++m)
         {
-            y[m] *= invPivot_[m];
+            spectrum_[m] *= invPivot_[m];
         }
     }
     else
     {
-        // forward elimination, then back substitution, all modes of a
-        // plane at once (contiguous)
-        const auto& cWall = coeffs_.offDiag[wall_];
-        for (std::size_t m = 0; m < nModes_; ++m)
-        {
-            y[m] *= invPivot_[m];
-        }
-        for (long p = 1; p < nPlanes_; ++p)
-        {
-            std::complex<double>* yp = y + nModes_*p;
-            const std::complex<double>* yBelow = yp - nModes_;
-            const double* inv = invPivot_.data() + nModes_*p;
-            const double c = cWall[p-1];
-            for (std::size_t m = 0; m < nModes_; ++m)
-            {
-                yp[m] = (yp[m] - c*yBelow[m])*inv[m];
-            }
-        }
-        for (long p = nPlanes_ - 2; p >= 0; --p)
-        {
-            std::complex<double>* yp = y + nModes_*p;
-            const std::complex<double>* yAbove = yp + nModes_;
-            const double* up = upper_.data() + nModes_*p;
-            for (std::size_t m = 0; m < nModes_; ++m)
-            {
-                yp[m] -= up[m]*yAbove[m];
-            }
-        }
+        solveModes(spectrum_, 0, nModes_);
     }
+    backwardPlanes();
+    std::copy(real_, real_ + nCells_, x);
+}
 
+
+void fdm::separableBoxSolver::forwardPlanes()
+{
+    if (forward_)
+    {
+        fftw_execute(static_cast<fftw_plan>(forward_));
+    }
+}
+
+
+void fdm::separableBoxSolver::backwardPlanes()
+{
+    if (!backward_)
+    {
+        return;
+    }
     fftw_execute(static_cast<fftw_plan>(backward_));
     // FFTW's transforms are unnormalised: forward then backward multiplies
     // by the number of points transformed
     const double norm = 1.0/double(nSlow_*nFast_);
-    for (std::size_t c = 0; c < nCells_; ++c)
+    const std::size_t cells = std::size_t(nSlow_*nFast_)*(planeEnd_ - planeBegin_);
+    for (std::size_t c = 0; c < cells; ++c)
     {
-        x[c] = norm*real_[c];
+        real_[c] *= norm;
+    }
+}
+
+
+void fdm::separableBoxSolver::solveModes
+(
+    std::complex<double>* y,
+    const std::size_t modeBegin,
+    const std::size_t modeEnd
+) const
+{
+    if (!factorised_ || wall_ < 0 || modeBegin > modeEnd || modeEnd > nModes_)
+    {
+        throw std::logic_error
+        (
+            "separableBoxSolver::solveModes needs the coefficients, a wall"
+            " axis and modes within the "
+          + std::to_string(nModes_) + " in-plane modes"
+        );
+    }
+    // forward elimination, then back substitution, all modes of a plane at
+    // once (contiguous)
+    const std::size_t width = modeEnd - modeBegin;
+    const auto& cWall = coeffs_.offDiag[wall_];
+    {
+        const double* inv = invPivot_.data() + modeBegin;
+        for (std::size_t m = 0; m < width; ++m)
+        {
+            y[m] *= inv[m];
+        }
+    }
+    for (long p = 1; p < nPlanes_; ++p)
+    {
+        std::complex<double>* yp = y + width*p;
+        const std::complex<double>* yBelow = yp - width;
+        const double* inv = invPivot_.data() + nModes_*p + modeBegin;
+        const double c = cWall[p-1];
+        for (std::size_t m = 0; m < width; ++m)
+        {
+            yp[m] = (yp[m] - c*yBelow[m])*inv[m];
+        }
+    }
+    for (long p = nPlanes_ - 2; p >= 0; --p)
+    {
+        std::complex<double>* yp = y + width*p;
+        const std::complex<double>* yAbove = yp + width;
+        const double* up = upper_.data() + nModes_*p + modeBegin;
+        for (std::size_t m = 0; m < width; ++m)
+        {
+            yp[m] -= up[m]*yAbove[m];
+        }
     }
 }
 
