@@ -125,9 +125,9 @@ def steps_done(root):
         return 0
 
 
-def run_and_kill(root, env, who, at_step):
-    """fdmRun in root, SIGKILL of `who` once `at_step` steps are recorded; returns fdmRun's exit code."""
-    proc = subprocess.Popen([FDMRUN, "--quiet", root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, errors="replace",
+def run_and_kill(root, env, who, at_step, *options):
+    """fdmRun [options] in root, SIGKILL of `who` once `at_step` steps are recorded; returns fdmRun's exit code."""
+    proc = subprocess.Popen([FDMRUN, "--quiet"] + list(options) + [root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, errors="replace",
                             text=True)
     deadline = time.time() + 240
     while steps_done(root) < at_step and proc.poll() is None and time.time() < deadline:
@@ -683,6 +683,27 @@ def test_snapshot_continues_close_to_the_uninterrupted_run(snapshot_dir, tmp_pat
     # the run's own checkpoints replaced the installed one (and the copy of 0/ at its time)
     assert sorted(os.listdir(os.path.join(root, "fluid", "checkpoint"))) == ["fluid.45", "fluid.50"]
     assert not os.path.exists(os.path.join(root, "fluid", "1"))
+
+
+def test_snapshot_run_killed_before_its_first_checkpoint_resumes_from_the_snapshot(snapshot_dir, tmp_path, env,
+                                                                                  reference_extrapolated):
+    """A continued run killed (fdmDEM, SIGKILL) after its first fluid step, before its own first checkpoint (25):
+    `fdmRun --resume` takes the installed snapshot (step 20, the fluid again from rest), and the run ends
+    within the same bound of the uninterrupted one, each step recorded once."""
+    _, dest = snapshot_dir
+    root = snapshot_case(tmp_path / "case")
+    assert run_and_kill(root, env, "fdmDEM", 1, "--from-snapshot", dest) != 0
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode == 0, r.stdout
+    log = open(os.path.join(root, "log.fluid")).read()
+    assert "==== fdmRun --resume from step 20" in log and log.count("from a compact snapshot: the fluid from rest") == 2
+    assert fluid_steps(root) == [s for s in fluid_steps(reference_extrapolated) if s > SNAPSHOT_STEP]
+    got, order = trajectory(root)
+    ref, _ = trajectory(reference_extrapolated)
+    assert order == list(range(SNAPSHOT_STEP, STEPS + 1)), order
+    worst = max(float(np.max(np.abs(got[s] - ref[s]))) for s in order)
+    print("killed and resumed from the installed snapshot: largest position difference %.3g a" % worst)
+    assert worst <= SNAPSHOT_BOUND[30]
 
 
 def test_snapshot_of_another_scene_is_refused(snapshot_dir, tmp_path, env):

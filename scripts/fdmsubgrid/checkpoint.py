@@ -676,7 +676,7 @@ def _mesh_cells(fluid: str) -> int:
 def snapshot_install(dest: str, case_dir: str, dem_input: str, np_fluid: int, until: int | None = None) -> tuple[int, int]:
     """fdmRun --from-snapshot, once snapshot_check passed and the case is meshed (and decomposed): the same
     number of cells as the snapshot's run; then the snapshot installed as the case's checkpoint of its step:
-    dem/checkpoint/dem.STEP, fluid/checkpoint/fluid.STEP (the snapshot's time, time index and step count, this
+    dem/checkpoint/dem.STEP (its last step the run's), fluid/checkpoint/fluid.STEP (the snapshot's time, time index and step count, this
     case's cells and processors, fromRest 1) with the files of 0/ copied to the step's time directory (each
     processor's in parallel), and the calibration record of this case. Returns (step, last step)."""
     step, last = snapshot_check(dest, case_dir, dem_input, until)
@@ -699,9 +699,15 @@ def snapshot_install(dest: str, case_dir: str, dem_input: str, np_fluid: int, un
         for n in os.listdir(source):
             if os.path.isfile(os.path.join(source, n)):
                 shutil.copyfile(os.path.join(source, n), os.path.join(target, n))
+    # the DEM checkpoint as if this run had written it: its last step this run's (the header line, outside the
+    # CRC of the data), so that a plain --resume from it, before the run's own first checkpoint, ends there too
+    with open(snap["dem"], "rb") as f:
+        data = f.read()
+    start = len(DEM_MAGIC)
+    end = data.index(b"\n", start)
+    line = re.sub(rb"\blastStep=\d+", b"lastStep=%d" % last, data[start:end])
     os.makedirs(os.path.join(case_dir, "dem", "checkpoint"), exist_ok=True)
-    shutil.copyfile(snap["dem"], dem_file(case_dir, step) + ".tmp")
-    os.replace(dem_file(case_dir, step) + ".tmp", dem_file(case_dir, step))
+    write_atomically(dem_file(case_dir, step), data[:start] + line + data[end:])
     entries = dict(marker, cells=str(cells), processors=str(np_fluid), regularOutput="0", fromRest="1")
     os.makedirs(os.path.join(fluid, "checkpoint"), exist_ok=True)
     write_atomically(fluid_marker(case_dir, step),
