@@ -723,15 +723,19 @@ def test_snapshot_of_another_scene_is_refused(snapshot_dir, tmp_path, env):
     # another input: the spring's stiffness
     root = snapshot_case(tmp_path / "input")
     path = os.path.join(root, "dem", "in.couette")
-    open(path, "w").write(open(path).read().replace("contact 400 200", "contact 500 200"))
-    refused(root, "in.couette is not the input of the snapshot's run")
+    text = open(path).read()
+    with open(path, "w") as f:
+        f.write(text.replace("contact 400 200", "contact 500 200"))
+    refused(root, "in.couette is not the input of the snapshot's run %s/in.couette: line 8 is 'pair_style      "
+            "fdm/subgrid model cutoff contact 400 200 0.5 0.05" % dest)
     # another particle count (the data file)
     root = make_scene(str(tmp_path / "natoms"), fix_extra=EXTRAPOLATED, spheres=[(5.0, 2.55, 3.0, 1.0), (3.0, 3.45, 3.0, 1.0)])
     refused(root, "spheres.data has 2 particles, the snapshot %s/dem.20 holds 3" % dest)
     # a calibration record of another table
     changed = str(tmp_path / "changed")
     shutil.copytree(dest, changed)
-    json.dump({"table": "/elsewhere/subgrid_calibration.dat", "sha256": "0" * 64}, open(os.path.join(changed, "calibration.json"), "w"))
+    with open(os.path.join(changed, "calibration.json"), "w") as f:
+        json.dump({"table": "/elsewhere/subgrid_calibration.dat", "sha256": "0" * 64}, f)
     refused(snapshot_case(tmp_path / "calibration"), "the sub-grid calibration table differs from the run's: the "
             "snapshot's run used /elsewhere/subgrid_calibration.dat", changed)
     # an incomplete snapshot
@@ -744,7 +748,8 @@ def test_snapshot_of_another_scene_is_refused(snapshot_dir, tmp_path, env):
     root = snapshot_case(tmp_path / "mesh")
     path = os.path.join(root, "fluid", "system", "blockMeshDict")
     text = open(path).read()
-    open(path, "w").write(text.replace("(16 12 12)", "(20 15 15)"))
+    with open(path, "w") as f:
+        f.write(text.replace("(16 12 12)", "(20 15 15)"))
     assert open(path).read() != text
     r = fdm_run(root, env, "--from-snapshot", dest)
     assert r.returncode != 0 and "has 4500 cells, the snapshot's run had 2304" in r.stdout, r.stdout[-3000:]
