@@ -1,6 +1,8 @@
 // The particles' loads on the walls, a line per step (wall_loads_file.h).
 #include "wall_loads_file.h"
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -52,9 +54,13 @@ void WallLoadsFile::write(long long step, double dt, bool append, const StepLoad
 {
   static const char *faceNames[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
   if (!out_) {
+    // a resumed run appends to the file it continues; one without it (fdmRun --from-snapshot, a fresh
+    // case folder) starts it with the header
+    struct stat st;
+    const bool header = !append || ::stat(path_.c_str(), &st) != 0 || st.st_size == 0;
     out_ = std::fopen(path_.c_str(), append ? "a" : "w");
     if (!out_) throw std::runtime_error("walls: cannot open " + path_ + " for writing");
-    if (!append) {
+    if (header) {
       std::fprintf(out_, "# fix fdm/couple walls: force of the particles on each wall [N]: sub-grid lubrication "
                          "(Eq. D.6) and contact; timestep %.17g\n# step", dt);
       for (const Wall &w : walls_)

@@ -3,7 +3,8 @@
    particle, Eq. D.6) and contact (minus the wall contact forces of the step's force evaluation and of the
    implicit springs' increment over the step, Eq. C2 of docs/contact.md): the particle side of the momentum
    balance of a sheared suspension (docs/profiles.md). One text line per step after a two-line header; a
-   resumed run appends (fdmRun --resume cut the file at the checkpoint, fdm/checkpoint.py). Rank 0; no
+   resumed run appends (fdmRun --resume cut the file at the checkpoint, fdm/checkpoint.py), writing the header
+   first if the file is missing or empty (fdmRun --from-snapshot in a fresh case folder). Rank 0; no
    LIGGGHTS. Problems are thrown as std::runtime_error("walls: ..."). */
 
 #ifndef FDM_WALL_LOADS_FILE_H

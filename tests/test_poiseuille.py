@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import load_case_module
-from fdmsubgrid import contacts, output, poiseuille, shear
+from fdmsubgrid import checkpoint, contacts, output, poiseuille, shear
 
 SMALL = ["--size", "8", "12", "8", "--duration", "2", "--dump-every", "0.1", "--seed", "2", "--fluid-every", "1"]
 
@@ -180,6 +180,26 @@ def test_a_channel_starts_from_the_last_record_of_another(case_module, small_run
         poiseuille.packing_from_records(path, [8, 16, 8])
     with pytest.raises(SystemExit):
         case_module.main(["--from-records", path, "--size", "8", "16", "8", "--workdir", str(tmp_path)])
+
+
+def test_a_channel_continues_from_a_compact_snapshot_and_is_analysed(case_module, small_run, tmp_path):
+    """The small run's compact snapshot (its last checkpoint, step 40: the case script recorded the scene's
+    command, without where it was written) continued to time 3 by `--from-snapshot` in a new folder: the run
+    starts at step 41, its records after step 40, and the analysis of a run that starts at t = 2 works."""
+    dest = str(tmp_path / "snapshot")
+    assert checkpoint.snapshot(small_run["run_dir"], dest)["step"] == 40
+    scene = open(os.path.join(dest, "scene")).read()
+    assert scene == "python3 cases/poiseuille/poiseuille.py %s\n" % " ".join(SMALL), scene
+    args = SMALL[:SMALL.index("--duration")] + ["--duration", "3"] + SMALL[SMALL.index("--duration") + 2:]
+    r = case_module.main(args + ["--from-snapshot", dest, "--workdir", str(tmp_path / "work"),
+                                 "--out", str(tmp_path / "r.json")])
+    steps = output.steps(os.path.join(r["run_dir"], "fluid"))["step"].astype(int)
+    assert list(steps) == list(range(41, 61))
+    records = output.read_particle_records(os.path.join(r["run_dir"], "dem", "particles.records"), mmap=False)
+    assert list(records.steps) == list(range(42, 61, 2))
+    assert r["time"] == pytest.approx(3.0) and r["steps"] == 20 and r["unconverged_steps"] == 0
+    assert r["wall_force_balance_rel_error"] < 0.01
+    assert "==== fdmRun --from-snapshot %s: step 40 to 60" % dest in open(os.path.join(r["run_dir"], "log.fluid")).read()
 
 
 def test_budget_predicts_the_run_it_was_measured_on(case_module, small_run):

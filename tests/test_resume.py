@@ -125,9 +125,9 @@ def steps_done(root):
         return 0
 
 
-def run_and_kill(root, env, who, at_step):
-    """fdmRun in root, SIGKILL of `who` once `at_step` steps are recorded; returns fdmRun's exit code."""
-    proc = subprocess.Popen([FDMRUN, "--quiet", root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, errors="replace",
+def run_and_kill(root, env, who, at_step, *options):
+    """fdmRun [options] in root, SIGKILL of `who` once `at_step` steps are recorded; returns fdmRun's exit code."""
+    proc = subprocess.Popen([FDMRUN, "--quiet"] + list(options) + [root], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, errors="replace",
                             text=True)
     deadline = time.time() + 240
     while steps_done(root) < at_step and proc.poll() is None and time.time() < deadline:
@@ -576,3 +576,185 @@ def test_resume_with_another_held_drag_is_refused_and_loses_nothing(tmp_path, en
         f.write(text)
     r = fdm_run(root, env, "--resume")
     assert r.returncode == 0, r.stdout
+
+
+# ------------------------------------------------------------------------------------------------
+# compact snapshot: the particles of a checkpoint in a few plain files, continued in a fresh case
+# with the fluid from rest (fdmRun --from-snapshot; docs/coupling.md "Compact snapshot")
+# ------------------------------------------------------------------------------------------------
+
+SNAPSHOT_STEP = 20
+SCENE = "tests/test_resume.py make_scene(root, fix_extra='%s')" % EXTRAPOLATED
+# the largest position difference from the uninterrupted run over the first 1, 5 and 30 steps after the
+# snapshot (a): measured 0 (step 21 holds the drag: the snapshot's state alone), 4.8e-6 and 4.8e-6 (the
+# inner iteration's tolerance, tolLambda 1e-4, from two starting points); bounds 10 times that
+SNAPSHOT_BOUND = {1: 0.0, 5: 5e-5, 30: 5e-5}
+
+
+@pytest.fixture(scope="module")
+def snapshot_dir(tmp_path_factory, env):
+    """The extrapolated-held-drag scene run to step 20 (a run of its own, ended there: checkpoints 15
+    and 20), and its compact snapshot."""
+    root = str(tmp_path_factory.mktemp("to20"))
+    make_scene(root, steps=SNAPSHOT_STEP, fix_extra=EXTRAPOLATED)
+    r = fdm_run(root, env)
+    assert r.returncode == 0, r.stdout
+    dest = str(tmp_path_factory.mktemp("snapshot") / "snapshot")
+    done = checkpoint.snapshot(root, dest, scene=SCENE)
+    assert done["step"] == SNAPSHOT_STEP
+    return root, dest
+
+
+def snapshot_case(path):
+    """A case folder freshly written by the scene's command (the 50-step run)."""
+    return make_scene(str(path), fix_extra=EXTRAPOLATED)
+
+
+def test_snapshot_is_complete_and_compact(snapshot_dir, env):
+    """The snapshot is the newest checkpoint's DEM file as fdmDEM wrote it (positions, velocities, contact
+    history, the position update's history, the extrapolated held drag's last two fluid steps), the fluid
+    marker, the input, the calibration record, the scene command and a README: 6 plain files, a few kB for
+    3 spheres. A second snapshot replaces the first."""
+    root, dest = snapshot_dir
+    assert sorted(os.listdir(dest)) == ["README", "calibration.json", "dem.20", "fluid.20", "in.couette", "scene"]
+    with open(os.path.join(dest, "dem.20"), "rb") as f, open(checkpoint.dem_file(root, 20), "rb") as g:
+        assert f.read() == g.read()
+    header, arrays = checkpoint.read_dem_checkpoint(os.path.join(dest, "dem.20"))
+    assert header["step"] == 20 and header["natoms"] == 3
+    assert len(arrays["atoms"]) == 14 * 3
+    assert arrays["heldDrag"][0] == 1 and len(arrays["heldDragLast"]) == len(arrays["heldDragBefore"]) == 6 * 3
+    assert arrays["heldDrag"][1] > arrays["heldDrag"][2] > 0     # the steps of the two fluid steps' targets
+    assert len(arrays["currentVelocity"]) == len(arrays["previousVelocity"]) == 6 * 3 and arrays["moveRate"]
+    assert sum(arrays["contactHistoryLength"]) > 0      # the frictional contact's spring
+    marker = checkpoint.read_fluid_marker(os.path.join(dest, "fluid.20"))
+    # stepsDone: the fluid's steps (1, the even ones, the checkpoints' 5 and 15), the count particlesEvery goes on with
+    assert (marker["step"], marker["stepsDone"], marker["timeIndex"]) == ("20", "13", "20")
+    assert open(os.path.join(dest, "scene")).read() == SCENE + "\n"
+    size = sum(os.path.getsize(os.path.join(dest, n)) for n in os.listdir(dest))
+    print("snapshot of 3 spheres: %d bytes (%s)" % (size, ", ".join(
+        "%s %d" % (n, os.path.getsize(os.path.join(dest, n))) for n in sorted(os.listdir(dest)))))
+    assert size < 16000
+    # taken again from an earlier checkpoint (the newer one truncated): the folder holds that one only
+    other = os.path.join(os.path.dirname(dest), "again")
+    shutil.copytree(dest, other)
+    copy = os.path.join(os.path.dirname(dest), "run-copy")
+    shutil.copytree(root, copy)
+    with open(checkpoint.dem_file(copy, 20), "r+b") as f:
+        f.truncate(100)
+    assert checkpoint.snapshot(copy, other, scene=SCENE)["step"] == 15
+    assert sorted(n for n in os.listdir(other) if n[0] in "df") == ["dem.15", "fluid.15"]
+
+
+def test_snapshot_continues_close_to_the_uninterrupted_run(snapshot_dir, tmp_path, env, reference_extrapolated):
+    """The 50-step scene written afresh and continued from the snapshot of step 20 (fdmRun --from-snapshot):
+    the fluid restarts from rest at its first step, 22 (the first step's tolerances, tolLambda 1e-5 against 1e-4), the
+    particles from the snapshot; the records start at step 21 (the DEM dump at 20), the fluid solves the
+    uninterrupted run's steps, and the trajectory stays within SNAPSHOT_BOUND of it: not bit-exact, since
+    the inner iteration starts from rest instead of the previous step's fields."""
+    _, dest = snapshot_dir
+    root = snapshot_case(tmp_path / "case")
+    r = fdm_run(root, env, "--from-snapshot", dest)
+    assert r.returncode == 0, r.stdout
+    log = open(os.path.join(root, "log.fluid")).read()
+    assert "==== fdmRun --from-snapshot %s: step 20 to 50" % dest in log
+    assert "from a compact snapshot: the fluid from rest" in log
+    steps = fluid_steps(root)
+    assert steps == [s for s in fluid_steps(reference_extrapolated) if s > SNAPSHOT_STEP], steps
+    # the first fluid step after the snapshot, 22 (21 holds the drag of 20 and 18): from rest, to the first
+    # step's tolerance
+    inner = dict(zip(steps, output.steps(os.path.join(root, "fluid"))["innerIterations"]))
+    ref = output.steps(os.path.join(reference_extrapolated, "fluid"))
+    ref_inner = dict(zip(ref["step"].astype(int), ref["innerIterations"]))
+    print("inner iterations at step 22: %d from rest, %d uninterrupted" % (inner[22], ref_inner[22]))
+    assert steps[0] == 22 and inner[22] > ref_inner[22]
+    got, order = trajectory(root)
+    ref, _ = trajectory(reference_extrapolated)
+    assert order == list(range(SNAPSHOT_STEP, STEPS + 1)), order
+    assert float(np.max(np.abs(got[SNAPSHOT_STEP] - ref[SNAPSHOT_STEP]))) == 0    # the snapshot's positions
+    records = output.read_particle_records(os.path.join(root, "dem", "particles.records"), mmap=False)
+    assert list(records.steps) == list(range(SNAPSHOT_STEP + 1, STEPS + 1))
+    worst = {}
+    for after, bound in SNAPSHOT_BOUND.items():
+        worst[after] = max(float(np.max(np.abs(got[s] - ref[s]))) for s in range(SNAPSHOT_STEP + 1, SNAPSHOT_STEP + after + 1))
+    print("largest position difference from the uninterrupted run over the first 1, 5, 30 steps: %s (a)"
+          % ", ".join("%.3g" % worst[k] for k in sorted(worst)))
+    for after, bound in SNAPSHOT_BOUND.items():
+        assert worst[after] <= bound, (after, worst)
+    # the run's own checkpoints replaced the installed one (and the copy of 0/ at its time)
+    assert sorted(os.listdir(os.path.join(root, "fluid", "checkpoint"))) == ["fluid.45", "fluid.50"]
+    assert not os.path.exists(os.path.join(root, "fluid", "1"))
+
+
+def test_snapshot_run_killed_before_its_first_checkpoint_resumes_from_the_snapshot(snapshot_dir, tmp_path, env,
+                                                                                  reference_extrapolated):
+    """A continued run killed (fdmDEM, SIGKILL) after its first fluid step, before its own first checkpoint (25):
+    `fdmRun --resume` takes the installed snapshot (step 20, the fluid again from rest), and the run ends
+    within the same bound of the uninterrupted one, each step recorded once."""
+    _, dest = snapshot_dir
+    root = snapshot_case(tmp_path / "case")
+    assert run_and_kill(root, env, "fdmDEM", 1, "--from-snapshot", dest) != 0
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode == 0, r.stdout
+    log = open(os.path.join(root, "log.fluid")).read()
+    assert "==== fdmRun --resume from step 20" in log and log.count("from a compact snapshot: the fluid from rest") == 2
+    assert fluid_steps(root) == [s for s in fluid_steps(reference_extrapolated) if s > SNAPSHOT_STEP]
+    got, order = trajectory(root)
+    ref, _ = trajectory(reference_extrapolated)
+    assert order == list(range(SNAPSHOT_STEP, STEPS + 1)), order
+    worst = max(float(np.max(np.abs(got[s] - ref[s]))) for s in order)
+    print("killed and resumed from the installed snapshot: largest position difference %.3g a" % worst)
+    assert worst <= SNAPSHOT_BOUND[30]
+
+
+def test_snapshot_of_another_scene_is_refused(snapshot_dir, tmp_path, env):
+    """fdmRun --from-snapshot refuses, naming the file and the value, before the case changes: a case that
+    holds a run, another input, another particle count, a changed calibration table, an incomplete snapshot,
+    another mesh."""
+    _, dest = snapshot_dir
+
+    def refused(root, message, snapshot=dest):
+        before = sorted(os.path.relpath(os.path.join(d, n), root) for d, _, files in os.walk(root) for n in files)
+        r = fdm_run(root, env, "--from-snapshot", snapshot)
+        assert r.returncode != 0 and message in r.stdout, (message, r.stdout[-3000:])
+        after = sorted(os.path.relpath(os.path.join(d, n), root) for d, _, files in os.walk(root) for n in files
+                       if "polyMesh" not in d and n != "log.blockMesh")
+        assert after == [p for p in before if "polyMesh" not in p], "the case changed"
+
+    # another input: the spring's stiffness
+    root = snapshot_case(tmp_path / "input")
+    path = os.path.join(root, "dem", "in.couette")
+    text = open(path).read()
+    with open(path, "w") as f:
+        f.write(text.replace("contact 400 200", "contact 500 200"))
+    refused(root, "in.couette is not the input of the snapshot's run %s/in.couette: line 8 is 'pair_style      "
+            "fdm/subgrid model cutoff contact 400 200 0.5 0.05" % dest)
+    # another particle count (the data file)
+    root = make_scene(str(tmp_path / "natoms"), fix_extra=EXTRAPOLATED, spheres=[(5.0, 2.55, 3.0, 1.0), (3.0, 3.45, 3.0, 1.0)])
+    refused(root, "spheres.data has 2 particles, the snapshot %s/dem.20 holds 3" % dest)
+    # a calibration record of another table
+    changed = str(tmp_path / "changed")
+    shutil.copytree(dest, changed)
+    with open(os.path.join(changed, "calibration.json"), "w") as f:
+        json.dump({"table": "/elsewhere/subgrid_calibration.dat", "sha256": "0" * 64}, f)
+    refused(snapshot_case(tmp_path / "calibration"), "the sub-grid calibration table differs from the run's: the "
+            "snapshot's run used /elsewhere/subgrid_calibration.dat", changed)
+    # an incomplete snapshot
+    incomplete = str(tmp_path / "incomplete")
+    shutil.copytree(dest, incomplete)
+    os.remove(os.path.join(incomplete, "fluid.20"))
+    refused(snapshot_case(tmp_path / "incomplete-case"), "is not a complete snapshot: it needs one dem.STEP and the "
+            "fluid.STEP", incomplete)
+    # another mesh (cells of 0.4 instead of 0.5: the same input)
+    root = snapshot_case(tmp_path / "mesh")
+    path = os.path.join(root, "fluid", "system", "blockMeshDict")
+    text = open(path).read()
+    with open(path, "w") as f:
+        f.write(text.replace("(16 12 12)", "(20 15 15)"))
+    assert open(path).read() != text
+    r = fdm_run(root, env, "--from-snapshot", dest)
+    assert r.returncode != 0 and "has 4500 cells, the snapshot's run had 2304" in r.stdout, r.stdout[-3000:]
+    # a case that holds a run
+    root = snapshot_case(tmp_path / "ran")
+    assert fdm_run(root, env, "--from-snapshot", dest).returncode == 0
+    r = fdm_run(root, env, "--from-snapshot", dest)
+    assert r.returncode != 0 and "--from-snapshot: %s holds a run" % root in r.stdout, r.stdout

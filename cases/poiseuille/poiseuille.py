@@ -19,6 +19,8 @@ a LIGGGHTS atom type, the smallest setting the mesh and the time step (fdmsubgri
   poiseuille.py --paper         writes the paper's (40, 40, 20) a1 channel (not run; --run runs it)
   poiseuille.py --write-only    writes the scene and stops (fdmRun runs it)
   poiseuille.py --analyse RUN   the analysis of a run folder as it stands
+  poiseuille.py ... --from-snapshot DIR   writes the scene of these options and continues the compact
+                                snapshot DIR in it (its file `scene` holds the options; docs/coupling.md)
   poiseuille.py --help          every option
 Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_poiseuille.png here (docs/cases.md).
 The migration time grows as L_y^2: the paper reached the steady state after about 1500 time units at
@@ -35,7 +37,7 @@ from typing import Any, List, Optional, Sequence
 
 import numpy as np
 
-from fdmsubgrid import case, couettescene, packing, poiseuille, sbm, suspension
+from fdmsubgrid import case, checkpoint, couettescene, packing, poiseuille, sbm, suspension
 from fdmsubgrid.results import Row, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -105,6 +107,10 @@ def main(argv: list[str] | None = None) -> dict:
                         "particles.records of a run of the same channel, e.g. its dense core) instead of a "
                         "random packing; the contacts' tangential history and the fluid start afresh")
     case.add_size_options(p)
+    p.add_argument("--from-snapshot", metavar="SNAPSHOT", default=None,
+                   help="continue the compact snapshot in this folder (python3 -m fdmsubgrid.checkpoint snapshot RUN "
+                        "DIR) in the scene these options write: the particles from its step on, the fluid from rest "
+                        "(fdmRun --from-snapshot; docs/coupling.md \"Compact snapshot\")")
     case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
     args = p.parse_args(argv)
     started = time.time()
@@ -201,16 +207,20 @@ def main(argv: list[str] | None = None) -> dict:
                                   args.acceleration, args.n_max, write_every, model=args.model,
                                   grad_p0=(grad, 0.0, 0.0), name="in.poiseuille", fluid_every=K,
                                   held_drag=args.held_drag)
+    # the command that writes this scene again, for a compact snapshot of its run
+    checkpoint.write_scene_command(run_dir, __file__, sys.argv[1:] if argv is None else list(argv))
     print("wrote %s: %d spheres (%s), phi %.4f, channel %s a1, %d cells, dP0/dx = %.4g Pa/m (U_c = %g), "
           "%d steps of dt %g L_y/(2U_c), a snapshot every %d steps"
           % (run_dir, pack.n, couettescene.species_text(pack), pack.phi,
              " x ".join("%g" % v for v in args.size), scene["cells"], grad, u_c, steps, args.dt, every))
     if (args.paper and not args.run) or args.write_only:
-        print("%s written, not run: fdmRun -f N -d M %s" % ("the paper's channel" if args.paper else "the scene",
-                                                            run_dir))
+        print("%s written, not run: fdmRun -f N -d M %s%s" % ("the paper's channel" if args.paper else "the scene",
+                                                              "--from-snapshot %s " % args.from_snapshot
+                                                              if args.from_snapshot else "", run_dir))
         return dict(run_dir=run_dir, **scene)
 
-    case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
+    case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem,
+             extra=("--from-snapshot", args.from_snapshot) if args.from_snapshot else ())
     results = report(run_dir, args.out, material, args.from_time, argv, args, started, table8,
                      args.plateau_threshold)
     if not args.keep:

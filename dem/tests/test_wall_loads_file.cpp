@@ -62,6 +62,25 @@ TEST(WallLoadsFile, AHeaderThenALinePerStepAndAResumedRunAppends)
   std::remove(path.c_str());
 }
 
+TEST(WallLoadsFile, AResumedRunWithoutTheFileStartsItWithTheHeader)
+{
+  // fdmRun --from-snapshot: a run resumed in a fresh case folder, where no earlier run wrote the file
+  const std::string path = fdm::testing::scratchPath("fdmWallLoadsTest", "fresh-walls.dat");
+  std::remove(path.c_str());
+  {
+    fdm::WallLoadsFile resumed(path, {{1, 0}, {1, 1}});
+    resumed.write(401, 0.05, true, loads());
+    resumed.write(402, 0.05, true, loads());
+  }
+  const std::string text = read(path);
+  EXPECT_EQ(text.find("# fix fdm/couple walls: force of the particles on each wall [N]"), 0u) << text;
+  EXPECT_NE(text.find("\n# step ylo:subgridX"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n401 -1.5"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n402 -1.5"), std::string::npos) << text;
+  EXPECT_EQ(text.find("# fix", 1), std::string::npos);   // one header
+  std::remove(path.c_str());
+}
+
 TEST(WallLoadsFile, BlocksAndWallIndicesMustAgree)
 {
   const fdm::WallLoadsFile file("unused", {{1, 0}});

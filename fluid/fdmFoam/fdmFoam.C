@@ -194,7 +194,9 @@ int main(int argc, char *argv[])
         meanFlow.setForcedCells(forcing.covered());
         stepParticleTime += wallClock() - stepStart;
 
-        const bool firstStep = (stepsBefore + nStepsDone == 0);
+        // the run's first step, or the first after a compact snapshot's
+        // restart from rest (fluidCheckpoint::fromRest)
+        const bool firstStep = resumed.firstStep(nStepsDone);
         const label nMax = firstStep ? nInnerMaxFirst : nInnerMax;
         convergence.reset
         (

@@ -22,7 +22,29 @@ each code keeps its two newest.
     python3 -m fdmsubgrid.checkpoint check-stamp CASE INPUT [--new-calibration]
                                                  on a resume: refuse if that table changed since (a run
                                                  never mixes two sub-grid models), unless asked
+
+A compact snapshot (docs/coupling.md, "Compact snapshot") is the particle state of the newest checkpoint
+in a small folder of plain files, to keep (e.g. in git) when the run folder may be lost; fdmRun
+--from-snapshot continues from it in a case folder freshly written by the same scene command, the fluid
+recomputed from the particles:
+
+    python3 -m fdmsubgrid.checkpoint snapshot CASE DEST [--scene COMMAND] [--dem-input NAME]
+                                                 write DEST (replacing the snapshot there): dem.STEP
+                                                 (the DEM checkpoint as fdmDEM wrote it), fluid.STEP (the
+                                                 fluid marker), the LIGGGHTS input, calibration.json (the
+                                                 run's CASE/.fdmRun-calibration), scene (the command that
+                                                 writes the scene: --scene, else CASE/scene) and README
+    python3 -m fdmsubgrid.checkpoint snapshot-check DEST CASE INPUT [L]
+                                                 fdmRun --from-snapshot, before anything changes: DEST is
+                                                 complete and of CASE's scene (input, particles, box,
+                                                 calibration table), the run goes on after its step; prints
+                                                 "STEP LAST" (L: --until)
+    python3 -m fdmsubgrid.checkpoint snapshot-install DEST CASE INPUT NP_FLUID [L]
+                                                 then, once meshed (and decomposed): the same mesh; DEM
+                                                 checkpoint, fluid marker (fromRest: the fields of 0/) and
+                                                 calibration record installed as CASE's checkpoint of STEP
 """
+import array
 import hashlib
 import json
 import os
@@ -117,16 +139,28 @@ def fluid_problem(case_dir, step):
     procs = int(m["processors"])
     dirs = [os.path.join(fluid, m["timeName"])] if procs == 1 else \
         [os.path.join(fluid, "processor%d" % p, m["timeName"]) for p in range(procs)]
+    # a compact snapshot's restart (fromRest) has the fields of 0/ there, lambda only if 0/ has it
+    fields = ("U", "p") if m.get("fromRest") == "1" else ("U", "p", "lambda")
     for d in dirs:
-        for field in ("U", "p", "lambda"):
+        for field in fields:
             if not os.path.isfile(os.path.join(d, field)) or os.path.getsize(os.path.join(d, field)) == 0:
                 return "its field %s is missing or empty in %s" % (field, os.path.relpath(d, case_dir))
     return None
 
 
-def select(case_dir):
+def _marker_problem(case_dir, step):
+    """None if fdmFoam's marker of step is complete, else what is wrong."""
+    try:
+        read_fluid_marker(fluid_marker(case_dir, step))
+    except CheckpointError as e:
+        return str(e)
+    return None
+
+
+def select(case_dir, fields=True):
     """(step, notes): the newest step whose checkpoints of both codes are complete, and why newer ones
-    were passed over. CheckpointError if there is none."""
+    were passed over. CheckpointError if there is none. fields=False: the fluid's marker suffices (a
+    compact snapshot does not take the fluid fields, which a case script may have deleted)."""
     fluid_steps = _steps(os.path.join(case_dir, "fluid", "checkpoint"), "fluid.")
     dem_steps = _steps(os.path.join(case_dir, "dem", "checkpoint"), "dem.")
     notes = []
@@ -141,7 +175,7 @@ def select(case_dir):
         if step not in fluid_steps:
             problems.append("fdmFoam has no checkpoint of it (killed before or while writing it?)")
         else:
-            p = fluid_problem(case_dir, step)
+            p = fluid_problem(case_dir, step) if fields else _marker_problem(case_dir, step)
             if p:
                 problems.append("fdmFoam's checkpoint: %s" % p)
         if not problems:
@@ -368,6 +402,321 @@ def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
     return "--new-calibration: continues with %s (it began with %s)" % (describe(now), describe(then))
 
 
+# ---- compact snapshot ----------------------------------------------------------------------------
+
+SCENE_FILE = "scene"                 # in a case folder and in a snapshot: the command that writes the scene
+SNAPSHOT_CALIBRATION = "calibration.json"
+# the options of a case script that say where, not what: left out of the scene command it records
+_WHERE_OPTIONS = ("--workdir", "--out", "--from-snapshot")
+_WHERE_FLAGS = ("--overwrite", "--keep")
+
+
+def scene_command(script: str, argv: list[str]) -> str:
+    """The command line that writes a case script's scene again: the script (relative to the repository,
+    run from its root) and its options, without those that say where it is written or what happens to an
+    older folder (--workdir, --out, --from-snapshot, --overwrite, --keep)."""
+    root = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+    path = os.path.relpath(os.path.abspath(script), root)
+    kept, skip = [], False
+    for word in argv:
+        if skip:
+            skip = False
+            continue
+        name = word.split("=", 1)[0]
+        if name in _WHERE_OPTIONS:
+            skip = "=" not in word
+            continue
+        if word in _WHERE_FLAGS:
+            continue
+        kept.append(word)
+    return shlex.join(["python3", path] + kept)
+
+
+def write_scene_command(case_dir: str, script: str, argv: list[str]) -> str:
+    """Record in CASE/scene the command that writes this scene (scene_command), for a snapshot of its run."""
+    command = scene_command(script, argv)
+    write_atomically(os.path.join(case_dir, SCENE_FILE), command + "\n")
+    return command
+
+
+def _dem_header(path: str) -> dict:
+    """The header entries of a DEM checkpoint (step, lastStep, natoms, dt, boxlo, boxhi)."""
+    with open(path, "rb") as f:
+        f.readline()
+        words = f.readline().decode(errors="replace").split()
+    entries = dict(w.split("=", 1) for w in words if "=" in w)
+    try:
+        return dict(step=int(entries["step"]), lastStep=int(entries["lastStep"]), natoms=int(entries["natoms"]),
+                    dt=float(entries["dt"]), boxlo=[float(v) for v in entries["boxlo"].split(",")],
+                    boxhi=[float(v) for v in entries["boxhi"].split(",")])
+    except (KeyError, ValueError):
+        raise CheckpointError("%s: its header line %r is not that of a particle checkpoint" % (path, " ".join(words)))
+
+
+def read_dem_checkpoint(path: str) -> tuple[dict, dict]:
+    """(header, arrays) of a DEM checkpoint file (dem/particle_checkpoint.h): the header entries as
+    _dem_header gives them and {name: list of floats} for each array, e.g. arrays["atoms"] (14 per particle)
+    or arrays["heldDragLast"]. CheckpointError if the file is not complete and intact."""
+    problem = dem_problem(path)
+    if problem:
+        raise CheckpointError("%s %s" % (path, problem))
+    header = _dem_header(path)
+    with open(path, "rb") as f:
+        data = f.read()
+    counts, pos = [], len(DEM_MAGIC)
+    pos = data.index(b"\n", pos) + 1                       # the header line
+    while not data.startswith(b"data ", pos):
+        end = data.index(b"\n", pos)
+        _, name, count = data[pos:end].decode().split()
+        counts.append((name, int(count)))
+        pos = end + 1
+    pos = data.index(b"\n", pos) + 1
+    arrays = {}
+    for name, count in counts:
+        values = array.array("d")
+        values.frombytes(data[pos:pos + 8 * count])
+        arrays[name] = values.tolist()
+        pos += 8 * count
+    return header, arrays
+
+
+def _dem_input_name(case_dir: str, dem_input: str | None) -> str:
+    if dem_input:
+        return dem_input
+    names = sorted(n for n in os.listdir(os.path.join(case_dir, "dem")) if n.startswith("in."))
+    if len(names) != 1:
+        raise CheckpointError("%s/dem has %d in.* files (%s): name the LIGGGHTS input with --dem-input"
+                              % (case_dir, len(names), ", ".join(names) or "none"))
+    return names[0]
+
+
+def snapshot(case_dir: str, dest: str, scene: str | None = None, dem_input: str | None = None) -> dict:
+    """Write the compact snapshot of the run in case_dir to the folder dest (module docstring), replacing
+    whatever snapshot dest held: the newest step both codes checkpointed completely (select). The new
+    folder is written beside dest and then put in its place. Returns {step, files: {name: bytes}, bytes}."""
+    step, _ = select(case_dir, fields=False)
+    name = _dem_input_name(case_dir, dem_input)
+    if scene is None:
+        path = os.path.join(case_dir, SCENE_FILE)
+        if not os.path.isfile(path):
+            raise CheckpointError("%s has no %s file (the command that writes the scene; the case scripts write it): "
+                                  "give it with --scene COMMAND" % (case_dir, SCENE_FILE))
+        with open(path) as f:
+            scene = f.read().strip()
+    stamp_path = os.path.join(case_dir, CALIBRATION_STAMP)
+    if not os.path.isfile(stamp_path):
+        raise CheckpointError("%s is missing: the run's record of its calibration table (fdmRun writes it when a run "
+                              "starts or resumes)" % stamp_path)
+    marker = read_fluid_marker(fluid_marker(case_dir, step))
+    dest = os.path.abspath(dest)
+    new = dest + ".new"
+    shutil.rmtree(new, ignore_errors=True)
+    os.makedirs(new)
+    shutil.copyfile(dem_file(case_dir, step), os.path.join(new, "dem.%d" % step))
+    shutil.copyfile(fluid_marker(case_dir, step), os.path.join(new, "fluid.%d" % step))
+    shutil.copyfile(os.path.join(case_dir, "dem", name), os.path.join(new, name))
+    shutil.copyfile(stamp_path, os.path.join(new, SNAPSHOT_CALIBRATION))
+    with open(os.path.join(new, SCENE_FILE), "w") as f:
+        f.write(scene + "\n")
+    with open(os.path.join(new, "README"), "w") as f:
+        f.write("Compact snapshot of a coupled run at step %d (time %s), docs/coupling.md \"Compact snapshot\".\n"
+                "To continue it: write the scene with the command in %s (in a new folder CASE), then\n"
+                "    fdmRun --from-snapshot THIS_FOLDER CASE\n"
+                "(case scripts: add --from-snapshot THIS_FOLDER to the command). The fluid restarts from rest.\n"
+                "dem.%d: the particles, their contact history and the position update's history (fdmDEM's\n"
+                "checkpoint, dem/particle_checkpoint.h); fluid.%d: the fluid's step, time and step count;\n"
+                "%s: the LIGGGHTS input; %s: the calibration table the run used.\n"
+                % (step, marker["time"], SCENE_FILE, step, step, name, SNAPSHOT_CALIBRATION))
+    check_snapshot(new)
+    old = dest + ".old"
+    shutil.rmtree(old, ignore_errors=True)
+    if os.path.exists(dest):
+        os.rename(dest, old)
+    os.rename(new, dest)
+    shutil.rmtree(old, ignore_errors=True)
+    files = {n: os.path.getsize(os.path.join(dest, n)) for n in sorted(os.listdir(dest))}
+    return dict(step=step, files=files, bytes=sum(files.values()))
+
+
+def check_snapshot(dest: str) -> dict:
+    """The parts of the snapshot in dest, checked complete: {step, dem, marker, input, scene, calibration}
+    (paths, the marker's entries and the DEM header). CheckpointError naming the file otherwise."""
+    if not os.path.isdir(dest):
+        raise CheckpointError("%s is not a folder (a compact snapshot: python3 -m fdmsubgrid.checkpoint snapshot)"
+                              % dest)
+    names = os.listdir(dest)
+    dem = _steps(dest, "dem.")
+    fluid = _steps(dest, "fluid.")
+    inputs = [n for n in names if n.startswith("in.")]
+    if len(dem) != 1 or fluid != dem:
+        raise CheckpointError("%s is not a complete snapshot: it needs one dem.STEP and the fluid.STEP of the same "
+                              "step, it has %s" % (dest, ", ".join(sorted(n for n in names if n.startswith(("dem.", "fluid."))))
+                                                   or "neither"))
+    if len(inputs) != 1:
+        raise CheckpointError("%s is not a complete snapshot: it needs one LIGGGHTS input in.*, it has %d"
+                              % (dest, len(inputs)))
+    for n in (SCENE_FILE, SNAPSHOT_CALIBRATION):
+        if n not in names:
+            raise CheckpointError("%s is not a complete snapshot: %s is missing" % (dest, n))
+    step = dem[0]
+    path = os.path.join(dest, "dem.%d" % step)
+    problem = dem_problem(path)
+    if problem:
+        raise CheckpointError("%s %s" % (path, problem))
+    header = _dem_header(path)
+    marker = read_fluid_marker(os.path.join(dest, "fluid.%d" % step))
+    if header["step"] != step or int(marker["step"]) != step:
+        raise CheckpointError("%s: dem.%d holds step %d and fluid.%d step %s" % (dest, step, header["step"], step,
+                                                                                  marker["step"]))
+    with open(os.path.join(dest, SNAPSHOT_CALIBRATION)) as f:
+        calibration = json.load(f)
+    return dict(step=step, dem=path, header=header, marker=marker, input=os.path.join(dest, inputs[0]),
+                scene=os.path.join(dest, SCENE_FILE), calibration=calibration)
+
+
+def _without_run(text: str) -> list[str]:
+    """The input's lines, its run command masked (the run's length is the case's)."""
+    return ["run ..." if _RUN_COMMAND.fullmatch(line) else line for line in text.splitlines()]
+
+
+def _last_step(dem_input: str) -> int:
+    with open(dem_input) as f:
+        commands = list(_RUN_COMMAND.finditer(f.read()))
+    found = _RUN_UPTO.match(commands[0].group(0)) if len(commands) == 1 else None
+    if not found:
+        raise CheckpointError("%s: a run continued from a snapshot needs one run command 'run N upto' (docs/coupling.md)"
+                              % dem_input)
+    return int(found.group(2))
+
+
+def _data_file(dem_input: str) -> str | None:
+    """The data file the input reads (read_data FILE, relative to the input's folder), or None."""
+    with open(dem_input) as f:
+        for line in f:
+            words = line.split("#", 1)[0].split()
+            if len(words) >= 2 and words[0] == "read_data":
+                return os.path.join(os.path.dirname(os.path.abspath(dem_input)), words[1])
+    return None
+
+
+def _data_scene(path: str) -> tuple[int, list[float], list[float]]:
+    """(atoms, box lo, box hi) of a LIGGGHTS data file's header."""
+    atoms, lo, hi = None, [None] * 3, [None] * 3
+    with open(path) as f:
+        for line in f:
+            words = line.split()
+            if len(words) == 2 and words[1] == "atoms":
+                atoms = int(words[0])
+            elif len(words) == 4 and words[2] in ("xlo", "ylo", "zlo"):
+                d = "xyz".index(words[2][0])
+                lo[d], hi[d] = float(words[0]), float(words[1])
+            elif words and words[0] in ("Atoms", "Velocities"):
+                break
+    if atoms is None or None in lo:
+        raise CheckpointError("%s: no 'N atoms' or box lines in its header" % path)
+    return atoms, lo, hi
+
+
+def snapshot_check(dest: str, case_dir: str, dem_input: str, until: int | None = None) -> tuple[int, int]:
+    """Before fdmRun --from-snapshot changes anything: the snapshot in dest is complete and of the scene in
+    case_dir (its LIGGGHTS input the snapshot's but for the run command; the particle count and box of its
+    data file the checkpoint's; the calibration table it reads the one the run used, by SHA-256), and the
+    run goes on after the snapshot's step (to the input's last step, or `until`). Returns (step, last step)."""
+    snap = check_snapshot(dest)
+    step, header = snap["step"], snap["header"]
+    with open(snap["input"]) as f:
+        theirs = _without_run(f.read())
+    with open(dem_input) as f:
+        ours = _without_run(f.read())
+    if theirs != ours:
+        k = next((k for k, (a, b) in enumerate(zip(theirs, ours)) if a != b), min(len(theirs), len(ours)))
+        line = lambda lines: repr(lines[k]) if k < len(lines) else "(the end of the file)"
+        raise CheckpointError("%s is not the input of the snapshot's run %s: line %d is %s there, %s here. Write the "
+                              "case with the command in %s" % (dem_input, snap["input"], k + 1, line(theirs), line(ours),
+                                                               snap["scene"]))
+    data = _data_file(dem_input)
+    if data and os.path.isfile(data):
+        atoms, lo, hi = _data_scene(data)
+        if atoms != header["natoms"]:
+            raise CheckpointError("%s has %d particles, the snapshot %s holds %d" % (data, atoms, snap["dem"],
+                                                                                   header["natoms"]))
+        for d in range(3):
+            span = header["boxhi"][d] - header["boxlo"][d]
+            if abs(lo[d] - header["boxlo"][d]) + abs(hi[d] - header["boxhi"][d]) > 1e-12 * span:
+                raise CheckpointError("%s: the box spans %.17g .. %.17g in %s, the snapshot %s's %.17g .. %.17g"
+                                      % (data, lo[d], hi[d], "xyz"[d], snap["dem"], header["boxlo"][d],
+                                         header["boxhi"][d]))
+    now = _table_identity(calibration_table(dem_input))
+    then = snap["calibration"]
+    if now["sha256"] != then.get("sha256"):
+        describe = lambda d: "no table" if d.get("table") is None else "%s (sha256 %s)" % (d["table"], d["sha256"][:12])
+        raise CheckpointError("the sub-grid calibration table differs from the run's: the snapshot's run used %s "
+                              "(recorded in %s), %s reads %s. Continuing would mix two sub-grid models in one run: "
+                              "check out the table the run used (git log -- dem/resistance/data)"
+                              % (describe(then), os.path.join(dest, SNAPSHOT_CALIBRATION), dem_input, describe(now)))
+    last = until if until is not None else _last_step(dem_input)
+    if last <= step:
+        raise CheckpointError("the snapshot is of step %d but %s runs to step %d: write the scene for a longer run, "
+                              "or give --until L" % (step, dem_input if until is None else "--until", last))
+    return step, last
+
+
+def _mesh_cells(fluid: str) -> int:
+    from .decomposition import DecompositionError, _read_foam_file
+    try:
+        header, _ = _read_foam_file(os.path.join(fluid, "constant", "polyMesh", "owner"))
+    except DecompositionError as e:
+        raise CheckpointError(str(e))
+    found = re.search(r"nCells:\s*(\d+)", header.get("note", ""))
+    if not found:
+        raise CheckpointError("%s/constant/polyMesh/owner: no nCells in its note" % fluid)
+    return int(found.group(1))
+
+
+def snapshot_install(dest: str, case_dir: str, dem_input: str, np_fluid: int, until: int | None = None) -> tuple[int, int]:
+    """fdmRun --from-snapshot, once snapshot_check passed and the case is meshed (and decomposed): the same
+    number of cells as the snapshot's run; then the snapshot installed as the case's checkpoint of its step:
+    dem/checkpoint/dem.STEP (its last step the run's), fluid/checkpoint/fluid.STEP (the snapshot's time, time index and step count, this
+    case's cells and processors, fromRest 1) with the files of 0/ copied to the step's time directory (each
+    processor's in parallel), and the calibration record of this case. Returns (step, last step)."""
+    step, last = snapshot_check(dest, case_dir, dem_input, until)
+    snap = check_snapshot(dest)
+    marker = snap["marker"]
+    fluid = os.path.join(case_dir, "fluid")
+    cells = _mesh_cells(fluid)
+    if cells != int(marker["cells"]):
+        raise CheckpointError("%s has %d cells, the snapshot's run had %s (%s): write the case with the command in %s"
+                              % (os.path.join(fluid, "constant", "polyMesh"), cells, marker["cells"],
+                                 os.path.join(dest, "fluid.%d" % step), snap["scene"]))
+    if until is not None:
+        set_last_step(dem_input, until, step)
+    bases = [fluid] if np_fluid == 1 else [os.path.join(fluid, "processor%d" % p) for p in range(np_fluid)]
+    for base in bases:
+        source, target = os.path.join(base, "0"), os.path.join(base, marker["timeName"])
+        if not os.path.isdir(source):
+            raise CheckpointError("%s is missing: the fluid restarts from the fields of 0/" % source)
+        os.makedirs(target, exist_ok=True)
+        for n in os.listdir(source):
+            if os.path.isfile(os.path.join(source, n)):
+                shutil.copyfile(os.path.join(source, n), os.path.join(target, n))
+    # the DEM checkpoint as if this run had written it: its last step this run's (the header line, outside the
+    # CRC of the data), so that a plain --resume from it, before the run's own first checkpoint, ends there too
+    with open(snap["dem"], "rb") as f:
+        data = f.read()
+    start = len(DEM_MAGIC)
+    end = data.index(b"\n", start)
+    line = re.sub(rb"\blastStep=\d+", b"lastStep=%d" % last, data[start:end])
+    os.makedirs(os.path.join(case_dir, "dem", "checkpoint"), exist_ok=True)
+    write_atomically(dem_file(case_dir, step), data[:start] + line + data[end:])
+    entries = dict(marker, cells=str(cells), processors=str(np_fluid), regularOutput="0", fromRest="1")
+    os.makedirs(os.path.join(fluid, "checkpoint"), exist_ok=True)
+    write_atomically(fluid_marker(case_dir, step),
+                     "# fdmRun --from-snapshot %s: the fields of 0/ in %s/ (the fluid from rest)\n"
+                     % (dest, marker["timeName"]) + "".join("%s %s\n" % kv for kv in entries.items()) + "end\n")
+    stamp(case_dir, dem_input)
+    return step, last
+
+
 def main(argv):
     if len(argv) >= 2 and argv[0] == "select":
         try:
@@ -400,6 +749,27 @@ def main(argv):
             print(e, file=sys.stderr)
             return 1
         return 0
+    try:
+        if len(argv) >= 3 and argv[0] == "snapshot":
+            options = dict(zip(argv[3::2], argv[4::2]))
+            unknown = set(options) - {"--scene", "--dem-input"}
+            if unknown or len(argv[3:]) % 2:
+                print(__doc__, file=sys.stderr)
+                return 2
+            done = snapshot(argv[1], argv[2], options.get("--scene"), options.get("--dem-input"))
+            print("snapshot of step %d in %s: %s; %d bytes" % (done["step"], argv[2], ", ".join(
+                "%s %d" % kv for kv in done["files"].items()), done["bytes"]))
+            return 0
+        if len(argv) in (4, 5) and argv[0] == "snapshot-check":
+            print("%d %d" % snapshot_check(argv[1], argv[2], argv[3], int(argv[4]) if len(argv) == 5 else None))
+            return 0
+        if len(argv) in (5, 6) and argv[0] == "snapshot-install":
+            print("%d %d" % snapshot_install(argv[1], argv[2], argv[3], int(argv[4]),
+                                             int(argv[5]) if len(argv) == 6 else None))
+            return 0
+    except (CheckpointError, OSError) as e:
+        print(e, file=sys.stderr)
+        return 1
     print(__doc__, file=sys.stderr)
     return 2
 

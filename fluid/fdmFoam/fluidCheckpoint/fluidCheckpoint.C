@@ -19,7 +19,8 @@ std::string Foam::fluidCheckpoint::write(const std::string& file) const
         << "\ntimeName " << timeName << "\nstepsDone " << stepsDone
         << "\ncells " << cells << "\nprocessors " << processors
         << "\nparticles " << particles << "\nregularOutput "
-        << (regularOutput ? 1 : 0) << "\nend\n";
+        << (regularOutput ? 1 : 0) << "\nfromRest " << (fromRest ? 1 : 0)
+        << "\nend\n";
     const std::string text = os.str();
     const std::string tmp = file + ".tmp";
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -69,6 +70,7 @@ std::string Foam::fluidCheckpoint::read(const std::string& file)
         else if (key == "processors") { is >> processors; ++found; }
         else if (key == "particles") { is >> particles; ++found; }
         else if (key == "regularOutput") { int r = 0; is >> r; regularOutput = r; }
+        else if (key == "fromRest") { int r = 0; is >> r; fromRest = r; }
         else { std::getline(is, key); }
     }
     if (!complete || found != 8 || is.bad())
