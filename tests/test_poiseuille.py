@@ -2,6 +2,7 @@
 driven by a pressure gradient between walls at rest, run by the real fdmFoam and fdmDEM for a few
 steps (about 30 s); the exact checks of the analysis (the phi integral, the walls' force balance, the
 linear shear stress in the core) and the case's bad input. The SBM's own tests: test_sbm.py."""
+import json
 import os
 
 import numpy as np
@@ -53,6 +54,24 @@ def test_each_species_is_reported(small_run):
     assert sum(s["phi_bulk"] for s in species) == pytest.approx(r["phi_bulk"], rel=1e-12)
     assert sum(s["phi_center"] for s in species) == pytest.approx(r["phi_center"], rel=1e-12)
     assert all(len(s["phi_profile"]) == len(r["species_profile_y"]) for s in species)
+
+
+def test_migration_series_of_a_segment_is_the_analysis_series(small_run, tmp_path):
+    """The series kept beside a compact snapshot (cases/poiseuille/paperRun --save) is the run's own: the
+    same times and phi at the centre as the analysis, phi(y) in bins of a1 integrating to phi_bulk."""
+    from fdmsubgrid import poiseuille
+    path = poiseuille.write_segment(small_run["run_dir"], str(tmp_path))
+    with open(path) as f:
+        series = json.load(f)
+    assert os.path.basename(path) == "segment_%g_%g.json" % (series["time"][0], series["time"][-1])
+    assert series["time"] == pytest.approx(small_run["series"]["time"], abs=1e-6)
+    assert series["phi_center"] == pytest.approx(small_run["series"]["phi_center"], abs=1e-5)
+    assert np.allclose(np.diff(series["y"]), 1.0)
+    for profile in series["phi_profile"]:
+        assert np.mean(profile) == pytest.approx(small_run["phi_bulk"], abs=2e-4)
+    # written again after the run went on: the segment of the same start is replaced, not added to
+    poiseuille.write_segment(small_run["run_dir"], str(tmp_path))
+    assert len(os.listdir(tmp_path)) == 1
 
 
 def test_momentum_balance(small_run):

@@ -835,3 +835,51 @@ def plateau_shear_rate(fine: profiles.ProfileAverage, plateau: Plateau, sc: Scal
     if inside.sum() < 2:
         return math.nan
     return float(np.mean(np.abs(np.diff(u) / np.diff(y))))
+
+
+def migration_series(run_dir: str) -> dict:
+    """The migration as the run's records hold it, small enough to keep beside a compact snapshot when the
+    run folder may be lost (a long run in segments, cases/poiseuille/paperRun): per record its time (in
+    L_y/(2U_c)), phi in the central slab |y - mid| < a1 and in the wall layers, and phi(y) in bins of a1."""
+    run = shear.read_run(run_dir)
+    sc = scales(run)
+    channel = run.channel
+    snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"), 1.0 / sc.time_unit)
+    if not snapshots:
+        raise PoiseuilleRunError("%s/dem/particles.records: no record yet" % run_dir)
+    mid = channel.y_mid
+    phi_y = [profiles.profiles_in_bins(s, channel) for s in snapshots]
+    return dict(
+        time=[round(float(s.time), 6) for s in snapshots],
+        phi_center=[round(profiles.volume_fraction(s, channel, mid - CENTRAL_HALF_WIDTH, mid + CENTRAL_HALF_WIDTH), 5)
+                    for s in snapshots],
+        phi_wall_layer=[round(0.5 * (profiles.volume_fraction(s, channel, channel.y_lo, channel.y_lo + WALL_LAYER)
+                                     + profiles.volume_fraction(s, channel, channel.y_hi - WALL_LAYER, channel.y_hi)), 5)
+                        for s in snapshots],
+        y=[round(float(v), 6) for v in phi_y[0].y],
+        phi_profile=[[round(float(v), 5) for v in p.phi] for p in phi_y])
+
+
+def write_segment(run_dir: str, folder: str) -> str:
+    """migration_series of run_dir written to folder/segment_<first>_<last>.json (times rounded to the
+    record); a segment file of the same first time is replaced (the run went on since)."""
+    import json
+    series = migration_series(run_dir)
+    first = series["time"][0]
+    os.makedirs(folder, exist_ok=True)
+    for name in os.listdir(folder):
+        if name.startswith("segment_%g_" % first) and name.endswith(".json"):
+            os.remove(os.path.join(folder, name))
+    path = os.path.join(folder, "segment_%g_%g.json" % (first, series["time"][-1]))
+    with open(path + ".tmp", "w") as f:
+        json.dump(series, f, separators=(",", ":"))
+    os.replace(path + ".tmp", path)
+    return path
+
+
+if __name__ == "__main__":
+    import sys
+    if len(sys.argv) != 4 or sys.argv[1] != "series":
+        raise SystemExit("usage: python3 -m fdmsubgrid.poiseuille series RUN_DIR FOLDER\n"
+                         "  the migration series of the run's records into FOLDER/segment_<t0>_<t1>.json")
+    print(write_segment(sys.argv[2], sys.argv[3]))
