@@ -22,6 +22,7 @@
 #define FDM_PAIR_FDM_SUBGRID_H
 
 #include "pair.h"
+#include "configuration_checks.h"
 
 #include <memory>
 #include <string>
@@ -96,10 +97,7 @@ class PairFdmSubgrid : public Pair {
   long contactsLast() const { return contactsLast_; }
   // The deepest overlap of two spheres this rank's last compute found: depth = -gap/min(a_i, a_j)
   // (negative: no overlap), the gap [m] and the two tags
-  struct Overlap {
-    double depth = -1e300, gap = 0;
-    long tagI = 0, tagJ = 0;
-  };
+  using Overlap = fdm::Overlap;   // configuration_checks.h
   const Overlap &deepestOverlap() const { return deepest_; }
   // The time-step limits of the contact springs, dt k/zeta below 1 (ab2) or 2 (euler), docs/contact.md
   // section 3c; called by fix fdm/couple, which knows the time step and its integrator.
