@@ -23,6 +23,7 @@
 
 #include "pair.h"
 #include "configuration_checks.h"
+#include "subgrid_options.h"
 
 #include <memory>
 #include <string>
@@ -49,11 +50,8 @@ class PairFdmSubgrid : public Pair {
   double init_one(int, int);
   void *extract(const char *, int &);
 
-  // A planar wall on a non-periodic face of the box, moving in its own plane.
-  struct Wall {
-    int axis, side;       // face = 2*axis + side (xlo, xhi, ylo, yhi, zlo, zhi)
-    double velocity[3];
-  };
+  // A planar wall on a non-periodic face of the box, moving in its own plane (subgrid_options.h).
+  using Wall = fdm::SubgridWall;
 
   // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0, in
   // the records of fdm::subgrid (particle_velocity_system.h), with their stress rows if withStress;
@@ -118,7 +116,8 @@ class PairFdmSubgrid : public Pair {
   void checkResolution();
   // Resistances of the contact modes at surface gap h (Stokes drag + sub-grid lubrication): two free
   // spheres of radius a (normal, and slip of the contact points), a sphere and a wall.
-  void defaultSettings();  // every keyword at its default (constructor, and settings() before parsing)
+  // the keywords' values (subgrid_options.h), and the sub-grid model to be built anew (constructor: the defaults)
+  void applySettings(const fdm::SubgridOptions &options);
   void pairResistance(double a, double h, double &normal, double &slip) const;
   void wallResistance(double a, double h, double &normal, double &slip) const;
 
