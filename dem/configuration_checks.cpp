@@ -167,4 +167,24 @@ std::string periodicBalanceProblem(const std::vector<GatheredParticle> &particle
   return text;
 }
 
+std::string couplingSetupProblem(bool newtonPair, const std::string &unitStyle, double dt)
+{
+  if (newtonPair) return "fix fdm/couple requires newton off";
+  if (unitStyle != "si")
+    return "fix fdm/couple requires units si (the fluid solver works in SI), not units " + unitStyle;
+  if (!(dt > 0)) return "fix fdm/couple requires a positive timestep";
+  return std::string();
+}
+
+std::string otherFixProblem(const std::string &style, const std::string &id, bool integratesMotion)
+{
+  if (style == "fdm/couple") return "fix fdm/couple is defined twice: one coupled fluid, one fix";
+  if (integratesMotion)
+    return "fix fdm/couple moves the particles itself (it replaces nve/sphere): remove fix " + id + " (" + style + ")";
+  if (style == "gravity")
+    return "fix " + id + " (gravity) adds the full weight m g without buoyancy: use the gravity keyword of fix "
+           "fdm/couple, which adds (rho_p - rho_f)/rho_p m g (Eq. 32)";
+  return std::string();
+}
+
 }  // namespace fdm

@@ -45,6 +45,17 @@ void CoupledVelocitySolve::resize(int n)
   results_.stress.assign(size_t(20) * n, 0.0);
 }
 
+void CoupledVelocitySolve::Results::perAtomRow(long index, int n, bool stresslets, double *row) const
+{
+  const bool known = index >= 0 && index < n && hydro.size() == size_t(6) * n;
+  for (int c = 0; c < 6; c++) {
+    row[c] = known ? hydro[size_t(6) * index + c] : 0.0;
+    row[6 + c] = known ? subgrid[size_t(6) * index + c] : 0.0;
+  }
+  if (stresslets)
+    for (int c = 0; c < 20; c++) row[12 + c] = known ? stress[size_t(20) * index + c] : 0.0;
+}
+
 void CoupledVelocitySolve::assemble(const std::vector<GatheredParticle> &particles, std::vector<double> pairBlocks,
                                     std::vector<double> wallBlocks, System::Springs springs)
 {

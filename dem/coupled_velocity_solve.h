@@ -34,6 +34,11 @@ class CoupledVelocitySolve {
  public:
   struct Results {
     std::vector<double> solution, hydro, fluidStress, subgrid, springs, stress;
+    // fix fdm/couple's per-atom columns: F^FDM, T^FDM, F^SG, T^SG (12), and with stresslets the 20 of stress
+    static int perAtomColumns(bool stresslets) { return stresslets ? 32 : 12; }
+    // Those columns of the particle of index tag - 1 (of n) into row; zeros for a particle the results do
+    // not hold (an index out of 0..n-1, or results not sized for n yet)
+    void perAtomRow(long index, int n, bool stresslets, double *row) const;
   };
 
   // settings: of Eq. (31) but the fluid's values; counts: where the solves are counted, and their

@@ -9,6 +9,7 @@
 #include "fluid_exchange.h"
 #include "message_text.h"
 #include "pair_fdm_subgrid.h"
+#include "step_collectives.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -21,9 +22,7 @@
 #include "update.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <cstring>
 
 using namespace LAMMPS_NS;
 namespace cpl = fdm::coupler;
@@ -49,8 +48,8 @@ fdm::CoupleOptions parseOptions(Error *error, int narg, char **arg)
 FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   Fix(lmp, narg, arg), session_(CouplingSession::instance()), options_(parseOptions(error, narg, arg)),
   solve_(options_.systemSettings(), run_), schedule_(options_.fluidEvery), heldDrag_(options_.heldExtrapolated),
-  plan_(options_.moveOptions()), pair_(nullptr), atomsAtInit_(0), natoms_(0), pairBlocks_(0),
-  wallBlocks_(0), contacts_(0), runStart_(0.0), nmax_(0), perAtom_(nullptr), checkpointSeconds_(0), resumed_(false)
+  plan_(options_.moveOptions()), pair_(nullptr), atomsAtInit_(0), natoms_(0), runStart_(0.0), nmax_(0),
+  perAtom_(nullptr), checkpointSeconds_(0), resumed_(false)
 {
   if (igroup != 0) error->all(FLERR, "fix fdm/couple must be applied to group all (every particle is in the fluid)");
   time_integrate = 1;
@@ -60,7 +59,7 @@ FixFdmCouple::FixFdmCouple(LAMMPS *lmp, int narg, char **arg) :
   extvector = 0;
   peratom_flag = 1;
   peratom_freq = 1;
-  perAtomColumns_ = options_.stresslets ? 32 : 12;
+  perAtomColumns_ = fdm::CoupledVelocitySolve::Results::perAtomColumns(options_.stresslets);
   size_peratom_cols = perAtomColumns_;
   session_.attach(this, options_.sessionRequest());
   if (!session_.resumeFile().empty() && !session_.connected()) readResumeCheckpoint();
@@ -96,24 +95,14 @@ void FixFdmCouple::init()
   if (!options_.wallFile.empty() && (!pair_ || pair_->walls().empty()))
     error->all(FLERR, ("fix fdm/couple: walls " + options_.wallFile + " needs pair_style fdm/subgrid with its walls "
                        "(wall FACE ux uy uz): there are no walls to write the loads of").c_str());
-  if (force->newton_pair) error->all(FLERR, "fix fdm/couple requires newton off");
-  if (std::strcmp(update->unit_style, "si") != 0)
-    error->all(FLERR, (std::string("fix fdm/couple requires units si (the fluid solver works in SI), not units ") +
-                       update->unit_style).c_str());
-  if (!(update->dt > 0)) error->all(FLERR, "fix fdm/couple requires a positive timestep");
+  const std::string setup = fdm::couplingSetupProblem(force->newton_pair != 0, update->unit_style, update->dt);
+  if (!setup.empty()) error->all(FLERR, setup.c_str());
   // the contact springs' stability limit depends on the time step and on this fix's integrator
   if (pair_) pair_->checkTimeStep(update->dt, options_.adamsBashforth);
   for (int i = 0; i < modify->nfix; i++) {
-    Fix *other = modify->fix[i];
-    if (other == this) continue;
-    if (std::strcmp(other->style, "fdm/couple") == 0)
-      error->all(FLERR, "fix fdm/couple is defined twice: one coupled fluid, one fix");
-    if (other->time_integrate)
-      error->all(FLERR, (std::string("fix fdm/couple moves the particles itself (it replaces nve/sphere): remove fix ") +
-                         other->id + " (" + other->style + ")").c_str());
-    if (std::strcmp(other->style, "gravity") == 0)
-      error->all(FLERR, (std::string("fix ") + other->id + " (gravity) adds the full weight m g without buoyancy: "
-                         "use the gravity keyword of fix fdm/couple, which adds (rho_p - rho_f)/rho_p m g (Eq. 32)").c_str());
+    const std::string problem = modify->fix[i] == this ? std::string() :
+      fdm::otherFixProblem(modify->fix[i]->style, modify->fix[i]->id, modify->fix[i]->time_integrate != 0);
+    if (!problem.empty()) error->all(FLERR, problem.c_str());
   }
   if (!comm->ghost_velocity && comm->me == 0)
     error->warning(FLERR, "fix fdm/couple: 'communicate single vel yes' is needed by the lubrication pair styles");
@@ -270,21 +259,14 @@ void FixFdmCouple::assembleSystem(const Particles &particles)
     run_.parts.lap(Profile::gatherScatter, t);
     // Eq. (C5): the straight step's chord of a sliding or rolling pair, in its normal spring, from
     // U_n (kept in the checkpoints: a resumed run takes the same chord terms)
-    const bool chord = options_.contactChord && plan_.haveVelocities && plan_.current.size() == size_t(6) * natoms_;
-    if (multistep) springs.gamma = 1.0 / 3.0;
-    if (chord) springs.dt = update->dt;
-    if (multistep || chord) springs.previous = plan_.current;
+    plan_.springHistory(multistep, options_.contactChord, natoms_, update->dt, springs);
   }
   if (wallLoads) {
     // the wall of each block, gathered in the same rank order as the blocks; the contact loads summed
     wallLoads_.subgridBlockWall = fdm::gatherToRoot(wallIndex, world);
-    const std::vector<double> &local = pair_->wallContactLoads();
-    std::vector<double> loads(3 * pair_->walls().size(), 0.0);
-    for (size_t k = 0; k < loads.size() && k < local.size(); k++) loads[k] = local[k];
-    wallLoads_.contactLoads.assign(loads.size(), 0.0);
-    MPI_Reduce(loads.data(), wallLoads_.contactLoads.data(), int(loads.size()), MPI_DOUBLE, MPI_SUM, 0, world);
+    wallLoads_.contactLoads = fdm::sumOnRoot(pair_->wallContactLoads(), 3 * pair_->walls().size(), world);
   }
-  MPI_Reduce(&contacts, &contacts_, 1, MPI_LONG, MPI_SUM, 0, world);
+  MPI_Reduce(&contacts, &blocks_.contacts, 1, MPI_LONG, MPI_SUM, 0, world);
   if (comm->me != 0) return;
 
   if (options_.move && session_.hasFluid() && domain->xperiodic && domain->yperiodic && domain->zperiodic) {
@@ -297,8 +279,8 @@ void FixFdmCouple::assembleSystem(const Particles &particles)
   } catch (const std::exception &e) {
     fail(e.what());
   }
-  pairBlocks_ = solve_.system()->pairBlocks();
-  wallBlocks_ = solve_.system()->wallBlocks();
+  blocks_.pairBlocks = solve_.system()->pairBlocks();
+  blocks_.wallBlocks = solve_.system()->wallBlocks();
 }
 
 void FixFdmCouple::final_integrate()
@@ -333,7 +315,7 @@ void FixFdmCouple::final_integrate()
         const double seconds = MPI_Wtime() - t0;
         run_.solve += seconds;
         // the drag's volumes and targets around the timed parts of Eq. (31)
-        run_.parts.add(Profile::systemSolves, std::max(0.0, seconds - (run_.parts.timed() - timedBefore)));
+        run_.parts.addUntimed(Profile::systemSolves, seconds, timedBefore);
       }
       if (!options_.wallFile.empty()) writeWallLoads();
     } catch (const std::exception &e) {
@@ -375,7 +357,7 @@ void FixFdmCouple::exchangeWithFluid(const Particles &particles)
   run_.exchange += seconds.exchange;
   run_.solve += seconds.handlers;
   // the handlers' copies of the messages around the timed parts of Eq. (31)
-  run_.parts.add(Profile::systemSolves, std::max(0.0, seconds.handlers - (run_.parts.timed() - timedBefore)));
+  run_.parts.addUntimed(Profile::systemSolves, seconds.handlers, timedBefore);
   run_.parts.add(Profile::fluidExchange, seconds.exchange);
 }
 
@@ -413,32 +395,10 @@ void FixFdmCouple::planNextMove(const Particles &particles)
 
 void FixFdmCouple::scatter()
 {
-  if (options_.move) {
-    int planned = plan_.planned ? 1 : 0;
-    MPI_Bcast(&planned, 1, MPI_INT, 0, world);
-    plan_.planned = planned != 0;
-    if (plan_.planned) {
-      plan_.rates.resize(size_t(6) * natoms_);
-      MPI_Bcast(plan_.rates.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
-    }
-  }
-  fdm::CoupledVelocitySolve::Results &r = solve_.results();
-  MPI_Bcast(r.solution.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
-  plan_.solved(r.solution);
-  MPI_Bcast(r.hydro.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
-  MPI_Bcast(r.subgrid.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
-  if (options_.stresslets) MPI_Bcast(r.stress.data(), 20 * natoms_, MPI_DOUBLE, 0, world);
-  long counters[4] = {solve_.solverIterations, pairBlocks_, wallBlocks_, contacts_};
-  MPI_Bcast(counters, 4, MPI_LONG, 0, world);
-  solve_.solverIterations = counters[0];
-  pairBlocks_ = counters[1];
-  wallBlocks_ = counters[2];
-  contacts_ = counters[3];
-  MPI_Bcast(&solve_.lastIterations, 1, MPI_INT, 0, world);
-  MPI_Bcast(&solve_.lastResidual, 1, MPI_DOUBLE, 0, world);
-  // the implicit part of the contact forces: f and torque become the forces that moved the particles
-  r.springs.resize(size_t(6) * natoms_, 0.0);
-  MPI_Bcast(r.springs.data(), 6 * natoms_, MPI_DOUBLE, 0, world);
+  // rank 0's plan, results and counters on every rank (step_collectives.h)
+  fdm::broadcastStep(plan_, options_.move, solve_, blocks_, natoms_, options_.stresslets, world);
+  const fdm::CoupledVelocitySolve::Results &r = solve_.results();
+  // the implicit part of the contact forces: f and torque become the forces that moved the particles;
   // the velocities of the converged inner iteration are the particles' velocities of this step
   for (int i = 0; i < atom->nlocal; i++) {
     const size_t t = size_t(6) * (atom->tag[i] - 1);
@@ -457,14 +417,10 @@ void FixFdmCouple::checkOverlaps()
 {
   // Every rank (collective): the deepest overlap of the ranks' pairs (configuration_checks.h)
   if (!pair_ || !session_.hasFluid()) return;
-  const PairFdmSubgrid::Overlap &mine = pair_->deepestOverlap();
-  struct { double depth; int rank; } local = {mine.depth, comm->me}, worst;
-  MPI_Allreduce(&local, &worst, 1, MPI_DOUBLE_INT, MPI_MAXLOC, world);
+  const fdm::Overlap worst = fdm::deepestOverlap(pair_->deepestOverlap(), cpl::contactOverlapTolerance, world);
   if (!(worst.depth > cpl::contactOverlapTolerance)) return;
-  double info[3] = {mine.gap, double(mine.tagI), double(mine.tagJ)};
-  MPI_Bcast(info, 3, MPI_DOUBLE, worst.rank, world);
-  const long tagI = std::lround(info[1]), tagJ = std::lround(info[2]);
-  allAgree(comm->me != 0 ? std::string() : fdm::deepOverlapProblem(tagI, tagJ, info[0], worst.depth, update->ntimestep));
+  allAgree(comm->me != 0 ? std::string() :
+           fdm::deepOverlapProblem(worst.tagI, worst.tagJ, worst.gap, worst.depth, update->ntimestep));
 }
 
 void FixFdmCouple::fillPerAtomArray()
@@ -475,17 +431,8 @@ void FixFdmCouple::fillPerAtomArray()
     memory->create(perAtom_, nmax_, perAtomColumns_, "fdm/couple:hydrodynamic");
     array_atom = perAtom_;
   }
-  const fdm::CoupledVelocitySolve::Results &r = solve_.results();
-  for (int i = 0; i < atom->nlocal; i++) {
-    const long t = atom->tag[i] - 1;
-    const bool known = t >= 0 && t < natoms_ && r.hydro.size() == size_t(6) * natoms_;
-    for (int c = 0; c < 6; c++) {
-      perAtom_[i][c] = known ? r.hydro[size_t(6) * t + c] : 0.0;
-      perAtom_[i][6 + c] = known ? r.subgrid[size_t(6) * t + c] : 0.0;
-    }
-    if (options_.stresslets)
-      for (int c = 0; c < 20; c++) perAtom_[i][12 + c] = known ? r.stress[size_t(20) * t + c] : 0.0;
-  }
+  for (int i = 0; i < atom->nlocal; i++)
+    solve_.results().perAtomRow(atom->tag[i] - 1, natoms_, options_.stresslets, perAtom_[i]);
 }
 
 void FixFdmCouple::post_run()
@@ -503,7 +450,7 @@ void FixFdmCouple::post_run()
   if (comm->me == 0) {
     const fdm::TimingContext c = {fdm::ParticleVelocitySystem::solverName(options_.solver), options_.adamsBashforth,
                                   options_.gapUpdate, options_.contactChord && pair_ && pair_->implicitContact(),
-                                  pairBlocks_, wallBlocks_, contacts_, solve_.notConverged, options_.fluidEvery,
+                                  blocks_.pairBlocks, blocks_.wallBlocks, blocks_.contacts, solve_.notConverged, options_.fluidEvery,
                                   options_.heldExtrapolated};
     const std::string line = fdm::timingLine("of this run", run_, now - runStart_, 1, c) +
                              run_.parts.report("this run", session_.whoseProfile(comm->nprocs), now - runStart_,
@@ -528,9 +475,9 @@ double FixFdmCouple::compute_vector(int n)
     case 2: return session_.totalSolve() + run_.solve;
     case 3: return session_.totalExchange() + run_.exchange;
     case 4: return solve_.solverIterations;
-    case 5: return pairBlocks_;
-    case 6: return wallBlocks_;
-    case 7: return contacts_;
+    case 5: return blocks_.pairBlocks;
+    case 6: return blocks_.wallBlocks;
+    case 7: return blocks_.contacts;
   }
   return 0.0;
 }

@@ -22,7 +22,8 @@
 
    The fix is the LIGGGHTS adapter: it reads the atoms, gathers them on rank 0, broadcasts what rank 0
    found and writes it back; the work is in units that do not know LIGGGHTS: the keywords
-   (couple_options.h), the configuration checks (configuration_checks.h), the exchange with the fluid
+   (couple_options.h), the configuration and set-up checks (configuration_checks.h), the step's
+   collectives (step_collectives.h: MPI only), the exchange with the fluid
    (fluid_exchange.h), Eq. (31) within a step (coupled_velocity_solve.h), the steps between fluid steps
    (fluid_step_schedule.h, held_drag.h), the position update (position_update.h), the wall loads
    (wall_loads_file.h), the timing line (coupling_timing.h) and the breakdown of the particle step
@@ -49,6 +50,7 @@
 #include "held_drag.h"
 #include "move_plan.h"
 #include "particle_checkpoint.h"
+#include "step_collectives.h"
 #include "wall_loads_file.h"
 
 #include <memory>
@@ -105,7 +107,7 @@ class FixFdmCouple : public Fix {
 
   int atomsAtInit_;                // atom count when init() checked the tags 1..N
   int natoms_;                     // N, particles are tags 1..N
-  long pairBlocks_, wallBlocks_, contacts_;  // of the last step, for the global vector
+  fdm::BlockCounts blocks_;        // of the last step, for the global vector
   double runStart_;
   int nmax_;                       // rows allocated in array_atom
   double **perAtom_;

@@ -3,6 +3,7 @@
 #include "gather_to_root.h"
 
 #include "coupling_session.h"
+#include "output_options.h"
 
 #include "atom.h"
 #include "comm.h"
@@ -12,6 +13,7 @@
 #include "modify.h"
 #include "update.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -72,33 +74,16 @@ FixFdmOutput::FixFdmOutput(LAMMPS *lmp, int narg, char **arg) :
   vtkThisRun_(0)
 {
   if (igroup != 0) error->all(FLERR, "fix fdm/output must be applied to group all");
-  for (int i = 3; i < narg; i++) {
-    const std::string key = arg[i];
-    auto value = [&](int n) -> const char * {
-      if (i + n >= narg) error->all(FLERR, ("fix fdm/output: keyword " + key + " needs " + std::to_string(n) +
-                                            " value" + (n > 1 ? "s" : "")).c_str());
-      return arg[i + n];
-    };
-    if (key == "records" || key == "vtk") {
-      const long every = force->inumeric(FLERR, value(1));
-      const std::string path = value(2);
-      if (every < 1) error->all(FLERR, ("fix fdm/output: " + key + " every " + std::to_string(every) +
-                                        " steps: must be 1 or more").c_str());
-      if (key == "records") { recordEvery_ = every; recordPath_ = path; }
-      else { vtkEvery_ = every; vtkDir_ = path; }
-      i += 2;
-    } else if (key == "append") {
-      const std::string v = value(1);
-      if (v != "yes" && v != "no") error->all(FLERR, "fix fdm/output: append must be yes or no");
-      append_ = v == "yes";
-      i++;
-    } else {
-      error->all(FLERR, ("fix fdm/output: unknown keyword " + key + " (records N FILE, vtk M DIR, append yes|no; "
-                         "docs/dem.md)").c_str());
-    }
+  try {
+    const fdm::OutputOptions o = fdm::parseOutputOptions(std::vector<std::string>(arg + std::min(3, narg), arg + narg));
+    recordEvery_ = long(o.recordEvery);
+    recordPath_ = o.recordPath;
+    vtkEvery_ = long(o.vtkEvery);
+    vtkDir_ = o.vtkDir;
+    append_ = o.append;
+  } catch (const fdm::KeywordError &e) {
+    error->all(FLERR, e.what());
   }
-  if (!recordEvery_ && !vtkEvery_)
-    error->all(FLERR, "fix fdm/output: nothing to write: give records N FILE and/or vtk M DIR");
   nevery = 1;
 }
 

@@ -55,6 +55,13 @@ class KeywordTable {
     });
   }
 
+  // A keyword of `count` values that `set` reads (with toNumber, toInteger, fail); a keyword given again
+  // calls it again (e.g. one wall per "wall FACE ...").
+  KeywordTable &values(const std::string &key, int count, std::function<void(const std::string *)> set)
+  {
+    return add(key, count, std::move(set));
+  }
+
   // Reads args in order (key, then its values); throws KeywordError on an unknown keyword, a missing
   // or malformed value, or a value against its rule. seeAlso ends the unknown-keyword message.
   void parse(const std::vector<std::string> &args, const std::string &seeAlso) const;
@@ -64,6 +71,8 @@ class KeywordTable {
   // LIGGGHTS's number forms: a floating-point number, an integer (KeywordError otherwise)
   double toNumber(const std::string &key, const std::string &text) const;
   long long toInteger(const std::string &key, const std::string &text) const;
+  // Throws KeywordError: "<owner>: <sentence>"
+  [[noreturn]] void fail(const std::string &sentence) const;
 
  private:
   struct Entry {
@@ -71,7 +80,6 @@ class KeywordTable {
     std::function<void(const std::string *)> set;
   };
   KeywordTable &add(const std::string &key, int values, std::function<void(const std::string *)> set);
-  [[noreturn]] void fail(const std::string &sentence) const;
 
   std::string owner_;
   std::map<std::string, Entry> entries_;

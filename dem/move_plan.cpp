@@ -61,6 +61,15 @@ bool MovePlan::multistep(int particles) const
   return options_.adamsBashforth && planned && haveVelocities && positions.size() == size_t(3) * particles;
 }
 
+void MovePlan::springHistory(bool multistep, bool chordTerms, int n, double dt,
+                             ParticleVelocitySystem::Springs &springs) const
+{
+  const bool chord = chordTerms && haveVelocities && current.size() == size_t(6) * n;
+  if (multistep) springs.gamma = 1.0 / 3.0;
+  if (chord) springs.dt = dt;
+  if (multistep || chord) springs.previous = current;
+}
+
 void MovePlan::solved(const std::vector<double> &u)
 {
   // the velocities of the step now ending are the "previous" ones of the next position update

@@ -7,6 +7,7 @@
 #define FDM_MOVE_PLAN_H
 
 #include "gathered_particles.h"
+#include "particle_velocity_system.h"
 #include "position_update.h"
 
 #include <functional>
@@ -36,6 +37,12 @@ class MovePlan {
   // Rank 0: whether the next step is a multistep one (Adams-Bashforth with a previous step), which the
   // implicit contact springs must know (docs/contact.md 2b).
   bool multistep(int particles) const;
+  // The history the implicit contact springs take from the plan (docs/contact.md 2b): with multistep
+  // (the next position update is Adams-Bashforth 2) U_n weighs gamma = 1/3; with chordTerms (contact_chord
+  // yes) the pair springs' chord term (Eq. C5) is estimated from U_n over dt, if U_n is known for the n
+  // particles. springs.previous is U_n when either needs it.
+  void springHistory(bool multistep, bool chordTerms, int n, double dt,
+                     ParticleVelocitySystem::Springs &springs) const;
   // Every rank, the step's velocities U_{n+1} broadcast: they become the current ones.
   void solved(const std::vector<double> &u);
 

@@ -36,8 +36,6 @@ using namespace LAMMPS_NS;
 namespace res = fdm::resistance;
 
 namespace {
-const char *faceNames[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
-
 
 std::string fmt(double x)
 {
@@ -56,23 +54,25 @@ PairFdmSubgrid::PairFdmSubgrid(LAMMPS *lmp) :
 {
   single_enable = 0;
   no_virial_fdotr_compute = 1;
-  defaultSettings();
+  applySettings(fdm::SubgridOptions());
 }
 
-void PairFdmSubgrid::defaultSettings()
+void PairFdmSubgrid::applySettings(const fdm::SubgridOptions &o)
 {
-  // The keywords' defaults (docs/dem.md). A pair_style line given again (LAMMPS calls settings() on the
-  // same object) starts from them too: what it does not say is not kept from the earlier line, and the
-  // sub-grid model is built anew.
-  lubrication_ = true;
-  calibrated_ = true;
-  calibrationFile_.clear();
-  cutoffCells_ = res::defaultPairCutoffCells;
-  wallCutoffCells_ = res::defaultWallCutoffCells;
-  kn_ = kt_ = mu_ = hr_ = 0;
-  walls_.clear();
-  unstableStepIsError_ = true;
-  implicit_ = true;
+  // A pair_style line given again (LAMMPS calls settings() on the same object) starts from the defaults
+  // too: what it does not say is not kept from the earlier line, and the sub-grid model is built anew.
+  lubrication_ = o.lubrication;
+  calibrated_ = o.calibrated;
+  calibrationFile_ = o.calibrationFile;
+  cutoffCells_ = o.cutoffCells;
+  wallCutoffCells_ = o.wallCutoffCells;
+  kn_ = o.kn;
+  kt_ = o.kt;
+  mu_ = o.mu;
+  hr_ = o.hr;
+  walls_ = o.walls;
+  unstableStepIsError_ = o.unstableStepIsError;
+  implicit_ = o.implicitContact;
   model_.reset();
   wallModel_.reset();
   calibration_.reset();
@@ -103,80 +103,10 @@ void PairFdmSubgrid::allocate()
 
 void PairFdmSubgrid::settings(int narg, char **arg)
 {
-  auto need = [&](int i, int n, const char *what) {
-    if (i + n >= narg) error->all(FLERR, (std::string("pair_style fdm/subgrid: ") + what).c_str());
-  };
-  defaultSettings();
-  for (int i = 0; i < narg; i++) {
-    const std::string key = arg[i];
-    if (key == "lubrication") {
-      need(i, 1, "lubrication yes|no");
-      const std::string v = arg[++i];
-      if (v != "yes" && v != "no") error->all(FLERR, "pair_style fdm/subgrid: lubrication yes|no");
-      lubrication_ = (v == "yes");
-    } else if (key == "cutoff") {
-      need(i, 1, "cutoff k (the cut-off gap in mesh cells)");
-      cutoffCells_ = force->numeric(FLERR, arg[++i]);
-      if (!(cutoffCells_ > 0)) error->all(FLERR, ("pair_style fdm/subgrid: cutoff " + fmt(cutoffCells_) +
-                                                  " must be positive (mesh cells)").c_str());
-    } else if (key == "model") {
-      need(i, 1, "model cutoff|calibrated");
-      const std::string v = arg[++i];
-      if (v != "cutoff" && v != "calibrated")
-        error->all(FLERR, ("pair_style fdm/subgrid: model " + v + ": use cutoff or calibrated").c_str());
-      calibrated_ = (v == "calibrated");
-    } else if (key == "calibration") {
-      need(i, 1, "calibration FILE (the squeeze calibration table)");
-      calibrationFile_ = arg[++i];
-      calibrated_ = true;
-    } else if (key == "wall_cutoff") {
-      need(i, 1, "wall_cutoff k (the wall cut-off gap in mesh cells)");
-      wallCutoffCells_ = force->numeric(FLERR, arg[++i]);
-      if (!(wallCutoffCells_ > 0)) error->all(FLERR, ("pair_style fdm/subgrid: wall_cutoff " + fmt(wallCutoffCells_) +
-                                                      " must be positive (mesh cells)").c_str());
-    } else if (key == "contact") {
-      need(i, 4, "contact kn kt mu_s h_r (N/m, N/m, -, m)");
-      kn_ = force->numeric(FLERR, arg[i + 1]);
-      kt_ = force->numeric(FLERR, arg[i + 2]);
-      mu_ = force->numeric(FLERR, arg[i + 3]);
-      hr_ = force->numeric(FLERR, arg[i + 4]);
-      i += 4;
-      if (!(kn_ > 0) || !(kt_ >= 0) || !(mu_ >= 0) || !(hr_ >= 0))
-        error->all(FLERR, ("pair_style fdm/subgrid: contact kn " + fmt(kn_) + " kt " + fmt(kt_) + " mu_s " + fmt(mu_) +
-                           " h_r " + fmt(hr_) + ": kn must be positive, kt, mu_s and h_r non-negative").c_str());
-    } else if (key == "wall") {
-      need(i, 4, "wall FACE ux uy uz (FACE = xlo xhi ylo yhi zlo zhi)");
-      const std::string face = arg[i + 1];
-      int k = 0;
-      while (k < 6 && face != faceNames[k]) k++;
-      if (k == 6) error->all(FLERR, ("pair_style fdm/subgrid: wall " + face + ": the face must be one of xlo xhi ylo "
-                                     "yhi zlo zhi").c_str());
-      Wall w;
-      w.axis = k / 2;
-      w.side = k % 2;
-      for (int d = 0; d < 3; d++) w.velocity[d] = force->numeric(FLERR, arg[i + 2 + d]);
-      if (w.velocity[w.axis] != 0)
-        error->all(FLERR, ("pair_style fdm/subgrid: wall " + face + " moves through itself (velocity component " +
-                           fmt(w.velocity[w.axis]) + " along its normal): a wall moves in its own plane").c_str());
-      for (const Wall &o : walls_)
-        if (o.axis == w.axis && o.side == w.side)
-          error->all(FLERR, ("pair_style fdm/subgrid: wall " + face + " is declared twice").c_str());
-      walls_.push_back(w);
-      i += 4;
-    } else if (key == "unstable_step") {
-      need(i, 1, "unstable_step error|warn");
-      const std::string v = arg[++i];
-      if (v != "error" && v != "warn") error->all(FLERR, "pair_style fdm/subgrid: unstable_step error|warn");
-      unstableStepIsError_ = (v == "error");
-    } else if (key == "contact_integration") {
-      need(i, 1, "contact_integration implicit|explicit");
-      const std::string v = arg[++i];
-      if (v != "implicit" && v != "explicit")
-        error->all(FLERR, ("pair_style fdm/subgrid: contact_integration " + v + ": implicit or explicit").c_str());
-      implicit_ = (v == "implicit");
-    } else {
-      error->all(FLERR, ("pair_style fdm/subgrid: unknown keyword " + key + " (see docs/dem.md)").c_str());
-    }
+  try {
+    applySettings(fdm::parseSubgridOptions(std::vector<std::string>(arg, arg + narg)));
+  } catch (const fdm::KeywordError &e) {
+    error->all(FLERR, e.what());
   }
 }
 
@@ -191,7 +121,7 @@ void PairFdmSubgrid::coeff(int narg, char **arg)
     for (int j = std::max(jlo, i); j <= jhi; j++) setflag[i][j] = 1;
 }
 
-std::string PairFdmSubgrid::wallName(const Wall &w) const { return faceNames[2 * w.axis + w.side]; }
+std::string PairFdmSubgrid::wallName(const Wall &w) const { return fdm::faceName(2 * w.axis + w.side); }
 
 void PairFdmSubgrid::fluidParameters()
 {
@@ -236,11 +166,11 @@ void PairFdmSubgrid::fluidParameters()
       if (2 * w.axis + w.side == face) declared = &w;
     const std::string u = "(" + fmt(velocity[0]) + " " + fmt(velocity[1]) + " " + fmt(velocity[2]) + ")";
     if (kind == CouplingSession::faceWall && !declared) {
-      problem = std::string("the fluid case has a no-slip wall on ") + faceNames[face] + " moving at " + u +
-                " m/s, not declared to pair_style fdm/subgrid: add 'wall " + faceNames[face] + " " + fmt(velocity[0]) +
+      problem = std::string("the fluid case has a no-slip wall on ") + fdm::faceName(face) + " moving at " + u +
+                " m/s, not declared to pair_style fdm/subgrid: add 'wall " + fdm::faceName(face) + " " + fmt(velocity[0]) +
                 " " + fmt(velocity[1]) + " " + fmt(velocity[2]) + "'";
     } else if (declared && kind != CouplingSession::faceWall) {
-      problem = std::string("pair_style fdm/subgrid declares a wall on ") + faceNames[face] +
+      problem = std::string("pair_style fdm/subgrid declares a wall on ") + fdm::faceName(face) +
                 " but the fluid case has " + CouplingSession::faceKindName(kind) + " there";
     } else if (declared) {
       double scale = 0, diff = 0;
@@ -249,7 +179,7 @@ void PairFdmSubgrid::fluidParameters()
         diff = std::max(diff, std::fabs(velocity[d] - declared->velocity[d]));
       }
       if (diff > 1e-9 * scale)
-        problem = std::string("wall ") + faceNames[face] + ": pair_style fdm/subgrid says it moves at (" +
+        problem = std::string("wall ") + fdm::faceName(face) + ": pair_style fdm/subgrid says it moves at (" +
                   fmt(declared->velocity[0]) + " " + fmt(declared->velocity[1]) + " " + fmt(declared->velocity[2]) +
                   ") m/s but the fluid case (0/U) at " + u + " m/s";
     }

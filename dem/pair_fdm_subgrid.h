@@ -22,6 +22,8 @@
 #define FDM_PAIR_FDM_SUBGRID_H
 
 #include "pair.h"
+#include "configuration_checks.h"
+#include "subgrid_options.h"
 
 #include <memory>
 #include <string>
@@ -48,11 +50,8 @@ class PairFdmSubgrid : public Pair {
   double init_one(int, int);
   void *extract(const char *, int &);
 
-  // A planar wall on a non-periodic face of the box, moving in its own plane.
-  struct Wall {
-    int axis, side;       // face = 2*axis + side (xlo, xhi, ylo, yhi, zlo, zhi)
-    double velocity[3];
-  };
+  // A planar wall on a non-periodic face of the box, moving in its own plane (subgrid_options.h).
+  using Wall = fdm::SubgridWall;
 
   // Blocks of R^SG of this rank's pairs and particle-wall gaps, for the fix to gather on rank 0, in
   // the records of fdm::subgrid (particle_velocity_system.h), with their stress rows if withStress;
@@ -96,10 +95,7 @@ class PairFdmSubgrid : public Pair {
   long contactsLast() const { return contactsLast_; }
   // The deepest overlap of two spheres this rank's last compute found: depth = -gap/min(a_i, a_j)
   // (negative: no overlap), the gap [m] and the two tags
-  struct Overlap {
-    double depth = -1e300, gap = 0;
-    long tagI = 0, tagJ = 0;
-  };
+  using Overlap = fdm::Overlap;   // configuration_checks.h
   const Overlap &deepestOverlap() const { return deepest_; }
   // The time-step limits of the contact springs, dt k/zeta below 1 (ab2) or 2 (euler), docs/contact.md
   // section 3c; called by fix fdm/couple, which knows the time step and its integrator.
@@ -120,7 +116,8 @@ class PairFdmSubgrid : public Pair {
   void checkResolution();
   // Resistances of the contact modes at surface gap h (Stokes drag + sub-grid lubrication): two free
   // spheres of radius a (normal, and slip of the contact points), a sphere and a wall.
-  void defaultSettings();  // every keyword at its default (constructor, and settings() before parsing)
+  // the keywords' values (subgrid_options.h), and the sub-grid model to be built anew (constructor: the defaults)
+  void applySettings(const fdm::SubgridOptions &options);
   void pairResistance(double a, double h, double &normal, double &slip) const;
   void wallResistance(double a, double h, double &normal, double &slip) const;
 

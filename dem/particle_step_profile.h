@@ -20,6 +20,7 @@
 #ifndef FDM_PARTICLE_STEP_PROFILE_H
 #define FDM_PARTICLE_STEP_PROFILE_H
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 
@@ -51,6 +52,12 @@ class ParticleStepProfile {
   // adds the time since `since` to `part` and returns now, the start of whatever follows
   Clock::time_point lap(Part part, Clock::time_point since);
   void add(Part part, double seconds) { seconds_[part] += seconds; }
+  // A stretch of `seconds` that began when timed() was timedBefore: what the parts timed within it do
+  // not hold (never below 0) goes to `part`
+  void addUntimed(Part part, double seconds, double timedBefore)
+  {
+    seconds_[part] += std::max(0.0, seconds - (timed() - timedBefore));
+  }
   double seconds(Part part) const { return seconds_[part]; }
   double timed() const;                   // the sum of the parts
   static const char *name(Part part);

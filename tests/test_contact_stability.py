@@ -40,6 +40,26 @@ def test_the_suspension_springs_follow_the_recipe():
     assert s.dt_limit_tangential == cs.explicit_time_step_limit(s.zeta_t, s.kt, "ab2")
 
 
+def test_the_suspension_springs_report_the_scenes_model_and_the_mid_gap_lever_arm():
+    # zeta_n, zeta_t of the a1-a1 pair at h_r/2 come from the sub-grid model the scene runs with (calibrated
+    # unless asked) and the contact points in the middle of the gap (docs/contact.md 2); the springs
+    # themselves do not depend on either. At a1/Delta = 3: zeta_t 17.16 N s/m (calibrated) against 19.40
+    # (cut-off model) and 19.42 with the lever arm a1 (fdmResistance matrix, 12 x 12 solve)
+    delta = 1.0 / 3.0
+    calibrated = suspension.choose_springs(stress=1.5, dt=0.01, delta=delta)
+    cutoff = suspension.choose_springs(stress=1.5, dt=0.01, delta=delta, model="cutoff")
+    gap = 0.5 * suspension.ROUGHNESS
+    assert (calibrated.zeta_n, calibrated.zeta_t) == theory.pair_mode_resistances(
+        suspension.A1, suspension.A1, gap, delta, suspension.ETA, model="calibrated", contact_in_mid_gap=True)
+    assert calibrated.zeta_t == pytest.approx(17.16, abs=0.01)
+    assert cutoff.zeta_t == pytest.approx(19.40, abs=0.01)
+    lever_a = theory.pair_mode_resistances(suspension.A1, suspension.A1, gap, delta, suspension.ETA)[1]
+    assert lever_a == pytest.approx(19.42, abs=0.01)
+    assert (calibrated.kn, calibrated.kt, calibrated.design_load) == (cutoff.kn, cutoff.kt, cutoff.design_load)
+    with pytest.raises(ValueError, match="model"):
+        theory.pair_mode_resistances(1.0, 1.0, gap, delta, model="exact")
+
+
 def test_limit_ratio_and_the_time_step_limits_of_docs_contact_md():
     assert cs.limit_ratio("ab2") == 1.0 and cs.limit_ratio("euler") == 2.0
     with pytest.raises(ValueError, match="integrator"):

@@ -14,11 +14,11 @@ import pytest
 
 TESTS = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(TESTS)
-MODULES = ("calibration", "case", "cellpositions", "channelscenes", "checkpoint", "cli", "contacts", "contactstability",
-           "convergence", "couettescene", "decomposition", "deminput", "demonly", "environment", "files", "foamcase",
-           "output", "packing", "pairshearstresslet", "pairstresslet", "pairtangential", "periodicarray", "poiseuille",
-           "profiles", "results", "rheology", "runner", "sbm", "shear", "squeeze", "suspension", "theory", "timeseries",
-           "validation", "wallcalibration")
+MODULES = ("calibration", "case", "cellpositions", "channelscenes", "checkpoint", "cli", "contacts", "contactscenes",
+           "contactstability", "convergence", "couettescene", "decomposition", "deminput", "demonly", "environment",
+           "files", "foamcase", "output", "packing", "pairshearstresslet", "pairstresslet", "pairtangential",
+           "periodicarray", "poiseuille", "profiles", "results", "rheology", "runner", "sbm", "shear", "squeeze",
+           "suspension", "theory", "timeseries", "validation", "wallcalibration")
 
 
 def clean_environment() -> dict:

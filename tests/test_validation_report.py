@@ -124,3 +124,50 @@ def test_table8_figures_join_the_report(tmp_path, env):
         name = "table8_" + summary[key]
         assert "![%s](r/%s)" % (name, name) in text
         assert (out.parent / "r" / name).stat().st_size > 0
+
+
+STORED = os.path.join(PROJECT, "docs", "data", "validation_report")
+
+
+def table_lines(text):
+    """The report's table rows (every line of a Markdown table) and its sections' headings, in order."""
+    return [line for line in text.splitlines() if line.startswith("|") or line.startswith("## ")]
+
+
+def test_report_only_rebuilds_the_stored_report_row_for_row(tmp_path):
+    """The stored report (docs/data/validation_report.md, .json) rebuilt with --report-only from results files
+    that hold its rows (the one shape, fdmsubgrid.results) and the records of its runs: every case's rows, the
+    squeeze calibration's rows (recomputed from the shipped measurements) and Table 8's (recomputed from the
+    stored summary) are the stored ones, and so is every table line of the Markdown, row for row. A change to
+    the reader, the rows' text or the report's tables shows here. No case runs (the calibration rows' theory
+    calls fdmResistance: about a minute at load 11 on 2 cores)."""
+    from fdmsubgrid import results, validation
+    with open(STORED + ".json") as f:
+        stored = json.load(f)
+    work = tmp_path / "work"
+    for case in stored["cases"]:
+        folder = work / case["key"]
+        folder.mkdir(parents=True)
+        date, commit = case["provenance"].split("run on ", 1)[1].split(", read from")[0].split(" at commit ")
+        document = dict(shape=results.SHAPE, case=case["key"], command=case["command"], commit=commit, date=date,
+                        wall_seconds=case["wall_seconds"], scene={}, rows=case["rows"], data={})
+        (folder / "results.json").write_text(json.dumps(document))
+        (folder / validation.RUN_RECORD).write_text(json.dumps(dict(command=case["command"], commit=commit, date=date,
+                                                                    wall_seconds=case["wall_seconds"], exit_code=0)))
+    out = tmp_path / "report.md"
+    env = dict(os.environ, PYTHONPATH=os.path.join(PROJECT, "scripts"))
+    done = report(["--report-only", "--workdir", str(work), "--table8", os.path.join(PROJECT, stored["table8"]),
+                   "--out", str(out)], env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    with open(tmp_path / "report.json") as f:
+        rebuilt = json.load(f)
+    assert [c["key"] for c in rebuilt["cases"]] == [c["key"] for c in stored["cases"]]
+    for got, want in zip(rebuilt["cases"], stored["cases"]):
+        assert got["status"] == want["status"] == "read" and got["command"] == want["command"], got["key"]
+        assert got["rows"] == want["rows"], got["key"]
+    assert rebuilt["squeeze_calibration_rows"] == stored["squeeze_calibration_rows"]
+    assert rebuilt["table8_rows"] == stored["table8_rows"]
+    got_lines, want_lines = table_lines(out.read_text()), table_lines(open(STORED + ".md").read())
+    assert len(got_lines) == len(want_lines) > 300
+    for got, want in zip(got_lines, want_lines):
+        assert got == want

@@ -182,7 +182,7 @@ def main(argv: list[str] | None = None) -> dict:
     if missing:
         raise SystemExit(case.refusal("poiseuille", missing))
     tau_w = abs(grad) * width / 2
-    springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt, sizes)
+    springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt, sizes, model=args.model)
     print(springs.describe(dt))
     warning = poiseuille.time_step_warning(args.dt, args.fluid_every, sizes)
     if warning:

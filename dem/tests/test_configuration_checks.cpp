@@ -123,3 +123,24 @@ TEST(ConfigurationChecks, ADeepOverlapDuringARunStopsIt)
   const std::string p = fdm::deepOverlapProblem(3, 7, -0.1, 0.1, 42);
   EXPECT_TRUE(contains(p, "particles 3 and 7 overlap by 0.1 m (0.1 of the smaller radius) at step 42")) << p;
 }
+
+TEST(ConfigurationChecks, TheInputsSetUpNeedsNewtonOffUnitsSiAndAPositiveStep)
+{
+  EXPECT_EQ(fdm::couplingSetupProblem(false, "si", 1e-3), "");
+  EXPECT_EQ(fdm::couplingSetupProblem(true, "si", 1e-3), "fix fdm/couple requires newton off");
+  EXPECT_EQ(fdm::couplingSetupProblem(false, "lj", 1e-3),
+            "fix fdm/couple requires units si (the fluid solver works in SI), not units lj");
+  EXPECT_EQ(fdm::couplingSetupProblem(false, "si", 0), "fix fdm/couple requires a positive timestep");
+  EXPECT_EQ(fdm::couplingSetupProblem(false, "si", std::nan("")), "fix fdm/couple requires a positive timestep");
+}
+
+TEST(ConfigurationChecks, OtherFixesThatMoveOrWeighTheParticlesAreRefusedByName)
+{
+  EXPECT_EQ(fdm::otherFixProblem("fdm/output", "out", false), "");
+  EXPECT_EQ(fdm::otherFixProblem("fdm/couple", "c2", true), "fix fdm/couple is defined twice: one coupled fluid, one fix");
+  EXPECT_EQ(fdm::otherFixProblem("nve/sphere", "integr", true),
+            "fix fdm/couple moves the particles itself (it replaces nve/sphere): remove fix integr (nve/sphere)");
+  const std::string g = fdm::otherFixProblem("gravity", "grav", false);
+  EXPECT_TRUE(contains(g, "fix grav (gravity) adds the full weight m g without buoyancy")) << g;
+  EXPECT_TRUE(contains(g, "use the gravity keyword of fix fdm/couple")) << g;
+}

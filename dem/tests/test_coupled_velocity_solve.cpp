@@ -130,3 +130,33 @@ TEST(CoupledVelocitySolve, AParticleWithNoFluidVolumeIsNamedWithTheMeshSize)
     EXPECT_NE(std::string(e.what()).find("is it smaller than a mesh cell (0.25)?"), std::string::npos) << e.what();
   }
 }
+
+TEST(CoupledVelocitySolve, PerAtomRowsAreTheFixsColumnsAndZeroForAnUnknownParticle)
+{
+  // one sphere pushed along x without a fluid: its row is the drag F^FDM = -F (6), F^SG = 0 (6) and,
+  // with stresslets, the 20 stress columns in order
+  const std::vector<fdm::GatheredParticle> p = {sphere(5, 1.0, 3.0), sphere(9, 1.5, 0.0)};
+  Solve s(2);
+  s.assemble(p);
+  s.solve.noFluidStep(p, 1, 6.0, 0.0);
+  fdm::CoupledVelocitySolve::Results &r = s.solve.results();
+  ASSERT_EQ(fdm::CoupledVelocitySolve::Results::perAtomColumns(false), 12);
+  ASSERT_EQ(fdm::CoupledVelocitySolve::Results::perAtomColumns(true), 32);
+  for (size_t k = 0; k < r.stress.size(); k++) r.stress[k] = double(k);
+  double row[32];
+  r.perAtomRow(0, 2, true, row);
+  EXPECT_EQ(row[0], r.hydro[0]);
+  EXPECT_NEAR(row[0], -3.0, 1e-12);
+  for (int c = 0; c < 6; c++) EXPECT_EQ(row[6 + c], r.subgrid[c]);
+  r.perAtomRow(1, 2, true, row);
+  for (int c = 0; c < 20; c++) EXPECT_EQ(row[12 + c], 20.0 + c);
+  // a tag beyond the particles the fluid was told of, or results not sized for them: zeros
+  for (long index : {-1L, 2L}) {
+    r.perAtomRow(index, 2, true, row);
+    for (int c = 0; c < 32; c++) EXPECT_EQ(row[c], 0.0) << index << " " << c;
+  }
+  row[12] = 7.0;
+  r.perAtomRow(0, 3, false, row);
+  for (int c = 0; c < 12; c++) EXPECT_EQ(row[c], 0.0);
+  EXPECT_EQ(row[12], 7.0);   // without stresslets the row is 12 columns: nothing beyond is written
+}

@@ -83,3 +83,32 @@ TEST(MovePlan, TheFallbackIsSaidWithItsCounts)
   EXPECT_EQ(w.find("fdm/couple: step 40: the log-gap targets of 12 pairs and 3 wall gaps contradict each other "
                    "(a gap still 0.7 of its target off after 30 sweeps)"), 0u) << w;
 }
+
+TEST(MovePlan, TheImplicitSpringsTakeUnOnlyWhenTheStepOrTheChordNeedsIt)
+{
+  fdm::MovePlan plan(options());
+  fdm::ParticleVelocitySystem::Springs none;
+  plan.springHistory(false, true, 1, 0.1, none);   // no velocities yet: no chord term
+  EXPECT_EQ(none.gamma, 0.0);
+  EXPECT_EQ(none.dt, 0.0);
+  EXPECT_TRUE(none.previous.empty());
+  const std::vector<double> u = {1, 2, 3, 4, 5, 6};
+  plan.solved(u);
+  fdm::ParticleVelocitySystem::Springs chord, multistep, both, off, otherCount;
+  plan.springHistory(false, true, 1, 0.1, chord);
+  EXPECT_EQ(chord.gamma, 0.0);
+  EXPECT_EQ(chord.dt, 0.1);
+  EXPECT_EQ(chord.previous, u);
+  plan.springHistory(true, false, 1, 0.1, multistep);
+  EXPECT_EQ(multistep.gamma, 1.0 / 3.0);
+  EXPECT_EQ(multistep.dt, 0.0);
+  EXPECT_EQ(multistep.previous, u);
+  plan.springHistory(true, true, 1, 0.1, both);
+  EXPECT_EQ(both.gamma, 1.0 / 3.0);
+  EXPECT_EQ(both.dt, 0.1);
+  plan.springHistory(false, false, 1, 0.1, off);
+  EXPECT_TRUE(off.previous.empty());
+  plan.springHistory(false, true, 2, 0.1, otherCount);   // U_n of another particle count: no chord term
+  EXPECT_EQ(otherCount.dt, 0.0);
+  EXPECT_TRUE(otherCount.previous.empty());
+}

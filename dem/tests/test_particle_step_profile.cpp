@@ -147,6 +147,23 @@ TEST(ParticleStepProfile, LapAddsTheElapsedTimeAndStartsTheNext)
   EXPECT_DOUBLE_EQ(p.timed(), p.seconds(Profile::contact));
 }
 
+TEST(ParticleStepProfile, AStretchAddsWhatItsTimedPartsDoNotHold)
+{
+  Profile p;
+  p.add(Profile::contact, 0.5);
+  const double before = p.timed();
+  p.add(Profile::systemAssembly, 0.25);   // timed within the stretch
+  p.add(Profile::systemFactorisation, 0.125);
+  p.addUntimed(Profile::systemSolves, 1.0, before);
+  EXPECT_EQ(p.seconds(Profile::systemSolves), 0.625);
+  EXPECT_EQ(p.timed(), 1.5);
+  // the timed parts hold more than the stretch (clocks read apart): nothing is added, never a negative
+  const double again = p.timed();
+  p.add(Profile::systemResults, 0.5);
+  p.addUntimed(Profile::systemSolves, 0.25, again);
+  EXPECT_EQ(p.seconds(Profile::systemSolves), 0.625);
+}
+
 TEST(ParticleStepProfile, EveryPartHasItsOwnName)
 {
   std::vector<std::string> names;

@@ -134,11 +134,12 @@ def time_step_warning(phi: float, dt: float, sizes: packing.SizeDistribution | N
 
 
 def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None,
-                   sizes: packing.SizeDistribution | None = None) -> suspension.Springs:
+                   sizes: packing.SizeDistribution | None = None, model: str = "calibrated") -> suspension.Springs:
     """The springs by the rule of the module docstring (docs/contact.md) for the shear stress
-    eta gamma_dot_0 eta_MP(phi) and the sizes (default the paper's), unless given."""
+    eta gamma_dot_0 eta_MP(phi) and the sizes (default the paper's), unless given; model: the scene's
+    sub-grid model (suspension.choose_springs)."""
     return suspension.choose_springs(ETA * SHEAR_RATE * suspension.maron_pierce_viscosity(phi), dt, delta, kn, kt,
-                                     sizes)
+                                     sizes, model=model)
 
 
 def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
@@ -221,7 +222,7 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
     missing = deminput.uncalibrated(pack.radii, delta, walls=True, model=model)
     if missing:
         raise UncalibratedScene(deminput.refusal("couette", missing))
-    springs = choose_springs(pack.phi, dt, delta, kn, kt, sizes)
+    springs = choose_springs(pack.phi, dt, delta, kn, kt, sizes, model=model)
     print(springs.describe(dt))
     warning = time_step_warning(pack.phi, dt, sizes)
     if warning:

@@ -21,7 +21,9 @@ The contact springs (docs/contact.md, "A recipe"):
                                                      2c) hold at any k_t dt/zeta_t (docs/benchmarks.md,
                                                      "Coulomb's law at the end of the step")
 with zeta_n, zeta_t the normal and slip resistances of a free pair of the smallest spheres at the gap h_r/2
-(Stokes drag plus the sub-grid block at this a1/Delta, fdmResistance).
+(Stokes drag plus the sub-grid block of the scene's sub-grid model at this a1/Delta, fdmResistance; the
+contact points in the middle of the gap). They set only the explicit springs' limits that Springs.describe
+reports.
 
 The smallest sphere sets the mesh and the time step (check_resolution, time_step_factor): the mesh must
 resolve it (a_min/Delta at least MIN_A_OVER_DELTA, and a calibration for each of its pairs), and the
@@ -124,15 +126,19 @@ def scaled_time_step(dt: float, sizes: packing.SizeDistribution) -> float:
 
 
 def choose_springs(stress: float, dt: float, delta: float, kn: float | None = None,
-                   kt: float | None = None, sizes: packing.SizeDistribution | None = None) -> Springs:
+                   kt: float | None = None, sizes: packing.SizeDistribution | None = None,
+                   model: str = "calibrated") -> Springs:
     """The springs by the rule of the module docstring for the shear stress `stress` [Pa] and the size distribution
     `sizes` (default the paper's), unless given (fdmsubgrid.contactstability: the design load, the recipe's k_n,
     the explicit springs' limits): the design load of the largest sphere, the resistances of a pair of the
-    smallest."""
+    smallest. model: the scene's sub-grid model (pair_style fdm/subgrid model, write_case's), which sets zeta_n
+    and zeta_t (not the springs)."""
     sizes = PAPER_SIZES if sizes is None else sizes
     design_load = contactstability.design_load(sizes.largest * A1, stress)
     a_min = sizes.smallest * A1
-    zeta_n, zeta_t = theory.pair_mode_resistances(a_min, a_min, 0.5 * ROUGHNESS, delta, ETA)
+    # the contact points in the middle of the gap (docs/contact.md 2): lever arms a + h_r/4
+    zeta_n, zeta_t = theory.pair_mode_resistances(a_min, a_min, 0.5 * ROUGHNESS, delta, ETA, model=model,
+                                                  contact_in_mid_gap=True)
     kn = contactstability.normal_stiffness(design_load, ROUGHNESS) if kn is None else kn
     # k_t independent of dt: until the return mapping of docs/contact.md 2c the rule was
     # min(k_n, 0.5 zeta_t/dt), which softened friction as dt grew (eta_s at phi 0.47 fell with dt)

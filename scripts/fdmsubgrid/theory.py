@@ -69,7 +69,7 @@ def wall_subgrid_range(a: float, delta: float, model: str = "calibrated") -> flo
 @functools.lru_cache(maxsize=4096)
 def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta: float = 1.0,
                           cutoff: Optional[float] = None, subgrid: bool = True,
-                          contact_in_mid_gap: bool = False) -> tuple[float, float]:
+                          contact_in_mid_gap: bool = False, model: str = "cutoff") -> tuple[float, float]:
     """(zeta_n, zeta_t) of two free spheres at surface gap `gap`: the force per unit closing speed
     under equal and opposite loads along the line of centres, and per unit slip speed of the contact
     points under equal and opposite tangential loads there (with their torques). The resistance is
@@ -78,7 +78,10 @@ def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta:
     (docs/contact.md, 3c). The contact points sit on the spheres' surfaces (a_i, a_j from the
     centres), or with contact_in_mid_gap in the middle of the gap (docs/contact.md 2). Without the
     sub-grid block, zeta_t of two equal spheres is 12/7 pi eta a. cutoff: the cut-off model's k in mesh
-    cells (None: the pair style's default)."""
+    cells (None: the pair style's default). model: pair_style fdm/subgrid's sub-grid model, 'cutoff' or
+    'calibrated' (the shipped table; the functions it lacks from the cut-off model at `cutoff`)."""
+    if model not in ("cutoff", "calibrated"):
+        raise ValueError("model must be 'cutoff' or 'calibrated', got %r" % (model,))
     if cutoff is None:
         cutoff = pair_style_cutoffs()[0]
     drag = [6 * math.pi * eta * a_i] * 3 + [8 * math.pi * eta * a_i ** 3] * 3 \
@@ -86,7 +89,8 @@ def pair_mode_resistances(a_i: float, a_j: float, gap: float, delta: float, eta:
     resistance_matrix = np.diag(drag)
     if subgrid:
         out = resistance("matrix", "--x1", 0, 0, 0, "--x2", "%.17g" % (a_i + a_j + gap), 0, 0, "--a1", a_i,
-                         "--a2", a_j, "--delta", "%.17g" % delta, "--eta", eta, "--cutoff", cutoff)
+                         "--a2", a_j, "--delta", "%.17g" % delta, "--eta", eta, "--cutoff", cutoff,
+                         *(("--calibrated",) if model == "calibrated" else ()))
         resistance_matrix = resistance_matrix + np.array(out["R"])
     d = np.array([1.0, 0.0, 0.0])       # from sphere i to sphere j
     t = np.array([0.0, 1.0, 0.0])
