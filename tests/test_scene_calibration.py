@@ -41,9 +41,9 @@ def test_a_scene_needing_only_an_interpolated_wall_runs_with_its_own_table(env, 
     assert sorted(set(pack.radii)) == [1.0, 1.4] and list(pack.radii).count(1.4) == 1     # the scene meant
     out = capsys.readouterr().out
     line = [l for l in out.splitlines() if "interpolated" in l]
-    assert line == ["couette: the sub-grid calibration interpolated for radius 1.4 at a wall (a/Delta 5.6, error "
-                    "1.2 %) (measured on held-back blocks, within 2 %): the run reads dem/subgrid_calibration.dat, "
-                    "the shipped table with these blocks (docs/resistance.md)"]
+    assert line == ["couette: the run reads dem/subgrid_calibration.dat, the shipped table with the squeeze "
+                    "interpolated for radius 1.4 at a wall (a/Delta 5.6, error 1.2 %) (measured on held-back blocks, "
+                    "within 2 %; the tangential functions there from the cut-off model: docs/resistance.md)"]
     table = os.path.join(run_dir, "dem", "subgrid_calibration.dat")
     dem_input = os.path.join(run_dir, "dem", "in.couette")
     pair_style = [l for l in open(dem_input) if l.startswith("pair_style")]

@@ -164,15 +164,15 @@ class SceneCalibration:
         return path
 
     def line(self) -> str | None:
-        """One line saying which pairs and walls are interpolated and their measured error bound (None for
-        the shipped table)."""
+        """One line saying which pairs and walls are interpolated and their measured error bound, and that
+        only their squeeze is (None for the shipped table)."""
         if self.text is None:
             return None
         from . import subgridinterp
-        return ("%s: the sub-grid calibration interpolated for %s (measured on held-back blocks, within %g %%): "
-                "the run reads dem/%s, the shipped table with these blocks (docs/resistance.md)"
-                % (self.who, "; ".join(_entry_text(e) for e in self.interpolated), 100 * subgridinterp.TOLERANCE,
-                   SCENE_TABLE))
+        return ("%s: the run reads dem/%s, the shipped table with the squeeze interpolated for %s (measured on "
+                "held-back blocks, within %g %%; the tangential functions there from the cut-off model: "
+                "docs/resistance.md)" % (self.who, SCENE_TABLE, "; ".join(_entry_text(e) for e in self.interpolated),
+                                         100 * subgridinterp.TOLERANCE))
 
 
 def _entry_text(entry) -> str:
