@@ -18,7 +18,7 @@ MODULES = ("calibration", "case", "cellpositions", "channelscenes", "checkpoint"
            "contactstability", "convergence", "couettescene", "decomposition", "deminput", "demonly", "environment",
            "files", "foamcase", "output", "packing", "pairshearstresslet", "pairstresslet", "pairtangential",
            "periodicarray", "poiseuille", "profiles", "results", "rheology", "runner", "sbm", "shear", "squeeze",
-           "subgridinterp", "suspension", "theory", "timeseries", "validation", "wallcalibration")
+           "steadystate", "subgridinterp", "suspension", "theory", "timeseries", "validation", "wallcalibration")
 
 
 def clean_environment() -> dict:

@@ -515,7 +515,23 @@ def snapshot(case_dir: str, dest: str, scene: str | None = None, dem_input: str 
     shutil.copyfile(dem_file(case_dir, step), os.path.join(new, "dem.%d" % step))
     shutil.copyfile(fluid_marker(case_dir, step), os.path.join(new, "fluid.%d" % step))
     shutil.copyfile(os.path.join(case_dir, "dem", name), os.path.join(new, name))
-    shutil.copyfile(stamp_path, os.path.join(new, SNAPSHOT_CALIBRATION))
+    # the table by its hash (what a continued run is checked against) and its path as the project names it:
+    # a snapshot is committed, and no machine's path goes with it
+    with open(stamp_path) as f:
+        identity = json.load(f)
+    if identity.get("table"):
+        root = os.path.normpath(os.environ.get("FDM_ROOT")
+                                or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+        table = os.path.normpath(identity["table"])
+        shipped = os.path.join("dem", "resistance", "data") + os.sep
+        if table.startswith(root + os.sep):
+            identity["table"] = os.path.relpath(table, root)
+        elif shipped in table:      # the shipped table of another checkout of the project
+            identity["table"] = table[table.rindex(shipped):]
+        else:
+            identity["table"] = os.path.basename(table)
+    with open(os.path.join(new, SNAPSHOT_CALIBRATION), "w") as f:
+        json.dump(identity, f)
     with open(os.path.join(new, SCENE_FILE), "w") as f:
         f.write(scene + "\n")
     with open(os.path.join(new, "README"), "w") as f:
