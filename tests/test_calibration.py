@@ -160,7 +160,8 @@ def test_calibrated_model_refuses_an_uncovered_resolution(tmp_path, env):
 
 def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
     """`fdmResistance coverage` makes the pair style's test; the suspension cases ask it before they
-    write anything: a1/Delta = 4 with a2 = 1.4 a1 between walls has no wall calibration for a/Delta 5.6."""
+    write anything: a1/Delta = 4 with a2 = 1.4 a1 between walls has no wall calibration for a/Delta 5.6 (the
+    interpolation gives one within 2 %) and no pair 1.4-1.4 at a1/Delta 5.6 (it does not)."""
     from fdmsubgrid import case
     covered = theory.resistance("coverage", "--a1", 1, "--a2", 1.4, "--delta", 1 / 3, "--wall")
     assert covered["pair"] and covered["pair_tangential"] and covered["wall"]
@@ -179,6 +180,8 @@ def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
     couette = load_case_module("couette")
     with pytest.raises(SystemExit) as refused:
         couette.main(["--a-over-delta", "4", "--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
-    assert "radius 1.4 at a wall (a/Delta 5.6)" in str(refused.value)
+    # the 1.4-1.4 pairs (a1/Delta 5.6) lie beyond the interpolation's 2 %; the wall of 1.4 does not
+    assert "the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated" in str(refused.value)
+    assert "interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.2 %)" in str(refused.value)
     assert "--model cutoff" in str(refused.value)
     assert os.listdir(tmp_path) == []

@@ -178,9 +178,12 @@ def main(argv: list[str] | None = None) -> dict:
         pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
                                        wall_gap=2 * suspension.ROUGHNESS, sizes=sizes)
     print("packing:", pack.summary())
-    missing = case.uncalibrated(pack.radii, delta, walls=True, model=args.model)
-    if missing:
-        raise SystemExit(case.refusal("poiseuille", missing))
+    try:
+        calibration = case.scene_calibration("poiseuille", pack.radii, delta, walls=True, model=args.model)
+    except case.UncalibratedScene as e:
+        raise SystemExit(str(e))
+    if calibration.line():
+        print(calibration.line(), flush=True)
     tau_w = abs(grad) * width / 2
     springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt, sizes, model=args.model)
     print(springs.describe(dt))
@@ -206,7 +209,7 @@ def main(argv: list[str] | None = None) -> dict:
     scene = suspension.write_case(run_dir, pack, springs, args.a_over_delta, dt, steps, every, args.tol_lambda,
                                   args.acceleration, args.n_max, write_every, model=args.model,
                                   grad_p0=(grad, 0.0, 0.0), name="in.poiseuille", fluid_every=K,
-                                  held_drag=args.held_drag)
+                                  held_drag=args.held_drag, calibration=calibration)
     # the command that writes this scene again, for a compact snapshot of its run
     checkpoint.write_scene_command(run_dir, __file__, sys.argv[1:] if argv is None else list(argv))
     print("wrote %s: %d spheres (%s), phi %.4f, channel %s a1, %d cells, dP0/dx = %.4g Pa/m (U_c = %g), "

@@ -142,12 +142,14 @@ def check_scene(eps_values: Sequence[float], radii: Sequence[float], size: Seque
 
 
 def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool, eps_values: Sequence[float],
-              offsets: Sequence[Sequence[float]], options, loads: str = "", load_name: str = "") -> dict:
+              offsets: Sequence[Sequence[float]], options, loads: str = "", load_name: str = "",
+              calibration: case.SceneCalibration | None = None) -> dict:
     """One coupled run: the sphere of `radius` at every eps (largest first) and every offset, one step each.
     Returns dict(per_step=[...], wall_seconds, cells). With `loads` (LIGGGHTS lines: fix addforce, fix
     fdm/torque; `load_name` tags the run folder) both walls are at rest and the fluid starts at rest: the
     sphere driven by the loads alone (shearStresslet.py), U_x/(gamma_dot d) and the like then in units of
-    gamma_dot = 1."""
+    gamma_dot = 1. calibration: the table the scene runs with (case.scene_calibration; None: the shipped one),
+    written into the run's dem/ when it holds interpolated blocks."""
     delta = A1 / options.a_over_delta
     lx, ly, lz = (float(v) for v in size)
     wall_speed = 0.0 if loads else SHEAR_RATE * ly
@@ -170,11 +172,16 @@ def run_scene(workdir: str, size: Sequence[float], radius: float, subgrid: bool,
     case.write_initial_velocity(fluid, box, lambda c: np.column_stack(
         [wall_speed / ly * c[:, 1], np.zeros(len(c)), np.zeros(len(c))]))
     runs = case.held_step_runs([[p] for p in positions])
+    # the calibration table the scene runs with: the shipped one, or with the interpolated wall blocks it needs
+    table = calibration.table() if calibration is not None and subgrid else None
+    if table is not None:
+        calibration.write(os.path.join(run_dir, "dem"))
     case.write_dem_input(os.path.join(run_dir, "dem"), box, [positions[0] + (radius,)], dt=1.0,
                          fix_options="move no stresslets yes",
                          # the walls as in the fluid case: y = 0 at rest, y = L_y at gamma_dot L_y along x
                          pair_style=case.subgrid_pair_style((("ylo", (0, 0, 0)), ("yhi", (wall_speed, 0, 0))),
-                                                            subgrid, options.model, options.cutoff, options.wall_cutoff),
+                                                            subgrid, options.model, options.cutoff, options.wall_cutoff,
+                                                            calibration=table),
                          before_run=case.RECORD_EVERY_STEP + ("\n" + loads if loads else ""),
                          runs=runs, name="in.wallShear")
     wall = case.run(run_dir, np_fluid=options.np_fluid)
@@ -244,13 +251,15 @@ def summarise(scene: dict, radius: float, subgrid: bool, size: Sequence[float], 
 
 
 def run_box(workdir: str, size: Sequence[float], radii: Sequence[float], subgrid_modes: Sequence[bool],
-            eps_values: Sequence[float], offsets, represented: int, options) -> dict:
-    """Every radius with every sub-grid mode in one box: one coupled run each. Returns the rows."""
+            eps_values: Sequence[float], offsets, represented: int, options,
+            calibration: case.SceneCalibration | None = None) -> dict:
+    """Every radius with every sub-grid mode in one box: one coupled run each (with the sub-grid correction on
+    the calibration table `calibration`, run_scene). Returns the rows."""
     t0 = time.time()
     rows, cells = [], None
     for radius in radii:
         for subgrid in subgrid_modes:
-            scene = run_scene(workdir, size, radius, subgrid, eps_values, offsets, options)
+            scene = run_scene(workdir, size, radius, subgrid, eps_values, offsets, options, calibration=calibration)
             cells = scene["cells"]
             rows += summarise(scene, radius, subgrid, size, represented, options)
             print("  radius %g, sub-grid %s: %.0f s" % (radius, "on" if subgrid else "off", scene["wall_seconds"]))
@@ -422,11 +431,16 @@ def main(argv: Sequence[str] | None = None) -> dict:
             check_scene(args.eps, args.radius, size, args.a_over_delta)
     except ValueError as e:
         p.error(str(e))
+    calibration = None
     if True in subgrid_modes:
-        # one sphere at a time: each radius against the walls needs a calibration
-        missing = case.uncalibrated(args.radius, A1 / args.a_over_delta, walls=True, model=args.model, pairs=False)
-        if missing:
-            p.error(case.refusal("wallShear", missing))
+        # one sphere at a time: each radius against the walls needs a calibration (or an interpolated one)
+        try:
+            calibration = case.scene_calibration("wallShear", args.radius, A1 / args.a_over_delta, walls=True,
+                                                 model=args.model, pairs=False)
+        except case.UncalibratedScene as e:
+            p.error(str(e))
+        if calibration.line():
+            print(calibration.line(), flush=True)
 
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()
@@ -434,7 +448,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
     for size in boxes:
         print("box %g x %g x %g a1, a1/Delta %g, %d offsets (%d computed)" % (*size, args.a_over_delta, represented,
                                                                             len(offsets)))
-        result = run_box(args.workdir, size, args.radius, subgrid_modes, args.eps, offsets, represented, args)
+        result = run_box(args.workdir, size, args.radius, subgrid_modes, args.eps, offsets, represented, args,
+                         calibration)
         print_rows(result["rows"])
         results.append(result)
     comparison = box_comparison(results) if len(results) > 1 else []

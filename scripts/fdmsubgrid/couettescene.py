@@ -145,16 +145,18 @@ def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None,
 def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
                strain: float, dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50,
                write_every: int = 100000, text_dump: bool = False, model: str = "calibrated",
-               fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated") -> dict:
+               fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated",
+               calibration: deminput.SceneCalibration | None = None) -> dict:
     """fluid/ and dem/ of the run (suspension.write_case with the walls at -U and +U); returns the
     scene's description. fluid_options: more arguments of case.write_fluid_case; fluid_every: particle
-    steps per fluid step; held_drag: how the steps between hold the fluid's force (fix fdm/couple)."""
+    steps per fluid step; held_drag: how the steps between hold the fluid's force (fix fdm/couple);
+    calibration: the table the scene runs with (deminput.scene_calibration; None: the shipped one)."""
     U = SHEAR_RATE * float(pack.box[1]) / 2
     steps = int(round(strain / (SHEAR_RATE * dt)))
     scene = suspension.write_case(run_dir, pack, springs, a_over_delta, dt, steps, dump_every, tol_lambda,
                                   acceleration, n_max, write_every, text_dump, model, wall_velocities=(-U, U),
                                   name="in.couette", fluid_options=fluid_options, fluid_every=fluid_every,
-                                  held_drag=held_drag)
+                                  held_drag=held_drag, calibration=calibration)
     scene.update(wall_velocity=U)
     return scene
 
@@ -170,8 +172,9 @@ def table8_row(phi: float) -> dict:
     return dict(zip(("phi_core", "gamma_core_over_gamma0", "size", "n_particles", "dt"), TABLE8[phi]))
 
 
-class UncalibratedScene(ValueError):
-    """The shipped sub-grid calibration does not cover the packing's radii at this mesh size."""
+# the scene refused: the calibration does not cover the packing's radii at this mesh size, not even by
+# interpolation within its measured tolerance (deminput.scene_calibration)
+UncalibratedScene = deminput.UncalibratedScene
 
 
 def sizes_tag(sizes: packing.SizeDistribution | None) -> str:
@@ -211,17 +214,18 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
     write_every strain units (on steps the fluid solves: multiples of fluid_every). The defaults are
     cases/couette/couette.py's; sizes: the size distribution (packing.SizeDistribution, default the paper's).
     SizeDistributionError if the mesh does not resolve the smallest sphere (suspension.check_resolution),
-    UncalibratedScene if the calibration does not cover the packing's radii (its message one line per missing
-    pair, deminput.refusal), FileExistsError if the folder exists and not overwrite. Returns dict(run_dir, name, pack, springs,
+    UncalibratedScene if the calibration does not cover the packing's radii, not even interpolated within its
+    measured 2 % (its message one line per refused pair, deminput.scene_calibration; where it does, the
+    interpolated table is written into dem/ and a line says so), FileExistsError if the folder exists and not overwrite. Returns dict(run_dir, name, pack, springs,
     dump_every_steps, scene) with the scene's description (write_case)."""
     delta = A1 / a_over_delta
     suspension.check_resolution(sizes or suspension.PAPER_SIZES, a_over_delta)
     pack = packing.channel_packing(size, phi=None if n_particles else phi, n=n_particles, seed=seed,
                                    min_gap=2 * ROUGHNESS, wall_gap=2 * ROUGHNESS, sizes=sizes)
     print("packing:", pack.summary())
-    missing = deminput.uncalibrated(pack.radii, delta, walls=True, model=model)
-    if missing:
-        raise UncalibratedScene(deminput.refusal("couette", missing))
+    calibration = deminput.scene_calibration("couette", pack.radii, delta, walls=True, model=model)
+    if calibration.line():
+        print(calibration.line(), flush=True)
     springs = choose_springs(pack.phi, dt, delta, kn, kt, sizes, model=model)
     print(springs.describe(dt))
     warning = time_step_warning(pack.phi, dt, sizes)
@@ -240,7 +244,8 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
     every = K * max(1, int(round(dump_every / (SHEAR_RATE * dt * K))))
     write_every_steps = K * max(1, int(round(write_every / (SHEAR_RATE * dt * K))))
     scene = write_case(run_dir, pack, springs, a_over_delta, dt, strain, every, tol_lambda, acceleration, n_max,
-                       write_every_steps, text_dump, model, fluid_every=fluid_every, held_drag=held_drag)
+                       write_every_steps, text_dump, model, fluid_every=fluid_every, held_drag=held_drag,
+                       calibration=calibration)
     print("wrote %s: %d spheres (%s), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot every %d steps"
           % (run_dir, pack.n, species_text(pack), pack.phi, " x ".join("%g" % v for v in size), scene["cells"],
              scene["steps"], dt, every))

@@ -1,18 +1,22 @@
 """The particle side of a coupled case: fdmDEM's LIGGGHTS input (the spheres' data file, the pair style
 fdm/subgrid, fix fdm/couple connected to ../fluid, the held-configuration runs, the records), and whether
-the shipped sub-grid calibration covers a scene before it is launched (docs/dem.md)."""
+the sub-grid calibration covers a scene before it is launched, with the interpolated blocks a scene
+needs where their measured error allows (scene_calibration; docs/dem.md)."""
 from __future__ import annotations
 
 import os
 from typing import Iterable
 
-def subgrid_pair_style(walls=(), subgrid=True, model=None, cutoff=None, wall_cutoff=None) -> str:
+def subgrid_pair_style(walls=(), subgrid=True, model=None, cutoff=None, wall_cutoff=None, calibration=None) -> str:
     """The pair_style line of fdm/subgrid (docs/dem.md): the sub-grid model, its cut-offs in mesh cells
     (pairs, walls; None: the pair style's defaults), `lubrication no` without the correction, and the
-    walls as (face, (ux, uy, uz)) pairs, e.g. (("ylo", (0, 0, 0)), ("yhi", (U, 0, 0)))."""
+    walls as (face, (ux, uy, uz)) pairs, e.g. (("ylo", (0, 0, 0)), ("yhi", (U, 0, 0))). calibration: the
+    calibration table's file relative to dem/ (SceneCalibration.table(); None: the shipped table)."""
     words = ["fdm/subgrid"]
     if model is not None:
         words.append("model %s" % model)
+    if calibration is not None and subgrid:
+        words.append("calibration %s" % calibration)
     if cutoff is not None:
         words.append("cutoff %g" % cutoff)
     if wall_cutoff is not None:
@@ -124,6 +128,101 @@ def refusal(who: str, missing: list[str]) -> str:
     lacking = sum(1 for line in missing if ": python3 -m fdmsubgrid.calibration" in line)
     return "%s: the sub-grid calibration (model calibrated) lacks %d of this scene's pairs and walls:\n%s" % (
         who, lacking, "\n".join("  " + line for line in missing))
+
+
+class UncalibratedScene(ValueError):
+    """A scene the sub-grid calibration does not cover, not even by an interpolation within its measured
+    tolerance (scene_calibration): the message says so one line per refused pair or wall, each with the
+    command that measures it."""
+
+
+# the file name of a scene's own calibration table, in its dem/ folder (pair_style fdm/subgrid calibration FILE)
+SCENE_TABLE = "subgrid_calibration.dat"
+
+
+class SceneCalibration:
+    """The sub-grid calibration table a scene runs with (scene_calibration): the shipped one (`text` None:
+    nothing to write, the pair style reads its default) or the shipped one with the interpolated blocks of
+    the scene's pairs and walls it lacks (`interpolated`: their subgridinterp.PairCoverage, each within
+    subgridinterp.TOLERANCE as measured), written into each run folder's dem/ by `write`."""
+
+    def __init__(self, who: str, text: str | None = None, interpolated: list | None = None) -> None:
+        self.who, self.text, self.interpolated = who, text, list(interpolated or [])
+
+    def table(self) -> str | None:
+        """The value of pair_style fdm/subgrid's `calibration` (relative to dem/), None for the shipped table."""
+        return None if self.text is None else SCENE_TABLE
+
+    def write(self, dem_dir: str) -> str | None:
+        """Write the table into dem_dir (made if missing); returns its path, None for the shipped table."""
+        if self.text is None:
+            return None
+        from .files import write_atomically
+        os.makedirs(dem_dir, exist_ok=True)
+        path = os.path.join(dem_dir, SCENE_TABLE)
+        write_atomically(path, self.text)
+        return path
+
+    def line(self) -> str | None:
+        """One line saying which pairs and walls are interpolated and their measured error bound, and that
+        only their squeeze is (None for the shipped table)."""
+        if self.text is None:
+            return None
+        from . import subgridinterp
+        return ("%s: the run reads dem/%s, the shipped table with the squeeze interpolated for %s (measured on "
+                "held-back blocks, within %g %%; the tangential functions there from the cut-off model: "
+                "docs/resistance.md)" % (self.who, SCENE_TABLE, "; ".join(_entry_text(e) for e in self.interpolated),
+                                         100 * subgridinterp.TOLERANCE))
+
+
+def _entry_text(entry) -> str:
+    """An interpolated subgridinterp.PairCoverage in a few words, with its measured error bound."""
+    if entry.kind == "wall":
+        return "radius %g at a wall (a/Delta %g, error %.1f %%)" % (entry.pair[0], entry.a_over_delta, 100 * entry.error)
+    return "radii %g and %g (a1/Delta %g, a2/a1 %g, error %.1f %%)" % (entry.pair + (entry.a_over_delta, entry.ratio,
+                                                                            100 * entry.error))
+
+
+def scene_calibration(who: str, radii: Iterable[float], delta: float, walls: bool = False,
+                      model: str = "calibrated", pairs: bool = True) -> SceneCalibration:
+    """The one decision every scene writer makes before it writes a run: which sub-grid calibration table the
+    scene runs with. The shipped table where it covers the scene (uncalibrated() finds nothing missing; model
+    cutoff needs none); else, where every pair and wall it lacks is interpolated within subgridinterp.TOLERANCE
+    as measured on held-back blocks (subgridinterp.coverage), the shipped table with those blocks added (the
+    writer writes it with SceneCalibration.write into the run's dem/, points the pair style at it with
+    `table()` and prints `line()`). Otherwise UncalibratedScene, its message one line per refused pair or wall
+    (subgridinterp.refusal: why, the command that measures it and its cost), a line naming what would be
+    interpolated, the table's line and the cut-off alternative. Arguments as uncalibrated()'s; who: the
+    writer's name, first word of its lines."""
+    radii = [float(r) for r in radii]
+    missing = uncalibrated(radii, delta, walls=walls, model=model, pairs=pairs)
+    if not missing:
+        return SceneCalibration(who)
+    from collections import Counter
+    from . import subgridinterp
+    counts = Counter(radii)
+    sizes = sorted(counts)
+    entries = [e for e in subgridinterp.coverage(sizes, sizes[0] / delta, walls=walls) if e.status != "calibrated"
+               and (e.kind == "wall" or (pairs and (e.pair[0] != e.pair[1] or counts[e.pair[0]] > 1)))]
+    refused = [e for e in entries if e.status == "refused"]
+    interpolated = [e for e in entries if e.status == "interpolated"]
+    if not entries:
+        # the resistance library and the interpolation's reading of the table disagree: refuse as the library does
+        raise UncalibratedScene(refusal(who, missing))
+    if refused:
+        lines = ["%s: the sub-grid calibration (model calibrated) lacks %d of this scene's pairs and walls beyond "
+                 "what the interpolation reaches within %g %%:" % (who, len(refused), 100 * subgridinterp.TOLERANCE)]
+        lines += ["  " + subgridinterp.refusal(e) for e in refused]
+        if interpolated:
+            lines.append("  interpolated within %g %%: %s" % (100 * subgridinterp.TOLERANCE, "; ".join(
+                _entry_text(e) for e in interpolated)))
+        lines += ["  " + line for line in missing[-2:]]
+        raise UncalibratedScene("\n".join(lines))
+    text, done = subgridinterp.interpolated_table([(e.kind, e.a_over_delta, e.ratio) for e in interpolated])
+    left = [d for d in done if d["status"] != "interpolated"]
+    if left:
+        raise RuntimeError("scene_calibration: coverage() and interpolated_table() disagree on %s" % left)
+    return SceneCalibration(who, text, interpolated)
 
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",

@@ -401,6 +401,15 @@ def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], ta
     (math.inf: also those no held-back test reaches), each preceded by a comment line and its header marked
     `interpolated`. Returns per target what was done (status "in the table", "interpolated" or "left out",
     with the measured error and, left out, the command that measures it)."""
+    from .files import write_atomically
+    text, done = interpolated_table(targets, table, max_error)
+    write_atomically(out, text)
+    return done
+
+
+def interpolated_table(targets: Sequence[Tuple[str, float, float]], table: str | None = None,
+                       max_error: float = TOLERANCE) -> Tuple[str, List[Dict]]:
+    """The text `write_interpolated` writes and its per-target record."""
     table = table or _project_file(os.path.join("dem", "resistance", "data", "subgrid_calibration.dat"))
     present = calibration.read_table(table)
     blocks = load_blocks()
@@ -432,9 +441,7 @@ def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], ta
         block += "".join("%.8e %.8e\n" % (xi, v) for xi, v in rows)
         added.append(note + block)
         done.append(dict(kind=kind, a_over_delta=ad, ratio=ratio, status="interpolated", error=bound, rows=len(rows)))
-    from .files import write_atomically
-    write_atomically(out, text + "".join(added))
-    return done
+    return text + "".join(added), done
 
 
 def print_errors(tests: Sequence[HeldBack] | None = None) -> None:

@@ -157,7 +157,8 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
                text_dump: bool = False, model: str = "calibrated", wall_velocities: tuple[float, float] = (0.0, 0.0),
                grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension",
-               fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated") -> dict:
+               fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated",
+               calibration: deminput.SceneCalibration | None = None) -> dict:
     """fluid/ and dem/ of the run; returns the scene's description. wall_velocities: the x velocities of
     the walls y = 0 and y = L_y; grad_p0: the uniform pressure gradient (Eq. 58) [Pa/m]. model:
     pair_style fdm/subgrid's sub-grid model (calibrated, the default: what the solver resolves, measured;
@@ -170,7 +171,9 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     fluid steps"); dump_every and write_every (unless beyond the run's steps) must then be multiples of it,
     so that every snapshot is of a step the fluid solved. held_drag: how the steps between fluid steps hold
     the fluid's force (fix fdm/couple ... held_drag: extrapolated, from the last two fluid steps, or constant;
-    docs/benchmarks.md "The held drag extrapolated")."""
+    docs/benchmarks.md "The held drag extrapolated"). calibration: the table the scene runs with
+    (deminput.scene_calibration; None or the shipped one: the pair style's default), written into dem/ and
+    named by the pair style's `calibration` keyword when it holds interpolated blocks."""
     if fluid_every < 1:
         raise ValueError("fluid_every must be at least 1, got %r" % fluid_every)
     if held_drag not in HELD_DRAG:
@@ -188,8 +191,10 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                  acceleration=acceleration, write_interval=write_every, **LINEAR_SOLVE_REL_TOL)
     fluid.update(fluid_options or {})
     foamcase.write_fluid_case(os.path.join(run_dir, "fluid"), box, **fluid)
-    pair = ("fdm/subgrid model %s contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
-            % (model, springs.kn, springs.kt, springs.mu_s, springs.h_r, u_lo, u_hi))
+    table = calibration.table() if calibration is not None else None
+    pair = ("fdm/subgrid model %s%s contact %r %r %r %r wall ylo %r 0 0 wall yhi %r 0 0"
+            % (model, "" if table is None else " calibration %s" % table, springs.kn, springs.kt, springs.mu_s,
+               springs.h_r, u_lo, u_hi))
     spheres = [tuple(x) + (float(a), int(t)) for x, a, t in zip(pack.positions, pack.radii, pack.types)]
     runs = (["fix             output all fdm/output records %d particles.records vtk %d vtk"
              % (dump_every, write_every)]
@@ -204,7 +209,15 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                             if fluid_every > 1 else ""), runs=runs,
                          name=name)
     packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
-    return dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
-                wall_velocities=[u_lo, u_hi], grad_p0=list(grad_p0), dt=dt, dump_every=dump_every,
-                write_every=write_every, subgrid_model=model, fluid_every=fluid_every,
-                held_drag=held_drag if fluid_every > 1 else None)
+    if table is not None:
+        calibration.write(os.path.join(run_dir, "dem"))
+    scene = dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
+                 wall_velocities=[u_lo, u_hi], grad_p0=list(grad_p0), dt=dt, dump_every=dump_every,
+                 write_every=write_every, subgrid_model=model, fluid_every=fluid_every,
+                 held_drag=held_drag if fluid_every > 1 else None)
+    if table is not None:
+        # the interpolated blocks the run reads (dem/<table>), each with its measured error bound
+        scene["calibration_interpolated"] = [dict(kind=e.kind, radii=[e.pair[0]] if e.kind == "wall" else list(e.pair),
+                                                  a_over_delta=e.a_over_delta, ratio=e.ratio, error=e.error)
+                                             for e in calibration.interpolated]
+    return scene

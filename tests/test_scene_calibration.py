@@ -1,0 +1,127 @@
+"""The calibration table a scene runs with (fdmsubgrid.deminput.scene_calibration, issue 50 item 2): the
+shipped table where it covers the scene; where every pair and wall it lacks is interpolated within 2 % as
+measured on held-back blocks, the shipped table with those blocks written into the run's dem/, the pair
+style pointed at it, one line saying so, and the table's SHA-256 in fdmRun's record and results.json;
+otherwise a refusal, one line per refused pair or wall with the command that measures it
+(docs/resistance.md, "Sizes and resolutions outside the table"). Scenes are written, not run (the coupled
+run of such a scene is in docs/cases/couette.md)."""
+import hashlib
+import json
+import math
+import os
+import subprocess
+import time
+
+import pytest
+
+from conftest import PROJECT, assert_refused, load_case_module
+from fdmsubgrid import calibration, case, checkpoint, couettescene, deminput, packing, results, subgridinterp
+
+SHIPPED = os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat")
+# one sphere of radius 1.4 among spheres of radius 1, at a1/Delta 4: the pairs 1-1 and 1-1.4 are in the table,
+# the larger sphere against a wall (a/Delta 5.6) is not (walls 3-5), and no pair 1.4-1.4 exists
+TRACER = packing.SizeDistribution.of([1.0, 1.4], [0.96, 0.04])
+
+
+def covered(env, root, *args) -> dict:
+    """fdmResistance coverage with the table root/dem/resistance/data/subgrid_calibration.dat (FDM_ROOT)."""
+    done = subprocess.run(["fdmResistance", "coverage"] + [str(a) for a in args], env=dict(env, FDM_ROOT=str(root)),
+                          check=True, capture_output=True, text=True)
+    return json.loads(done.stdout)
+
+
+def test_a_scene_needing_only_an_interpolated_wall_runs_with_its_own_table(env, tmp_path, capsys):
+    """The tracer suspension in 12^3 a1 at a1/Delta 4 is written, not refused: dem/subgrid_calibration.dat is
+    the shipped table with the one wall block it lacks (a/Delta 5.6, measured error 1.2 %), the pair style
+    reads it, the resistance library covers the scene with it (and not with the shipped one), one line says
+    so, and fdmRun's record and results.json name that file and its SHA-256."""
+    written = couettescene.write_run(str(tmp_path), (12, 12, 12), dt=0.02, strain=0.04, phi=0.2, a_over_delta=4.0,
+                                     sizes=TRACER)
+    pack, run_dir = written["pack"], written["run_dir"]
+    assert sorted(set(pack.radii)) == [1.0, 1.4] and list(pack.radii).count(1.4) == 1     # the scene meant
+    out = capsys.readouterr().out
+    line = [l for l in out.splitlines() if "interpolated" in l]
+    assert line == ["couette: the run reads dem/subgrid_calibration.dat, the shipped table with the squeeze "
+                    "interpolated for radius 1.4 at a wall (a/Delta 5.6, error 1.2 %) (measured on held-back blocks, "
+                    "within 2 %; the tangential functions there from the cut-off model: docs/resistance.md)"]
+    table = os.path.join(run_dir, "dem", "subgrid_calibration.dat")
+    dem_input = os.path.join(run_dir, "dem", "in.couette")
+    pair_style = [l for l in open(dem_input) if l.startswith("pair_style")]
+    assert len(pair_style) == 1 and " model calibrated calibration subgrid_calibration.dat contact " in pair_style[0]
+    # the shipped table unchanged, one block added
+    shipped_text = open(SHIPPED).read()
+    assert open(table).read().startswith(shipped_text)
+    added = set(calibration.read_table(table)) - set(calibration.read_table(SHIPPED))
+    assert added == {("wall", 5.6, 1.0)}
+    [entry] = written["scene"]["calibration_interpolated"]
+    assert entry["kind"] == "wall" and entry["radii"] == [1.4] and entry["a_over_delta"] == 5.6
+    assert 0 < entry["error"] <= subgridinterp.TOLERANCE
+    # the resistance library reads it as the pair style does: the wall of 1.4 at Delta 0.25 covered with it only
+    root = tmp_path / "root"
+    (root / "dem" / "resistance" / "data").mkdir(parents=True)
+    (root / "dem" / "resistance" / "data" / "subgrid_calibration.dat").write_text(open(table).read())
+    assert covered(env, root, "--a1", 1.4, "--a2", 1.0, "--delta", 0.25, "--wall")["wall"]
+    assert covered(env, root, "--a1", 1.0, "--a2", 1.4, "--delta", 0.25)["pair"]
+    assert not covered(env, PROJECT, "--a1", 1.4, "--delta", 0.25, "--wall")["wall"]
+    # the record fdmRun makes at the start, and results.json
+    checkpoint.stamp(run_dir, dem_input)
+    digest = hashlib.sha256(open(table, "rb").read()).hexdigest()
+    assert json.load(open(os.path.join(run_dir, checkpoint.CALIBRATION_STAMP))) == dict(table=table, sha256=digest)
+    out = os.path.join(run_dir, "results.json")
+    script = os.path.join(PROJECT, "cases", "couette", "couette.py")
+    results.write_results(out, script, [], {}, [], dict(run_dir=run_dir), time.time())
+    assert json.load(open(out))["calibration"] == [dict(table=os.path.relpath(table, PROJECT), sha256=digest)]
+    assert digest != hashlib.sha256(open(SHIPPED, "rb").read()).hexdigest()
+
+
+def test_a_pair_beyond_the_interpolation_is_refused_one_line(tmp_path, capsys):
+    """The same suspension with more larger spheres (pairs 1.4-1.4 at a1/Delta 5.6, interpolated to 2.1 %
+    > 2 % at worst): refused before anything is written, one line for that pair with the command that
+    measures it, the interpolable wall named as such."""
+    with pytest.raises(deminput.UncalibratedScene) as refused:
+        deminput.scene_calibration("couette", [1.0] * 5 + [1.4] * 2, 0.25, walls=True)
+    lines = str(refused.value).splitlines()
+    assert lines[0] == ("couette: the sub-grid calibration (model calibrated) lacks 1 of this scene's pairs and walls "
+                        "beyond what the interpolation reaches within 2 %:")
+    assert lines[1].startswith("  the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated, "
+                               "interpolation error 2.1 % > 2 %; measure it (about ")
+    assert lines[1].endswith("core-seconds): python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 "
+                             "--no-wall --boxes 8 12 --out my_calibration.dat")
+    assert lines[2] == "  interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.2 %)"
+    assert lines[3].startswith("  dem/resistance/data/subgrid_calibration.dat has pairs")
+    assert lines[4].startswith("  or --model cutoff")
+    assert len(lines) == 5
+    # the case script: refused with that message, no run folder
+    couette = load_case_module("couette")
+    with pytest.raises(SystemExit) as stopped:
+        couette.main(["--radii", "1", "1.4", "--volume-fractions", "0.8", "0.2", "--phi", "0.2", "--size", "12", "12",
+                      "12", "--a-over-delta", "4", "--write-only", "--workdir", str(tmp_path)])
+    assert "the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated" in str(stopped.value)
+    assert os.listdir(tmp_path) == []
+
+
+def test_the_decision_for_walls_alone_and_for_the_shipped_table(tmp_path, capsys):
+    """A free sphere against the walls (pairs=False): at a/Delta 4 the shipped table (nothing written, no
+    keyword), at 6 the interpolated wall (1.2 %), at 7 (farther above 3-5 than any held-back wall) refused
+    with the command; the cut-off model needs no table. wallShear refuses a/Delta 7 as argparse does."""
+    shipped = case.scene_calibration("wallShear", [1.0], 1 / 4, walls=True, pairs=False)
+    assert shipped.table() is None and shipped.line() is None and shipped.write(str(tmp_path / "a")) is None
+    assert not (tmp_path / "a").exists()
+    assert case.subgrid_pair_style(calibration=shipped.table()) == "fdm/subgrid"
+    finer = case.scene_calibration("wallShear", [1.0], 1 / 6, walls=True, pairs=False)
+    assert [(e.kind, e.a_over_delta, e.status) for e in finer.interpolated] == [("wall", 6.0, "interpolated")]
+    assert finer.interpolated[0].error == pytest.approx(0.0117, abs=5e-4)
+    path = finer.write(str(tmp_path / "b" / "dem"))
+    assert set(calibration.read_table(path)) - set(calibration.read_table(SHIPPED)) == {("wall", 6.0, 1.0)}
+    assert case.subgrid_pair_style((("ylo", (0, 0, 0)),), calibration=finer.table()) == \
+        "fdm/subgrid calibration subgrid_calibration.dat wall ylo 0.0 0.0 0.0"
+    # without the correction the table does not enter the line
+    assert case.subgrid_pair_style(subgrid=False, calibration=finer.table()) == "fdm/subgrid lubrication no"
+    with pytest.raises(case.UncalibratedScene, match=r"radius 1 against a wall at a/Delta 7: not calibrated, no "
+                       r"held-back test .* --a-over-delta 7 --no-pairs --out my_calibration.dat"):
+        case.scene_calibration("wallShear", [1.0], 1 / 7, walls=True, pairs=False)
+    assert case.scene_calibration("wallShear", [1.0], 1 / 7, walls=True, pairs=False, model="cutoff").table() is None
+    wall_shear = load_case_module("wallShear")
+    assert_refused(wall_shear.main, ["--a-over-delta", "7", "--subgrid-only"],
+                   ["wallShear: the sub-grid calibration (model calibrated) lacks 1 of this scene's pairs and walls",
+                    "radius 1 against a wall at a/Delta 7"], tmp_path, capsys)
