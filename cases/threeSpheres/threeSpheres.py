@@ -625,8 +625,7 @@ def main(argv: Sequence[str] | None = None) -> dict:
         return write_study(args, argv, runs, study_result, shared["offsets"], time.time())
     if study and (args.boxes is not None or args.reference):
         p.error("several --a-over-delta (the resolution study) run in one box: no --boxes or --reference")
-    if not study:
-        args.a_over_delta = resolutions[0]
+    args.a_over_delta = resolutions if study else resolutions[0]
     if args.reference:
         for r in args.r:
             if not r > 2 * RADIUS:
