@@ -69,9 +69,13 @@ def test_stored_study_is_its_runs_bookkeeping(three_spheres, stored):
                         assert t[name] is None, name
                     else:
                         assert t[name] == pytest.approx(value, rel=1e-12, abs=1e-15), (entry["r"], key, name)
-    # the far-field reference is used from r/a = 4 only, and the finest a/Delta below it
+    # the far-field reference is used from r/a = 4 only (docs/validation.md's: dU 0.66083, U23y 0.06983,
+    # W23z 0.02154 at r/a 4), and the finest a/Delta below it
     for entry in stored["resolution"]:
         assert ("far_field" in entry) == (entry["r"] >= 4.0)
+        if entry["r"] == 4.0:
+            for q, value in dict(dU=0.66083, U23y=0.06983, W23z=0.02154).items():
+                assert entry["far_field"][0][q + "_reference"] == pytest.approx(value, abs=6e-6)
         finest = entry["series"][-1]
         for q in three_spheres.RESOLUTION_QUANTITIES:
             assert finest[q + "_error"] == 0.0

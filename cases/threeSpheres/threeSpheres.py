@@ -348,8 +348,8 @@ def resolution_study(boxes: Sequence[dict]) -> list[dict]:
     """The resolution study from one run_box result per a/Delta (the same box, r, positions and model,
     any order): per r, the measured quantities at each a/Delta (convergence.resolution_series: value,
     spread over the positions, change from the next coarser a/Delta, error against the reference).
-    The reference: from r/a = FAR_FIELD_FROM the far field (farField.three_spheres, unbounded fluid),
-    compared with the box-free estimates (`far_field` series); at every r the finest a/Delta, compared
+    The reference: from r/a = FAR_FIELD_FROM the far field (farField.three_spheres, unbounded fluid,
+    as the runs' far_field_comparison holds it), compared with the box-free estimates (`far_field` series); at every r the finest a/Delta, compared
     with the values as measured in the box (`series`: near contact no independent reference exists and
     the box changes dU, U23y, W23z by less than 1 % there). A mismatch between the runs is a ValueError
     naming it."""
@@ -370,14 +370,16 @@ def resolution_study(boxes: Sequence[dict]) -> list[dict]:
     for coarse, fine in zip(resolutions, resolutions[1:]):
         if fine == coarse:
             raise ValueError("threeSpheres: a/Delta %g appears twice in the resolution study" % fine)
+    # the far field at each r from FAR_FIELD_FROM, as each run compared with it (far_field_comparison)
+    references = {f["r"]: f["reference"] for f in first.get("far_field") or []}
     out = []
     for k, r in enumerate(r_first):
         measured = [b["rows"][k] for b in boxes]
         entry = dict(r=r, a_over_delta=resolutions, reference_below="finest a/Delta %g" % resolutions[-1],
                      series=convergence.resolution_series(resolutions, measured, QUANTITIES,
                                                           reference={q: measured[-1][q] for q in QUANTITIES}))
-        if r >= FAR_FIELD_FROM - 1e-12 and all(row.get("unbounded_estimate") for row in measured):
-            ref = farField.three_spheres(r)
+        ref = references.get(r)
+        if ref is not None and all(row.get("unbounded_estimate") for row in measured):
             entry["far_field"] = convergence.resolution_series(
                 resolutions, [row["unbounded_estimate"] for row in measured], QUANTITIES,
                 reference={q: ref[q] for q in QUANTITIES})
