@@ -348,11 +348,11 @@ def resolution_study(boxes: Sequence[dict]) -> list[dict]:
     """The resolution study from one run_box result per a/Delta (the same box, r, positions and model,
     any order): per r, the measured quantities at each a/Delta (convergence.resolution_series: value,
     spread over the positions, change from the next coarser a/Delta, error against the reference).
-    The reference: from r/a = FAR_FIELD_FROM the far field (farField.three_spheres, unbounded fluid,
-    as the runs' far_field_comparison holds it), compared with the box-free estimates (`far_field` series); at every r the finest a/Delta, compared
-    with the values as measured in the box (`series`: near contact no independent reference exists and
-    the box changes dU, U23y, W23z by less than 1 % there). A mismatch between the runs is a ValueError
-    naming it."""
+    The reference: at every r the finest a/Delta, compared with the values as measured in the box
+    (`series`: near contact no independent reference exists, and the box changes dU, U23y, W23z by less
+    than 1 % there); from r/a = FAR_FIELD_FROM also the far field (farField.three_spheres, unbounded
+    fluid, as the runs' far_field_comparison holds it), compared with the box-free estimates
+    (`far_field`). A mismatch between the runs is a ValueError naming it."""
     if len(boxes) < 2:
         raise ValueError("threeSpheres: the resolution study needs at least two a/Delta, got %d" % len(boxes))
     boxes = sorted(boxes, key=lambda b: b["a_over_delta"])
@@ -620,7 +620,8 @@ def main(argv: Sequence[str] | None = None) -> dict:
         except (OSError, ValueError) as e:
             p.error(str(e))
         args.a_over_delta = sorted(b["a_over_delta"] for b in runs)
-        args.r, args.size, args.positions = [row["r"] for row in runs[0]["rows"]], runs[0]["box"], runs[0]["n_positions"]
+        args.r, args.size = [row["r"] for row in runs[0]["rows"]], runs[0]["box"]
+        args.positions = runs[0]["n_positions"]
         args.model, args.tol_lambda, args.subgrid = shared["model"], shared["tol_lambda"], shared["subgrid"]
         args.offset = shared["offsets"]
         args.cutoff = None if shared["cutoff_cells"] == "default" else shared["cutoff_cells"]

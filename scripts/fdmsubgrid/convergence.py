@@ -62,7 +62,8 @@ def resolution_series(a_over_delta: Sequence[float], values: Sequence[Mapping[st
             else:
                 coarser = float(values[k - 1][q])
                 if coarser == 0:
-                    raise ValueError("resolution_series: %s is 0 at a/Delta %g: no relative change" % (q, resolutions[k - 1]))
+                    raise ValueError("resolution_series: %s is 0 at a/Delta %g: no relative change"
+                                     % (q, resolutions[k - 1]))
                 entry[q + "_change"] = entry[q] - coarser
                 entry[q + "_rel_change"] = (entry[q] - coarser) / abs(coarser)
             ref = None if reference is None else reference.get(q)
