@@ -204,6 +204,11 @@ def test_single_sphere_box_effect(small_scene):
     (["--offset", "1.2", "0", "0"], "in [0, 1)"),
     (["--a-over-delta", "0"], "must be positive"),
     (["--reference", "--r", "2"], "overlap or touch"),
+    (["--a-over-delta", "3", "3"], "appears twice"),
+    (["--a-over-delta", "3", "4", "--boxes"], "run in one box"),
+    (["--a-over-delta", "3", "4.1"], "even number of cells"),
+    (["--combine", "no_such_results.json"], "no_such_results.json"),
+    (["--combine", "a.json", "--a-over-delta", "3", "4"], "takes the scene from its files"),
 ])
 def test_bad_options_refused(three_spheres, tmp_path, capsys, options, message):
     assert_refused(three_spheres.main, options, message, tmp_path, capsys)

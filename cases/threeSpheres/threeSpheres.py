@@ -46,6 +46,15 @@ unbounded fluid (error below 0.6 % at r/a = 4, 0.1 % at 6), compared at r/a >= 4
   threeSpheres.py --boxes 16 16 12 20 20 16   any boxes (LX LY LZ per box)
   threeSpheres.py --full            the paper's: box 60 x 40 x 50 a, a/Delta = 5, 64 positions (16 computed)
                                     (15 M cells: out of reach of this 2-core machine)
+  threeSpheres.py --a-over-delta 3 4 5 --r 2.01 2.1 2.5 4
+                                    the resolution study: every r at each a/Delta in one box, each quantity's
+                                    change from the next coarser a/Delta and its error against the reference
+                                    (the far field, box taken off, from r/a = 4; the finest a/Delta below);
+                                    writes results_resolution.json and results_resolution.png (about 40
+                                    minutes here for these 12 scenes, 8 positions)
+  threeSpheres.py --combine A.json B.json ...
+                                    the same study from the results of single-a/Delta runs of the same scene
+                                    (no solver)
   threeSpheres.py --reference [--full | --size LX LY LZ]
                                     no solver: the far-field reference and the box's share in that box
   threeSpheres.py --help            every option
@@ -63,7 +72,8 @@ from typing import List, Sequence
 import numpy as np
 
 from fdmsubgrid import case
-from fdmsubgrid.results import Row, relative, write_results
+from fdmsubgrid import convergence
+from fdmsubgrid.results import Row, read_data, relative, write_results
 import channelImages
 import farField
 
@@ -79,6 +89,8 @@ PAPER_BOX = (60.0, 40.0, 50.0)
 FAR_FIELD_FROM = 4.0                        # r/a from which the far-field reference is compared
 MODEL_FROM = 2.5                            # r/a from which the spheres follow the images' flow as tracers
 QUANTITIES = ("U1x", "U23x", "dU", "U23y", "W23z")
+RESOLUTION_QUANTITIES = ("dU", "U23y", "W23z")   # the resolution study's: the box leaves them near contact
+RESOLUTION_R_DEFAULT = [2.01, 2.1, 2.5, 4.0]
 MIN_WALL_GAP = 1.0                          # a: the smallest surface gap to a wall the case accepts
 MIN_IMAGE_GAP = 1.0                         # a: ... and to a periodic image
 
@@ -332,6 +344,152 @@ def box_comparison(boxes: list[dict]) -> list[dict]:
     return out
 
 
+def resolution_study(boxes: Sequence[dict]) -> list[dict]:
+    """The resolution study from one run_box result per a/Delta (the same box, r, positions and model,
+    any order): per r, the measured quantities at each a/Delta (convergence.resolution_series: value,
+    spread over the positions, change from the next coarser a/Delta, error against the reference).
+    The reference: at every r the finest a/Delta, compared with the values as measured in the box
+    (`series`: near contact no independent reference exists, and the box changes dU, U23y, W23z by less
+    than 1 % there); from r/a = FAR_FIELD_FROM also the far field (farField.three_spheres, unbounded
+    fluid, as the runs' far_field_comparison holds it), compared with the box-free estimates
+    (`far_field`). A mismatch between the runs is a ValueError naming it."""
+    if len(boxes) < 2:
+        raise ValueError("threeSpheres: the resolution study needs at least two a/Delta, got %d" % len(boxes))
+    boxes = sorted(boxes, key=lambda b: b["a_over_delta"])
+    first = boxes[0]
+    r_first = [row["r"] for row in first["rows"]]
+    for b in boxes[1:]:
+        for key in ("box", "n_positions", "positions_computed", "subgrid"):
+            if b[key] != first[key]:
+                raise ValueError("threeSpheres: the runs at a/Delta %g and %g differ in %s (%s, %s)"
+                                 % (first["a_over_delta"], b["a_over_delta"], key, first[key], b[key]))
+        if [row["r"] for row in b["rows"]] != r_first:
+            raise ValueError("threeSpheres: the runs at a/Delta %g and %g have different r/a (%s, %s)" % (
+                first["a_over_delta"], b["a_over_delta"], r_first, [row["r"] for row in b["rows"]]))
+    resolutions = [b["a_over_delta"] for b in boxes]
+    for coarse, fine in zip(resolutions, resolutions[1:]):
+        if fine == coarse:
+            raise ValueError("threeSpheres: a/Delta %g appears twice in the resolution study" % fine)
+    # the far field at each r from FAR_FIELD_FROM, as each run compared with it (far_field_comparison)
+    references = {f["r"]: f["reference"] for f in first.get("far_field") or []}
+    out = []
+    for k, r in enumerate(r_first):
+        measured = [b["rows"][k] for b in boxes]
+        entry = dict(r=r, a_over_delta=resolutions, reference_below="finest a/Delta %g" % resolutions[-1],
+                     series=convergence.resolution_series(resolutions, measured, QUANTITIES,
+                                                          reference={q: measured[-1][q] for q in QUANTITIES}))
+        ref = references.get(r)
+        if ref is not None and all(row.get("unbounded_estimate") for row in measured):
+            entry["far_field"] = convergence.resolution_series(
+                resolutions, [row["unbounded_estimate"] for row in measured], QUANTITIES,
+                reference={q: ref[q] for q in QUANTITIES})
+        out.append(entry)
+    return out
+
+
+def resolution_rows(data: dict) -> List[Row]:
+    """The results rows of the resolution study: per r, a/Delta and quantity (RESOLUTION_QUANTITIES),
+    the value against the far field (box taken off, r/a >= FAR_FIELD_FROM) or, below, as measured
+    against the finest a/Delta (a comparison, not a headline)."""
+    rows = []
+    box = "×".join("%g" % v for v in data["box"])
+    for entry in data["resolution"]:
+        far = entry.get("far_field")
+        for k, s in enumerate(entry["series"]):
+            for q in RESOLUTION_QUANTITIES:
+                config = "r/a %g, box %s a, a/Δ %g, %d positions" % (entry["r"], box, s["a_over_delta"],
+                                                                     data["n_positions"])
+                if far:
+                    f = far[k]
+                    rows.append(Row(q + " (box removed)", config, f[q], f[q + "_reference"], "Tables 6–7",
+                                    f[q + "_error"], spread=s[q + "_std"] or None))
+                else:
+                    rows.append(Row(q, config + ", against the finest a/Δ", s[q], s[q + "_reference"],
+                                    "Tables 6–7", s[q + "_error"], spread=s[q + "_std"] or None, headline=False))
+    return rows
+
+
+def shown_series(entry: dict) -> tuple[list[dict], str]:
+    """The series of one r the study reports, and what it is compared with: from r/a = FAR_FIELD_FROM
+    the box-free estimates against the far field, below the values as measured against the finest a/Delta."""
+    if entry.get("far_field"):
+        return entry["far_field"], "box taken off, against the far field (unbounded)"
+    return entry["series"], "as measured, against the %s" % entry["reference_below"]
+
+
+def print_resolution(study: list[dict]) -> None:
+    """The resolution study's table: per r and a/Delta each quantity +- its spread over the positions,
+    its change from the next coarser a/Delta and its error against the reference, in %."""
+    for entry in study:
+        series, what = shown_series(entry)
+        print("r/a %g (%s)" % (entry["r"], what))
+        for k, s in enumerate(series):
+            cells = []
+            for q in RESOLUTION_QUANTITIES:
+                change = "%+.2f %%" % (100 * s[q + "_rel_change"]) if s[q + "_rel_change"] is not None else "—"
+                error = "%+.2f %%" % (100 * s[q + "_error"]) if s[q + "_error"] is not None else "—"
+                spread = entry["series"][k][q + "_std"] or 0.0
+                cells.append("%s %.5f +- %.5f (change %s, error %s)" % (q, s[q], spread, change, error))
+            print("  a/Delta %-3g %s" % (s["a_over_delta"], "; ".join(cells)))
+
+
+def plot_resolution(study: list[dict], path: str) -> None:
+    """One panel per r (rows) and quantity (columns, RESOLUTION_QUANTITIES): the value +- its spread over
+    the positions against a/Delta with its reference (shown_series): below r/a = FAR_FIELD_FROM as
+    measured, the finest a/Delta dotted; from it the box-free estimate, the far field drawn."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = dict(dU="dU = U1x - U23x", U23y="U23y", W23z="W23z")
+    fig, axes = plt.subplots(len(study), len(RESOLUTION_QUANTITIES), figsize=(10, 2.3 * len(study) + 0.6),
+                             squeeze=False)
+    for i, entry in enumerate(study):
+        series, _ = shown_series(entry)
+        far = bool(entry.get("far_field"))
+        n = [s["a_over_delta"] for s in series]
+        for j, q in enumerate(RESOLUTION_QUANTITIES):
+            ax = axes[i][j]
+            ax.errorbar(n, [s[q] for s in series], yerr=[s[q + "_std"] or 0 for s in entry["series"]],
+                        marker="o", capsize=3, label="box taken off" if far else "measured")
+            ax.axhline(series[-1][q + "_reference"], color="k", lw=1, ls="-" if far else ":",
+                       label="far field (unbounded)" if far else entry["reference_below"])
+            ax.set_xticks(n)
+            ax.set_title("r/a %g: %s%s" % (entry["r"], labels[q], " (box taken off)" if far else ""), fontsize=9)
+            if i == len(study) - 1:
+                ax.set_xlabel("a/Δ")
+            ax.tick_params(labelsize=8)
+            if j == 0:
+                ax.legend(fontsize=7)
+    fig.suptitle("three spheres: velocities (F/(6πηa)) and angular velocity (F/(6πηa²)) against a/Δ, "
+                 "± spread over the centroid positions", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def combine_runs(paths: Sequence[str]) -> tuple[list[dict], dict]:
+    """The single-a/Delta results files of a resolution study: their box results (run_box's) and the
+    scene they share (model, cut-off, tolLambda, offsets); a file of another case or study, or runs that
+    differ in the scene, is a ValueError naming the file."""
+    boxes, shared = [], None
+    for path in paths:
+        data = read_data(path)
+        if data.get("case") != "threeSpheres" or "boxes" not in data:
+            raise ValueError("threeSpheres --combine: %s is not a single-a/Delta threeSpheres results file" % path)
+        if len(data["boxes"]) != 1:
+            raise ValueError("threeSpheres --combine: %s holds %d boxes (a run of one box is combined)"
+                             % (path, len(data["boxes"])))
+        scene = {k: data.get(k) for k in ("model", "cutoff_cells", "tol_lambda", "offsets", "subgrid")}
+        if shared is None:
+            shared = scene
+        elif scene != shared:
+            differ = sorted(k for k in scene if scene[k] != shared[k])
+            raise ValueError("threeSpheres --combine: %s differs from %s in %s" % (path, paths[0], ", ".join(differ)))
+        boxes.append(data["boxes"][0])
+    return boxes, shared
+
+
 def print_box(result: dict) -> None:
     """The table of one box: measured means +- standard deviations over the positions, the largest
     mirror asymmetry, the inner iterations; the box's share (point-force model) and the box-free
@@ -419,7 +577,13 @@ def main(argv: Sequence[str] | None = None) -> dict:
     p.add_argument("--boxes", type=float, nargs="*", default=None, metavar="L",
                    help="run every r in several boxes, LX LY LZ per box (default, no numbers: %s): the box "
                         "independence of dU, U23y, W23z" % ", ".join("%g x %g x %g" % b for b in BOXES_DEFAULT))
-    p.add_argument("--a-over-delta", type=float, default=3.0, help="a/Delta, mesh cells per radius")
+    p.add_argument("--a-over-delta", type=float, nargs="+", default=[3.0],
+                   help="a/Delta, mesh cells per radius; several values: the resolution study, every r at each "
+                        "a/Delta in one box (--out defaults to results_resolution.json, and a PNG beside it)")
+    p.add_argument("--combine", nargs="+", default=None, metavar="FILE",
+                   help="the resolution study from the results files of single-a/Delta runs of one scene (the same "
+                        "box, r, positions and model): no solver")
+    p.add_argument("--no-plot", action="store_true", help="the resolution study without its PNG")
     p.add_argument("--positions", type=int, default=8,
                    help="centroid positions in one mesh cell: an even cube m^3 (8, 64) is the m x m x m lattice, "
                         "computed at its m^3/4 points in the half-cell that the mirror symmetries make the whole "
@@ -440,7 +604,31 @@ def main(argv: Sequence[str] | None = None) -> dict:
     args = p.parse_args(argv)
 
     if args.full:
-        args.size, args.a_over_delta, args.positions = list(PAPER_BOX), 5.0, 64
+        args.size, args.a_over_delta, args.positions = list(PAPER_BOX), [5.0], 64
+    resolutions = sorted(args.a_over_delta)
+    if len(set(resolutions)) != len(resolutions):
+        p.error("--a-over-delta %s: a value appears twice" % " ".join("%g" % n for n in args.a_over_delta))
+    study = len(resolutions) > 1 or args.combine is not None
+    if study and args.out == os.path.join(HERE, "results.json"):
+        args.out = os.path.join(HERE, "results_resolution.json")
+    if args.combine is not None:
+        if len(resolutions) > 1 or args.reference or args.boxes is not None:
+            p.error("--combine takes the scene from its files: no --a-over-delta list, --boxes or --reference")
+        try:
+            runs, shared = combine_runs(args.combine)
+            study_result = resolution_study(runs)
+        except (OSError, ValueError) as e:
+            p.error(str(e))
+        args.a_over_delta = sorted(b["a_over_delta"] for b in runs)
+        args.r, args.size = [row["r"] for row in runs[0]["rows"]], runs[0]["box"]
+        args.positions = runs[0]["n_positions"]
+        args.model, args.tol_lambda, args.subgrid = shared["model"], shared["tol_lambda"], shared["subgrid"]
+        args.offset = shared["offsets"]
+        args.cutoff = None if shared["cutoff_cells"] == "default" else shared["cutoff_cells"]
+        return write_study(args, argv, runs, study_result, shared["offsets"], time.time())
+    if study and (args.boxes is not None or args.reference):
+        p.error("several --a-over-delta (the resolution study) run in one box: no --boxes or --reference")
+    args.a_over_delta = resolutions if study else resolutions[0]
     if args.reference:
         for r in args.r:
             if not r > 2 * RADIUS:
@@ -451,12 +639,23 @@ def main(argv: Sequence[str] | None = None) -> dict:
         p.error("--n-max must be at least 1")
     try:
         for size in boxes:
-            check_scene(args.r, size, args.a_over_delta)
+            for n in resolutions:
+                check_scene(args.r, size, n)
     except ValueError as e:
         p.error(str(e))
 
     os.makedirs(args.workdir, exist_ok=True)
     t0 = time.time()
+    if study:
+        runs = []
+        for n in resolutions:
+            result = run_box(args.workdir, boxes[0], args.r, offsets, represented,
+                             argparse.Namespace(**dict(vars(args), a_over_delta=n)))
+            print_box(result)
+            result["far_field"] = far_field_comparison(result["rows"])
+            print_far_field(result["far_field"])
+            runs.append(result)
+        return write_study(args, argv, runs, resolution_study(runs), [list(o) for o in offsets], t0)
     results = []
     for size in boxes:
         result = run_box(args.workdir, size, args.r, offsets, represented, args)
@@ -480,6 +679,30 @@ def main(argv: Sequence[str] | None = None) -> dict:
                far_field=results[0]["far_field"], boxes=results, box_comparison=comparison)
     write_results(args.out, __file__, argv, args, validation_rows, out, t0)
     print("wrote %s (%.0f s)" % (args.out, out["wall_seconds"]))
+    return out
+
+
+def write_study(args, argv: Sequence[str] | None, runs: list[dict], study: list[dict], offsets: list,
+                started: float) -> dict:
+    """Print the resolution study, write its results file (--out) and, without --no-plot, its PNG beside
+    it; returns the record."""
+    print_resolution(study)
+    runs = sorted(runs, key=lambda b: b["a_over_delta"])
+    first = runs[0]
+    out = dict(case="threeSpheres", study="resolution", paper_section="5.5",
+               units="velocities in F/(6 pi eta a), angular velocities in F/(6 pi eta a^2)", box=first["box"],
+               r=[row["r"] for row in first["rows"]], a_over_delta=[b["a_over_delta"] for b in runs],
+               cells=[b["cells"] for b in runs], wall_seconds_per_resolution=[b["wall_seconds"] for b in runs],
+               n_positions=first["n_positions"], positions_computed=first["positions_computed"], offsets=offsets,
+               subgrid=args.subgrid, model=args.model, cutoff_cells=getattr(args, "cutoff", None) or "default",
+               tol_lambda=args.tol_lambda, resolution=study, boxes=runs,
+               wall_seconds=float(sum(b["wall_seconds"] for b in runs)))
+    write_results(args.out, __file__, argv, args, resolution_rows, out, started)
+    if not args.no_plot:
+        png = os.path.splitext(args.out)[0] + ".png"
+        plot_resolution(study, png)
+        print("wrote %s" % png)
+    print("wrote %s (%.0f s of runs)" % (args.out, out["wall_seconds"]))
     return out
 
 
