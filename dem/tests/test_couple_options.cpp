@@ -2,32 +2,17 @@
 // parsed once from the table, numbers read as LIGGGHTS reads them, each problem named with the value it got.
 #include "couple_options.h"
 
-#include <gtest/gtest.h>
+#include "keyword_lines.h"
 
-#include <sstream>
+#include <gtest/gtest.h>
 
 namespace {
 
-std::vector<std::string> words(const std::string &line)
-{
-  std::istringstream in(line);
-  std::vector<std::string> out;
-  for (std::string w; in >> w;) out.push_back(w);
-  return out;
-}
+using fdm::testing::words;
 
 fdm::CoupleOptions parse(const std::string &line) { return fdm::parseCoupleOptions(words(line)); }
 
-// The message of the KeywordError the line raises ("" if none).
-std::string problem(const std::string &line)
-{
-  try {
-    parse(line);
-  } catch (const fdm::KeywordError &e) {
-    return e.what();
-  }
-  return "";
-}
+std::string problem(const std::string &line) { return fdm::testing::keywordProblem(fdm::parseCoupleOptions, line); }
 
 }  // namespace
 

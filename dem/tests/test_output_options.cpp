@@ -2,29 +2,15 @@
 // reaching its option and each problem named with the keyword and the value it got.
 #include "output_options.h"
 
-#include <gtest/gtest.h>
+#include "keyword_lines.h"
 
-#include <sstream>
+#include <gtest/gtest.h>
 
 namespace {
 
-std::vector<std::string> words(const std::string &line)
-{
-  std::istringstream in(line);
-  std::vector<std::string> out;
-  for (std::string w; in >> w;) out.push_back(w);
-  return out;
-}
+using fdm::testing::words;
 
-std::string problem(const std::string &line)
-{
-  try {
-    fdm::parseOutputOptions(words(line));
-  } catch (const fdm::KeywordError &e) {
-    return e.what();
-  }
-  return "";
-}
+std::string problem(const std::string &line) { return fdm::testing::keywordProblem(fdm::parseOutputOptions, line); }
 
 }  // namespace
 

@@ -3,31 +3,17 @@
 // keyword and the value it got.
 #include "subgrid_options.h"
 
-#include <gtest/gtest.h>
+#include "keyword_lines.h"
 
-#include <sstream>
+#include <gtest/gtest.h>
 
 namespace {
 
-std::vector<std::string> words(const std::string &line)
-{
-  std::istringstream in(line);
-  std::vector<std::string> out;
-  for (std::string w; in >> w;) out.push_back(w);
-  return out;
-}
+using fdm::testing::words;
 
 fdm::SubgridOptions parse(const std::string &line) { return fdm::parseSubgridOptions(words(line)); }
 
-std::string problem(const std::string &line)
-{
-  try {
-    parse(line);
-  } catch (const fdm::KeywordError &e) {
-    return e.what();
-  }
-  return "";
-}
+std::string problem(const std::string &line) { return fdm::testing::keywordProblem(fdm::parseSubgridOptions, line); }
 
 }  // namespace
 

@@ -256,18 +256,20 @@ TEST(SeparableBoxSolver, SolvedInPartsGivesTheWholeSolve)
                 parts.back()->setCoefficients(c);
             }
             const std::size_t perPlane = whole.cellsPerPlane(), modes = whole.modesPerPlane();
+            // cell (i, j, k)'s value in the slab of the part that holds its plane
+            auto inSlab = [&](long i, long j, long k) -> double&
+            {
+                const long ijk[3] = {i, j, k};
+                const long p = ijk[l.wall];
+                int r = 0;
+                while (planeStart(r + 1) <= p) ++r;
+                return parts[r]->planeValues()[(p - planeStart(r))*perPlane + whole.inPlaneIndex(i, j, k)];
+            };
             // the right-hand side into the slabs
             for (long k = 0; k < l.n[2]; ++k)
                 for (long j = 0; j < l.n[1]; ++j)
                     for (long i = 0; i < l.n[0]; ++i)
-                    {
-                        const long ijk[3] = {i, j, k};
-                        const long p = ijk[l.wall];
-                        int r = 0;
-                        while (planeStart(r + 1) <= p) ++r;
-                        parts[r]->planeValues()[(p - planeStart(r))*perPlane + whole.inPlaneIndex(i, j, k)] =
-                            b[whole.index(i, j, k)];
-                    }
+                        inSlab(i, j, k) = b[whole.index(i, j, k)];
             for (auto& part : parts) part->forwardPlanes();
             // transpose, solve each range of modes, transpose back
             for (int s = 0; s < nProcs; ++s)
@@ -289,15 +291,7 @@ TEST(SeparableBoxSolver, SolvedInPartsGivesTheWholeSolve)
             for (long k = 0; k < l.n[2]; ++k)
                 for (long j = 0; j < l.n[1]; ++j)
                     for (long i = 0; i < l.n[0]; ++i)
-                    {
-                        const long ijk[3] = {i, j, k};
-                        const long p = ijk[l.wall];
-                        int r = 0;
-                        while (planeStart(r + 1) <= p) ++r;
-                        const double v =
-                            parts[r]->planeValues()[(p - planeStart(r))*perPlane + whole.inPlaneIndex(i, j, k)];
-                        largest = std::max(largest, std::abs(v - expected[whole.index(i, j, k)]));
-                    }
+                        largest = std::max(largest, std::abs(inSlab(i, j, k) - expected[whole.index(i, j, k)]));
             EXPECT_LT(largest, 1e-13) << "lattice " << l.n[0] << "x" << l.n[1] << "x" << l.n[2] << " wall axis "
                                     << l.wall << " on " << nProcs << " processors";
         }
