@@ -520,11 +520,11 @@ def snapshot(case_dir: str, dest: str, scene: str | None = None, dem_input: str 
     with open(stamp_path) as f:
         identity = json.load(f)
     if identity.get("table"):
-        root = os.path.normpath(os.environ.get("FDM_ROOT")
-                                or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+        from .environment import project_dir
+        root = os.path.normpath(project_dir() or os.sep)
         table = os.path.normpath(identity["table"])
         shipped = os.path.join("dem", "resistance", "data") + os.sep
-        if table.startswith(root + os.sep):
+        if project_dir() and table.startswith(root + os.sep):
             identity["table"] = os.path.relpath(table, root)
         elif shipped in table:      # the shipped table of another checkout of the project
             identity["table"] = table[table.rindex(shipped):]

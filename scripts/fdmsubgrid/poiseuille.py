@@ -301,11 +301,7 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
                          % (run_dir, len(snapshots), MIN_SNAPSHOTS))
     times = np.array([s.time for s in snapshots])
     mid = channel.y_mid
-    phi_center = np.array([profiles.volume_fraction(s, channel, mid - CENTRAL_HALF_WIDTH, mid + CENTRAL_HALF_WIDTH)
-                           for s in snapshots])
-    phi_walls = np.array([0.5 * (profiles.volume_fraction(s, channel, channel.y_lo, channel.y_lo + WALL_LAYER)
-                                 + profiles.volume_fraction(s, channel, channel.y_hi - WALL_LAYER, channel.y_hi))
-                          for s in snapshots])
+    phi_center, phi_walls = centre_and_wall_series(snapshots, channel)
     phi_integral = np.array([profiles.volume_fraction(s, channel) for s in snapshots])
     # the steady window from the data (steady_window: the migration's approach fitted, phi_center's trend
     # over the window checked), unless a start is given
@@ -689,6 +685,18 @@ def plateau_shear_rate(fine: profiles.ProfileAverage, plateau: Plateau, sc: Scal
     return float(np.mean(np.abs(np.diff(u) / np.diff(y))))
 
 
+def centre_and_wall_series(snapshots: list, channel: profiles.Channel) -> tuple[NDArray, NDArray]:
+    """Per snapshot, phi in the central slab |y - mid| < CENTRAL_HALF_WIDTH and the mean of the two wall
+    layers WALL_LAYER deep: the migration as analyse() and migration_series() follow it."""
+    mid = channel.y_mid
+    centre = np.array([profiles.volume_fraction(s, channel, mid - CENTRAL_HALF_WIDTH, mid + CENTRAL_HALF_WIDTH)
+                       for s in snapshots])
+    walls = np.array([0.5 * (profiles.volume_fraction(s, channel, channel.y_lo, channel.y_lo + WALL_LAYER)
+                             + profiles.volume_fraction(s, channel, channel.y_hi - WALL_LAYER, channel.y_hi))
+                      for s in snapshots])
+    return centre, walls
+
+
 def migration_series(run_dir: str) -> dict:
     """The migration as the run's records hold it, small enough to keep beside a compact snapshot when the
     run folder may be lost (a long run in segments, cases/poiseuille/paperRun): per record its time (in
@@ -699,15 +707,12 @@ def migration_series(run_dir: str) -> dict:
     snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"), 1.0 / sc.time_unit)
     if not snapshots:
         raise PoiseuilleRunError("%s/dem/particles.records: no record yet" % run_dir)
-    mid = channel.y_mid
+    phi_center, phi_walls = centre_and_wall_series(snapshots, channel)
     phi_y = [profiles.profiles_in_bins(s, channel) for s in snapshots]
     return dict(
         time=[round(float(s.time), 6) for s in snapshots],
-        phi_center=[round(profiles.volume_fraction(s, channel, mid - CENTRAL_HALF_WIDTH, mid + CENTRAL_HALF_WIDTH), 5)
-                    for s in snapshots],
-        phi_wall_layer=[round(0.5 * (profiles.volume_fraction(s, channel, channel.y_lo, channel.y_lo + WALL_LAYER)
-                                     + profiles.volume_fraction(s, channel, channel.y_hi - WALL_LAYER, channel.y_hi)), 5)
-                        for s in snapshots],
+        phi_center=[round(float(v), 5) for v in phi_center],
+        phi_wall_layer=[round(float(v), 5) for v in phi_walls],
         y=[round(float(v), 6) for v in phi_y[0].y],
         phi_profile=[[round(float(v), 5) for v in p.phi] for p in phi_y])
 
