@@ -17,6 +17,13 @@ namespace
     {
         return a == 0 ? "x" : (a == 1 ? "y" : "z");
     }
+
+    //- The axis of the largest component of |v| (a face normal's axis)
+    int dominantAxis(const Foam::vector& v)
+    {
+        const Foam::vector m = Foam::cmptMag(v);
+        return (m.x() >= m.y() && m.x() >= m.z()) ? 0 : (m.y() >= m.z() ? 1 : 2);
+    }
 }
 
 
@@ -222,9 +229,8 @@ bool Foam::boxLattice::recogniseLocal
             offsets.setSize(nf.size());
             forAll(nf, facei)
             {
-                const vector m = cmptMag(nf[facei]);
-                const int a = (m.x() >= m.y() && m.x() >= m.z()) ? 0 : (m.y() >= m.z() ? 1 : 2);
-                if (m[a] < 1 - 1e-6)
+                const int a = dominantAxis(nf[facei]);
+                if (mag(nf[facei][a]) < 1 - 1e-6)
                 {
                     why << "face " << facei << " of processor patch "
                         << patch.name() << " is not normal to an axis";
@@ -261,8 +267,7 @@ bool Foam::boxLattice::recogniseLocal
                 {
                     // one cell along the axis, its own neighbour: the face's
                     // normal tells the axis
-                    const vector nf = cmptMag(patch.nf()()[facei]);
-                    faceAxis = (nf.x() >= nf.y() && nf.x() >= nf.z()) ? 0 : (nf.y() >= nf.z() ? 1 : 2);
+                    faceAxis = dominantAxis(patch.nf()()[facei]);
                     steps = (n_[faceAxis] == 1) ? 1 : 0;
                 }
                 if (steps != 1 || faceAxis < 0 || (axis >= 0 && faceAxis != axis))
