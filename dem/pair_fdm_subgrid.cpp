@@ -61,18 +61,7 @@ void PairFdmSubgrid::applySettings(const fdm::SubgridOptions &o)
 {
   // A pair_style line given again (LAMMPS calls settings() on the same object) starts from the defaults
   // too: what it does not say is not kept from the earlier line, and the sub-grid model is built anew.
-  lubrication_ = o.lubrication;
-  calibrated_ = o.calibrated;
-  calibrationFile_ = o.calibrationFile;
-  cutoffCells_ = o.cutoffCells;
-  wallCutoffCells_ = o.wallCutoffCells;
-  kn_ = o.kn;
-  kt_ = o.kt;
-  mu_ = o.mu;
-  hr_ = o.hr;
-  walls_ = o.walls;
-  unstableStepIsError_ = o.unstableStepIsError;
-  implicit_ = o.implicitContact;
+  options_ = o;
   model_.reset();
   wallModel_.reset();
   calibration_.reset();
@@ -138,21 +127,23 @@ void PairFdmSubgrid::fluidParameters()
   meshSize_ = session.meshSize();
   // Two cut-offs: the solver resolves a wall gap less well than a pair gap of the same width
   // (measured with cases/pairSqueeze and cases/wallSqueeze, docs/validation.md)
-  if (calibrated_ && lubrication_ && !model_) {
+  if (options_.calibrated && options_.lubrication && !model_) {
     // the default: the functions measured with the solver itself (Appendix B; subgrid_calibration.hpp):
     // the squeeze functions and, where tabulated, the tangential pair and wall functions
-    const std::string path = calibrationFile_.empty() ? res::SubgridCalibration::defaultPath() : calibrationFile_;
+    const std::string path =
+        options_.calibrationFile.empty() ? res::SubgridCalibration::defaultPath() : options_.calibrationFile;
     try {
       calibration_.reset(new res::SubgridCalibration(res::SubgridCalibration::read(path)));
-      model_ = std::make_shared<res::CalibratedSubgridModel>(*calibration_, meshSize_, cutoffCells_, wallCutoffCells_);
+      model_ = std::make_shared<res::CalibratedSubgridModel>(*calibration_, meshSize_, options_.cutoffCells,
+                                                             options_.wallCutoffCells);
       wallModel_ = model_;   // it holds both cut-offs
     } catch (const std::exception &e) {
       session.abandon(std::string("fdmDEM: pair fdm/subgrid: ") + e.what());
       error->all(FLERR, (std::string("pair fdm/subgrid: ") + e.what()).c_str());
     }
   }
-  if (!model_) model_.reset(new res::CutoffSubgridModel(meshSize_, cutoffCells_));
-  if (!wallModel_) wallModel_.reset(new res::CutoffSubgridModel(meshSize_, wallCutoffCells_));
+  if (!model_) model_.reset(new res::CutoffSubgridModel(meshSize_, options_.cutoffCells));
+  if (!wallModel_) wallModel_.reset(new res::CutoffSubgridModel(meshSize_, options_.wallCutoffCells));
 
   // The walls declared here are the fluid case's no-slip walls, with the same velocities.
   std::string problem;
@@ -162,7 +153,7 @@ void PairFdmSubgrid::fluidParameters()
     double velocity[3];
     session.fluidFace(face, kind, velocity);
     const Wall *declared = nullptr;
-    for (const Wall &w : walls_)
+    for (const Wall &w : options_.walls)
       if (2 * w.axis + w.side == face) declared = &w;
     const std::string u = "(" + fmt(velocity[0]) + " " + fmt(velocity[1]) + " " + fmt(velocity[2]) + ")";
     if (kind == CouplingSession::faceWall && !declared) {
@@ -234,7 +225,7 @@ void PairFdmSubgrid::checkCalibration()
       if (!calibration_->pairInternalCorrection(radii[a], radii[b], meshSize_, 0.1, K))
         uncalibratedTangential_ += (uncalibratedTangential_.empty() ? "" : ", ") + fmt(radii[a]) + "-" + fmt(radii[b]);
     }
-    if (!walls_.empty()) {
+    if (!options_.walls.empty()) {
       if (!calibration_->coversWall(radii[a], meshSize_))
         fail("model calibrated: no wall squeeze calibration for radius " + fmt(radii[a]) + " at mesh size " +
              fmt(meshSize_) + " (a/Delta " + fmt(radii[a] / meshSize_) + ") in " + calibration_->path() +
@@ -247,9 +238,9 @@ void PairFdmSubgrid::init_style()
 {
   if (!atom->sphere_flag) error->all(FLERR, "pair_style fdm/subgrid requires atom_style sphere");
   if (force->newton_pair) error->all(FLERR, "pair_style fdm/subgrid requires newton off");
-  if (hr_ > 0 && !comm->ghost_velocity)
+  if (options_.hr > 0 && !comm->ghost_velocity)
     error->all(FLERR, "pair_style fdm/subgrid with contact needs ghost velocities: 'communicate single vel yes'");
-  for (const Wall &w : walls_)
+  for (const Wall &w : options_.walls)
     if (domain->periodicity[w.axis])
       error->all(FLERR, ("pair_style fdm/subgrid: wall " + wallName(w) + " on a periodic boundary: make the " +
                          std::string(1, "xyz"[w.axis]) + " boundary fixed (boundary ... f ...)").c_str());
@@ -273,7 +264,7 @@ void PairFdmSubgrid::init_style()
 
   // Pairs up to this surface gap must be in the neighbour list, and keep their contact history:
   // LIGGGHTS's granular list includes r < (r_i + r_j) * contact_distance_factor (+ skin).
-  rangeGap_ = std::max(hr_, lubricationActive() ? cutoffCells_ * meshSize_ : 0.0);
+  rangeGap_ = std::max(options_.hr, lubricationActive() ? options_.cutoffCells * meshSize_ : 0.0);
   if (lubricationActive() && calibration_) checkCalibration();
   distanceFactor_ = 1.0 + 1.000001 * rangeGap_ / (2.0 * rmin_);
   if (rangeGap_ > 0) neighbor->register_contact_dist_factor(distanceFactor_);
@@ -284,10 +275,10 @@ void PairFdmSubgrid::init_style()
     history_ = dynamic_cast<FixContactHistoryFdm *>(modify->fix[modify->find_fix("contacthistory")]);
     if (!history_) error->all(FLERR, "pair fdm/subgrid: fix contacthistory is not the fdmDEM one (FixContactHistoryFdm)");
   }
-  if (contactActive() && !walls_.empty() && !wallHistory_) {
+  if (contactActive() && !options_.walls.empty() && !wallHistory_) {
     // tangential spring elongation against each wall, per atom: migrates with the atom
     std::vector<std::string> args = {"fdm_wall_history", "all", "property/atom", "fdmWallShear", "vector", "yes", "no", "no"};
-    for (size_t k = 0; k < wallHistoryWidth * walls_.size(); k++) args.push_back("0");
+    for (size_t k = 0; k < wallHistoryWidth * options_.walls.size(); k++) args.push_back("0");
     std::vector<char *> argv;
     for (std::string &s : args) argv.push_back(&s[0]);
     wallHistory_ = modify->add_fix_property_atom(int(argv.size()), argv.data(), "pair fdm/subgrid");
@@ -312,25 +303,27 @@ void PairFdmSubgrid::init_style()
               (calibration_ ? "up to " + fmt(rangeGap_) + " m (the calibrated squeeze, sliding, rolling and twist" +
                                   (uncalibratedTangential_.empty() ? std::string()
                                    : " except for radii " + uncalibratedTangential_ + ", whose are the cut-off model's") +
-                                  "; the stresslets within " + fmt(cutoffCells_) + " mesh cells)"
-                            : fmt(cutoffCells_) + " mesh cells = " + fmt(cutoffCells_ * meshSize_) + " m") +
-              (walls_.empty() ? std::string()
+                                  "; the stresslets within " + fmt(options_.cutoffCells) + " mesh cells)"
+                            : fmt(options_.cutoffCells) + " mesh cells = " +
+                                  fmt(options_.cutoffCells * meshSize_) + " m") +
+              (options_.walls.empty() ? std::string()
                : calibration_ ? ", walls within a surface gap of up to " + fmt(wallModel_->wallRange(rmax_) * rmax_) +
                                     " m (eps = " + fmt(wallModel_->wallRange(rmax_)) + ", the calibrated wall functions)"
-                              : ", walls within " + fmt(wallCutoffCells_) + " mesh cells = " +
-                                    fmt(wallCutoffCells_ * meshSize_) + " m") + "; viscosity " +
+                              : ", walls within " + fmt(options_.wallCutoffCells) + " mesh cells = " +
+                                    fmt(options_.wallCutoffCells * meshSize_) + " m") + "; viscosity " +
               fmt(viscosity_) + " Pa s; " + model_->describe() + ")";
     else
-      line += std::string("sub-grid lubrication OFF (") + (model_ || !lubrication_ ? "lubrication no" :
+      line += std::string("sub-grid lubrication OFF (") + (model_ || !options_.lubrication ? "lubrication no" :
               "no fix fdm/couple: no fluid") + ")";
-    if (walls_.empty()) line += "; no walls (no wall search)";
-    for (const Wall &w : walls_)
+    if (options_.walls.empty()) line += "; no walls (no wall search)";
+    for (const Wall &w : options_.walls)
       line += "; wall " + wallName(w) + " at velocity (" + fmt(w.velocity[0]) + " " + fmt(w.velocity[1]) + " " +
               fmt(w.velocity[2]) + ")";
     if (contactActive())
-      line += "; contact ON (kn " + fmt(kn_) + " N/m, kt " + fmt(kt_) + " N/m, mu_s " + fmt(mu_) + ", h_r " + fmt(hr_) +
-              " m" + (walls_.empty() ? "" : ", also with the walls") + "; springs " +
-              (implicit_ ? "implicit in Eq. 31" : "explicit") + ")";
+      line += "; contact ON (kn " + fmt(options_.kn) + " N/m, kt " + fmt(options_.kt) + " N/m, mu_s " +
+              fmt(options_.mu) + ", h_r " + fmt(options_.hr) +
+              " m" + (options_.walls.empty() ? "" : ", also with the walls") + "; springs " +
+              (options_.implicitContact ? "implicit in Eq. 31" : "explicit") + ")";
     else
       line += "; contact OFF (h_r = 0: no contact search)";
     line += "\n";
@@ -448,20 +441,20 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
   std::vector<Mode> modes;
   const double a = rmin_;
   // with mu_s = 0 the tangential force is capped at 0: the spring never acts
-  const bool tangentialSpring = kt_ > 0 && mu_ > 0;
+  const bool tangentialSpring = options_.kt > 0 && options_.mu > 0;
   if (atom->natoms > 1) {
     double n0, s0, n1, s1;
-    pairResistance(a, hr_, n0, s0);
+    pairResistance(a, options_.hr, n0, s0);
     pairResistance(a, 0.0, n1, s1);
-    modes.push_back({"normal spring of two spheres", kn_, n0, n1});
-    if (tangentialSpring) modes.push_back({"tangential spring of two spheres", kt_, s0, s1});
+    modes.push_back({"normal spring of two spheres", options_.kn, n0, n1});
+    if (tangentialSpring) modes.push_back({"tangential spring of two spheres", options_.kt, s0, s1});
   }
-  if (!walls_.empty()) {
+  if (!options_.walls.empty()) {
     double n0, s0, n1, s1;
-    wallResistance(a, hr_, n0, s0);
+    wallResistance(a, options_.hr, n0, s0);
     wallResistance(a, 0.0, n1, s1);
-    modes.push_back({"normal spring of a sphere on a wall", kn_, n0, n1});
-    if (tangentialSpring) modes.push_back({"tangential spring of a sphere on a wall", kt_, s0, s1});
+    modes.push_back({"normal spring of a sphere on a wall", options_.kn, n0, n1});
+    if (tangentialSpring) modes.push_back({"tangential spring of a sphere on a wall", options_.kt, s0, s1});
   }
   if (modes.empty()) return;
   const Mode *worst = &modes[0];
@@ -469,7 +462,7 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
     if (m.zetaContact / m.k < worst->zetaContact / worst->k) worst = &m;
   const double limit = factor * worst->zetaContact / worst->k;
   if (dt <= limit) return;
-  if (implicit_) {
+  if (options_.implicitContact) {
     // implicit springs (docs/contact.md 2b, Eq. C4): no stability limit from them; say how far
     // beyond the explicit limit the step is (the contacts then settle within a few steps)
     if (comm->me == 0) {
@@ -498,9 +491,10 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
                                 "the contact springs at every gap: the " + never->name + " (k " + fmt(never->k) +
                                 " N/m) needs dt < " + fmt(limitTouching) + " s even at zero gap (zeta " +
                                 fmt(never->zetaTouching) + " N s/m), and dt < " + fmt(limit) + " s at the contact gap "
-                                "h_r = " + fmt(hr_) + " m (the " + worst->name + ", zeta " + fmt(worst->zetaContact) +
+                                "h_r = " + fmt(options_.hr) + " m (the " + worst->name + ", zeta " +
+                                fmt(worst->zetaContact) +
                                 " N s/m) " + how;
-    if (unstableStepIsError_) {
+    if (options_.unstableStepIsError) {
       CouplingSession &session = CouplingSession::instance();
       if (session.connected()) session.abandon("fdmDEM: " + message);
       error->all(FLERR, (message + "; 'unstable_step warn' to run anyway").c_str());
@@ -511,7 +505,8 @@ void PairFdmSubgrid::checkTimeStep(double dt, bool adamsBashforth)
   if (comm->me == 0)
     error->warning(FLERR, ("pair_style fdm/subgrid: time step " + fmt(dt) + " s is beyond the stability limit " +
                            fmt(limit) + " s of the " + worst->name + " (k " + fmt(worst->k) + " N/m, zeta " +
-                           fmt(worst->zetaContact) + " N s/m at the contact gap h_r = " + fmt(hr_) + " m) " + how +
+                           fmt(worst->zetaContact) + " N s/m at the contact gap h_r = " + fmt(options_.hr) + " m) " +
+                           how +
                            ": stable only for contacts pressed deeper into the roughness layer (zeta grows as the "
                            "gap closes); an unstable contact shows no NaN, only wrong gaps and forces").c_str());
 }
@@ -542,7 +537,7 @@ void PairFdmSubgrid::compute(int eflag, int vflag)
   computeflag = 1;
   contactsLast_ = 0;
   contacts_.clear();
-  wallContactLoads_.assign(3 * walls_.size(), 0.0);
+  wallContactLoads_.assign(3 * options_.walls.size(), 0.0);
   deepest_ = Overlap();
   if (contactStressRequested_) {
     if (atom->nmax > nmaxStress_) {
@@ -556,7 +551,7 @@ void PairFdmSubgrid::compute(int eflag, int vflag)
   if (!contactActive()) return;  // lubrication is no force here: it is R^SG in Eq. (31)
   const auto start = std::chrono::steady_clock::now();
   contactForces();
-  if (!walls_.empty()) wallContactForces();
+  if (!options_.walls.empty()) wallContactForces();
   contactSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -594,14 +589,14 @@ void PairFdmSubgrid::contactLaw(const double n[3], double normalForce, const dou
   for (int d = 0; d < 3; d++) shear[d] += (vr[d] - vn * n[d]) * dt;
   const double sn = shear[0] * n[0] + shear[1] * n[1] + shear[2] * n[2];
   for (int d = 0; d < 3; d++) shear[d] -= sn * n[d];
-  double ft[3] = {-kt_ * shear[0], -kt_ * shear[1], -kt_ * shear[2]};
+  double ft[3] = {-options_.kt * shear[0], -options_.kt * shear[1], -options_.kt * shear[2]};
   const double ftNorm = std::sqrt(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2]);
-  const double ftMax = mu_ * normalForce;
+  const double ftMax = options_.mu * normalForce;
   if (ftNorm > ftMax) {
     const double scale = ftMax / ftNorm;
     for (int d = 0; d < 3; d++) {
       ft[d] *= scale;
-      if (kt_ > 0) shear[d] = -ft[d] / kt_;
+      if (options_.kt > 0) shear[d] = -ft[d] / options_.kt;
     }
   }
   for (int d = 0; d < 3; d++) force[d] = normalForce * n[d] + ft[d];
@@ -632,7 +627,7 @@ void PairFdmSubgrid::contactForces()
       double *shear = &allShear[3 * jj];
       const double del[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
       const double rsq = del[0] * del[0] + del[1] * del[1] + del[2] * del[2];
-      const double reach = radius[i] + radius[j] + hr_;
+      const double reach = radius[i] + radius[j] + options_.hr;
       if (rsq >= reach * reach) {  // apart: the contact and its history end now
         touch[jj] = 0;
         shear[0] = shear[1] = shear[2] = 0.0;
@@ -646,7 +641,7 @@ void PairFdmSubgrid::contactForces()
       touch[jj] = 1;
       const double r = std::sqrt(rsq);
       const double n[3] = {del[0] / r, del[1] / r, del[2] / r};  // from j to i
-      const double normalForce = kn_ * (reach - r);
+      const double normalForce = options_.kn * (reach - r);
       // the contact point in the middle of the gap: lever arms l = a + h/2 (l_i + l_j = r), so that a
       // rigid motion of the pair does not slip the contact points (docs/contact.md 2, Eq. C1)
       const double halfGap = 0.5 * (r - radius[i] - radius[j]);
@@ -668,14 +663,14 @@ void PairFdmSubgrid::contactForces()
       // the same positions, may move it by an ulp, and a resumed run would not continue the springs of
       // the run it continues (contactLaw on a copy)
       double force[3], nxft[3], setupShear[3] = {shear[0], shear[1], shear[2]};
-      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, update->setupflag ? setupShear : shear, force,
-                 nxft);
+      contactLaw(n, normalForce, vr, options_.implicitContact && fresh ? 0.0 : dt,
+                 update->setupflag ? setupShear : shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= leverI * nxft[d];
       }
       const double weightI = radius[i] / (radius[i] + radius[j]);
-      if (implicit_ && (j < nlocal || atom->tag[i] < atom->tag[j]))
+      if (options_.implicitContact && (j < nlocal || atom->tag[i] < atom->tag[j]))
         contacts_.push_back(Contact{i, j, {n[0], n[1], n[2]}, leverI, leverJ, {-del[0], -del[1], -del[2]}, weightI,
                                     normalForce, {force[0] - normalForce * n[0],
                                     force[1] - normalForce * n[1], force[2] - normalForce * n[2]}});
@@ -707,15 +702,15 @@ void PairFdmSubgrid::wallContactForces()
   const double dt = update->setupflag ? 0.0 : update->dt;
   double **history = wallHistory_->array_atom;
   for (int i = 0; i < atom->nlocal; i++) {
-    for (size_t k = 0; k < walls_.size(); k++) {
-      const Wall &wall = walls_[k];
+    for (size_t k = 0; k < options_.walls.size(); k++) {
+      const Wall &wall = options_.walls[k];
       double *shear = &history[i][wallHistoryWidth * k];
       double &touching = shear[3];
       // n: from the wall into the fluid; h: centre-to-wall distance
       const double h = wall.side == 0 ? x[i][wall.axis] - domain->boxlo[wall.axis] :
                                         domain->boxhi[wall.axis] - x[i][wall.axis];
       const double gap = h - radius[i];
-      if (gap >= hr_) {
+      if (gap >= options_.hr) {
         shear[0] = shear[1] = shear[2] = touching = 0.0;
         continue;
       }
@@ -723,15 +718,15 @@ void PairFdmSubgrid::wallContactForces()
       touching = 1.0;
       double n[3] = {0, 0, 0};
       n[wall.axis] = wall.side == 0 ? 1.0 : -1.0;
-      const double normalForce = kn_ * (hr_ - gap);
+      const double normalForce = options_.kn * (options_.hr - gap);
       double vr[3];
       const double aw[3] = {radius[i] * omega[i][0], radius[i] * omega[i][1], radius[i] * omega[i][2]};
       const double wxn[3] = {aw[1] * n[2] - aw[2] * n[1], aw[2] * n[0] - aw[0] * n[2], aw[0] * n[1] - aw[1] * n[0]};
       for (int d = 0; d < 3; d++) vr[d] = v[i][d] - wall.velocity[d] - wxn[d];
       // a setup force evaluation leaves the spring as it is (as for pairs, contactForces)
       double force[3], nxft[3], setupShear[3] = {shear[0], shear[1], shear[2]};
-      contactLaw(n, normalForce, vr, implicit_ && fresh ? 0.0 : dt, update->setupflag ? setupShear : shear, force,
-                 nxft);
+      contactLaw(n, normalForce, vr, options_.implicitContact && fresh ? 0.0 : dt,
+                 update->setupflag ? setupShear : shear, force, nxft);
       for (int d = 0; d < 3; d++) {
         f[i][d] += force[d];
         torque[i][d] -= radius[i] * nxft[d];
@@ -739,7 +734,7 @@ void PairFdmSubgrid::wallContactForces()
       }
       const double branch[3] = {-h * n[0], -h * n[1], -h * n[2]};
       if (contactStressRequested_) addContactStress(i, force, branch, 1.0);
-      if (implicit_)
+      if (options_.implicitContact)
         contacts_.push_back(Contact{i, -1 - int(k), {n[0], n[1], n[2]}, radius[i], 0.0,
                                     {branch[0], branch[1], branch[2]}, 1.0, normalForce,
                                     {force[0] - normalForce * n[0], force[1] - normalForce * n[1],
@@ -764,9 +759,10 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
   const int *tag = atom->tag;
   double R[144], term[6];
   for (const Contact &c : contacts_) {
-    const double kt = mu_ > 0 ? kt_ : 0.0;  // every frictional contact: the solve decides whether it slides (2c)
+    // every frictional contact: the solve decides whether it slides (2c)
+    const double kt = options_.mu > 0 ? options_.kt : 0.0;
     if (c.j >= 0) {
-      fdm::contact::pairSpringBlock(c.n, c.leverI, c.leverJ, kn_, kt, c1 * dt, R);
+      fdm::contact::pairSpringBlock(c.n, c.leverI, c.leverJ, options_.kn, kt, c1 * dt, R);
       pairs.push_back(tag[c.i]);
       pairs.push_back(tag[c.j]);
       pairs.insert(pairs.end(), R, R + 144);
@@ -774,17 +770,17 @@ void PairFdmSubgrid::collectSpringBlocks(double c1, double dt, std::vector<doubl
       pairs.push_back(c.weight);
       // the friction tail (fdm::springs): Coulomb's law at the end of the step (docs/contact.md 2c)
       pairs.insert(pairs.end(), c.n, c.n + 3);
-      pairs.insert(pairs.end(), {c.leverI, c.leverJ, kt * c1 * dt, mu_, c.normalForce, kn_ * c1 * dt});
+      pairs.insert(pairs.end(), {c.leverI, c.leverJ, kt * c1 * dt, options_.mu, c.normalForce, options_.kn * c1 * dt});
       pairs.insert(pairs.end(), c.ft, c.ft + 3);
     } else {
-      const Wall &w = walls_[size_t(-1 - c.j)];
-      fdm::contact::wallSpringBlock(c.n, c.leverI, kn_, kt, c1 * dt, dt, w.velocity, R, term);
+      const Wall &w = options_.walls[size_t(-1 - c.j)];
+      fdm::contact::wallSpringBlock(c.n, c.leverI, options_.kn, kt, c1 * dt, dt, w.velocity, R, term);
       walls.push_back(tag[c.i]);
       walls.insert(walls.end(), R, R + 36);
       walls.insert(walls.end(), term, term + 6);
       walls.insert(walls.end(), c.branch, c.branch + 3);
       walls.insert(walls.end(), c.n, c.n + 3);
-      walls.insert(walls.end(), {c.leverI, kt * c1 * dt, kt * dt, mu_, c.normalForce, kn_ * c1 * dt});
+      walls.insert(walls.end(), {c.leverI, kt * c1 * dt, kt * dt, options_.mu, c.normalForce, options_.kn * c1 * dt});
       walls.insert(walls.end(), c.ft, c.ft + 3);
       walls.insert(walls.end(), w.velocity, w.velocity + 3);
       if (wallIndex) wallIndex->push_back(double(-1 - c.j));
@@ -821,8 +817,8 @@ void PairFdmSubgrid::collectBlocks(bool withStress, std::vector<double> &pairs, 
     }
   }
   res::WallBlock wallBlock;
-  for (size_t k = 0; k < walls_.size(); k++) {
-    const Wall &w = walls_[k];
+  for (size_t k = 0; k < options_.walls.size(); k++) {
+    const Wall &w = options_.walls[k];
     double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};  // normal into the wall (Appendix A.2)
     point[w.axis] = w.side == 0 ? domain->boxlo[w.axis] : domain->boxhi[w.axis];
     normal[w.axis] = w.side == 0 ? -1.0 : 1.0;

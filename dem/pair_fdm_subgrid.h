@@ -65,12 +65,12 @@ class PairFdmSubgrid : public Pair {
   // wallIndex (optional): the wall (index in walls()) of each wall spring block, in the same order
   void collectSpringBlocks(double c1, double dt, std::vector<double> &pairs, std::vector<double> &walls,
                            std::vector<double> *wallIndex = nullptr) const;
-  bool implicitContact() const { return contactActive() && implicit_; }
+  bool implicitContact() const { return contactActive() && options_.implicitContact; }
 
-  bool lubricationActive() const { return lubrication_ && model_; }
-  bool contactActive() const { return hr_ > 0; }
-  double roughness() const { return hr_; }
-  const std::vector<Wall> &walls() const { return walls_; }
+  bool lubricationActive() const { return options_.lubrication && model_; }
+  bool contactActive() const { return options_.hr > 0; }
+  double roughness() const { return options_.hr; }
+  const std::vector<Wall> &walls() const { return options_.walls; }
   // The contact histories, for fix fdm/couple's checkpoints (null without contact, or without walls)
   class FixContactHistoryFdm *contactHistory() const;
   class FixPropertyAtom *wallHistory() const { return wallHistory_; }
@@ -122,14 +122,7 @@ class PairFdmSubgrid : public Pair {
   void wallResistance(double a, double h, double &normal, double &slip) const;
 
   // settings
-  bool lubrication_;
-  bool calibrated_;                 // model calibrated (the default): the calibration of Appendix B
-  std::string calibrationFile_;     // its table (default: SubgridCalibration::defaultPath())
-  double cutoffCells_, wallCutoffCells_;
-  double kn_, kt_, mu_, hr_;
-  bool unstableStepIsError_;   // unstable_step error (default) | warn
-  bool implicit_;              // contact_integration implicit (default) | explicit
-  std::vector<Wall> walls_;
+  fdm::SubgridOptions options_;    // the keywords of the pair_style line (subgrid_options.h)
 
   // from the fluid solver at the handshake (coupling session)
   double viscosity_, meshSize_;
