@@ -23,7 +23,9 @@ def test_box_extrapolation_removes_dipole_images():
 
 
 def test_fit_recovers_a_logistic_resistance():
-    gaps = calibration.GAPS
+    """A solver resistance that is the logistic curve itself, at the gaps where the table's correction is the
+    fit's untapered (xi <= TAPER_START): the fit gives back its parameters and leaves no velocity error."""
+    gaps = [g for g in calibration.GAPS if g <= calibration.TAPER_START]
     truth = dict(r_0=2.7, r_inf=0.6, xi_1=0.3, p=1.25)
     r = calibration.fitted_resistance(np.array(gaps), **truth)
     cal = calibration.SqueezeCalibration("pair", 3.0, 1.0, gaps, [8.0, 12.0],
@@ -31,7 +33,7 @@ def test_fit_recovers_a_logistic_resistance():
     fit = cal.fit()
     for k, v in truth.items():
         assert fit[k] == pytest.approx(v, rel=1e-4), k
-    assert fit["max_rel"] < 1e-6
+    assert fit["max_rel"] < 1e-6 and fit["velocity_max"] < 1e-6
 
 
 def test_taper_is_continuous_and_ends_the_correction():
@@ -93,17 +95,90 @@ def test_position_floor_is_the_best_any_gap_only_correction_can_do():
 
 def test_no_position_beats_the_floor_and_the_mean_holds():
     """The shipped calibrations at their own 4 positions: the model, a correction of the gap alone, is nowhere
-    better at its worst position than the floor; averaged over the positions it is within 3.5 % at every gap
-    (measured 3.0 %), and near contact, where the correction carries the resistance, the worst position is
-    within 1 % (xi <= 1e-3)."""
+    better at its worst position than the floor; averaged over the positions it is within the fit's bound at
+    every gap (calibration.FIT_VELOCITY_BOUND, 1.8 %), and near contact, where the correction carries the
+    resistance, the worst position is within 1 % (xi <= 1e-3)."""
     for e in calibration.position_errors(os.path.join(DATA, "squeeze_calibration.json")):
         label = "%s a/Delta %g ratio %g" % (e["kind"], e["a_over_delta"], e["ratio"])
         assert e["positions"] == 4, label
         for g, worst, floor, mean in zip(e["gaps"], e["worst"], e["floor"], e["mean"]):
             assert abs(worst) >= floor - 1e-12, (label, g)
-            assert abs(mean) < 0.035, (label, g)
+            assert abs(mean) <= calibration.FIT_VELOCITY_BOUND + 1e-6, (label, g)
             if g <= 1e-3:
                 assert abs(worst) < 0.01, (label, g)
+
+
+def table_s_hat(rows: np.ndarray, xi: float) -> float:
+    """s_hat of a table block's rows as the resistance library reads them (SubgridCalibration::Block::sHatAt):
+    xi * s_hat linear in ln xi, 0 from the last row on."""
+    t = np.log(xi)
+    if t >= np.log(rows[-1, 0]):
+        return 0.0
+    return float(np.interp(t, np.log(rows[:, 0]), rows[:, 1])) / xi
+
+
+def test_shipped_table_within_2_percent_at_every_gap():
+    """The issue's criterion, as the paper judges it: the closing velocity the shipped table's correction gives,
+    averaged over the calibration's 4 positions in the cell, within 2 % of the theory at every measured gap
+    (xi or eps 1e-4 ... 1) for every shipped (a1/Delta, a2/a1, wall): 9 blocks x 15 gaps. The correction is
+    the table's rows as the resistance library interpolates them, the solver's resistance at each position
+    the stored measurement (the resistances add: exact, no run)."""
+    blocks = calibration.read_table(TABLE)
+    with open(os.path.join(DATA, "squeeze_calibration.json")) as f:
+        summaries = json.load(f)
+    kinds, points, worst = set(), 0, 0.0
+    for s in summaries:
+        cal = calibration.SqueezeCalibration(s["kind"], s["a_over_delta"], s["ratio"], s["gaps"], s["boxes"],
+                                             s["velocities"])
+        _, rows = blocks[(s["kind"], float(s["a_over_delta"]), float(s["ratio"]))]
+        s_hat = np.array([table_s_hat(rows, g) for g in cal.gaps])
+        mean = (cal.theory() ** -1 / (1 / cal.velocity_by_position() + s_hat) - 1).mean(axis=0)
+        label = "%s a1/Delta %g a2/a1 %g" % (s["kind"], s["a_over_delta"], s["ratio"])
+        for g, e in zip(cal.gaps, mean):
+            assert abs(e) < 0.02, (label, g, e)
+        # the table holds the fit's correction: the errors the calibration module reports from the fit, but for the
+        # linear interpolation between the table's rows (20 per decade; measured at most 0.04 %)
+        assert np.allclose(mean, cal.corrected_errors(s["fit"]).mean(axis=0), rtol=0, atol=5e-4), label
+        kinds.add((s["kind"], s["a_over_delta"], s["ratio"]))
+        points += len(mean)
+        worst = max(worst, float(np.max(np.abs(mean))))
+    assert kinds == {(k, ad, r) for ad in (3.0, 4.0, 5.0) for k, r in (("pair", 1.0), ("pair", 1.4), ("wall", 1.0))}
+    assert points == 135
+    print("squeeze calibration: 135 position-averaged points, worst %.2f %%" % (100 * worst))
+
+
+def test_cpp_reads_the_shipped_correction_python_computes(env):
+    """fdmResistance (the resistance library pair_style fdm/subgrid uses, `--calibrated`: the shipped table) gives
+    X21A = -6 pi a1 s_hat (pairs) and X^A = 6 pi a s_hat (walls) with s_hat the table's rows interpolated in ln xi
+    (to 1e-6), and that is the calibration module's correction from its fit, kept where positive and tapered
+    (within 0.1 % of the resistance the corrected model gives), at every measured gap of every shipped block."""
+    import subprocess
+    blocks = calibration.read_table(TABLE)
+    with open(os.path.join(DATA, "squeeze_calibration.json")) as f:
+        summaries = json.load(f)
+
+    def resistance(*args):
+        done = subprocess.run(["fdmResistance"] + [str(a) for a in args], env=env, check=True, capture_output=True,
+                              text=True)
+        return json.loads(done.stdout)
+    for s in summaries:
+        cal = calibration.SqueezeCalibration(s["kind"], s["a_over_delta"], s["ratio"], s["gaps"], s["boxes"],
+                                             s["velocities"])
+        _, rows = blocks[(s["kind"], float(s["a_over_delta"]), float(s["ratio"]))]
+        delta = 1 / s["a_over_delta"]
+        for g in cal.gaps:
+            if s["kind"] == "pair":
+                out = resistance("pair", "--a1", 1, "--a2", s["ratio"], "--xi", g, "--subgrid", "--calibrated",
+                                 "--delta", delta)
+                cpp = -out["base"]["X21A"] / (6 * np.pi)
+            else:
+                out = resistance("wall", "--a", 1, "--eps", g, "--delta", delta, "--calibrated")
+                cpp = out["subgrid_dimensional_over_eta"]["XA"] / (6 * np.pi)
+            label = (s["kind"], s["a_over_delta"], s["ratio"], g)
+            assert cpp == pytest.approx(table_s_hat(rows, g), rel=1e-6, abs=1e-9), label
+            python = max(cal.correction(g, s["fit"]), 0.0) * calibration.taper(g)
+            r_th = 1 / calibration.theory_velocity(s["kind"], s["ratio"], g)
+            assert abs(cpp - python) < 1e-3 * r_th, label
 
 
 def test_position_errors_predict_the_coupled_solver(tmp_path, env):
@@ -182,6 +257,6 @@ def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
         couette.main(["--a-over-delta", "4", "--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
     # the 1.4-1.4 pairs (a1/Delta 5.6) lie beyond the interpolation's 2 %; the wall of 1.4 does not
     assert "the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated" in str(refused.value)
-    assert "interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.2 %)" in str(refused.value)
+    assert "interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.3 %)" in str(refused.value)
     assert "--model cutoff" in str(refused.value)
     assert os.listdir(tmp_path) == []

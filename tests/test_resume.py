@@ -388,6 +388,97 @@ def test_changed_calibration_table_refuses_a_resume(tmp_path):
         checkpoint.check_stamp(str(case_dir), dem_input)
 
 
+# the table the shipped one replaced, kept beside it by the first 8 hex digits of its SHA-256: the paper
+# channel's committed snapshot (cases/poiseuille/paper/snapshot) and Table 8's shipped rows ran with it
+PREVIOUS_TABLE = os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration_b6ffff38.dat")
+PAPER_SNAPSHOT = os.path.join(PROJECT, "cases", "poiseuille", "paper", "snapshot")
+
+
+def test_the_previous_table_is_found_by_its_hash():
+    """checkpoint.table_by_hash: the kept previous table by the SHA-256 a run or snapshot recorded, the shipped
+    one by its own, nothing for a hash no table of the project has."""
+    previous = json.load(open(os.path.join(PAPER_SNAPSHOT, checkpoint.SNAPSHOT_CALIBRATION)))["sha256"]
+    assert os.path.basename(PREVIOUS_TABLE) == "subgrid_calibration_%s.dat" % previous[:8]
+    assert checkpoint.table_by_hash(previous) == PREVIOUS_TABLE
+    shipped = os.path.join(PROJECT, "dem", "resistance", "data", "subgrid_calibration.dat")
+    digest = checkpoint._table_identity(shipped)["sha256"]
+    assert digest != previous
+    assert checkpoint.table_by_hash(digest) == shipped
+    assert checkpoint.table_by_hash("0" * 64) is None and checkpoint.table_by_hash(None) is None
+
+
+def test_committed_paper_snapshot_continues_with_the_table_it_ran_with(tmp_path, monkeypatch):
+    """The paper channel's committed snapshot ran with the previous table; a case of its scene reads the
+    shipped one. snapshot_check accepts it (the project keeps the previous table), snapshot_table names that
+    table, and use_table (what snapshot_install does) points the input at a copy of it beside the input, so
+    that the run reads the bytes the snapshot's run read; with a hash no table of the project has, the check
+    refuses, naming the snapshot's record and the hash. (The case here is the snapshot's input alone: no data
+    file, no mesh.)"""
+    monkeypatch.setenv("FDM_ROOT", PROJECT)
+    case_dir = tmp_path / "case"
+    (case_dir / "dem").mkdir(parents=True)
+    dem_input = str(case_dir / "dem" / "in.poiseuille")
+    shutil.copyfile(os.path.join(PAPER_SNAPSHOT, "in.poiseuille"), dem_input)
+    snap = checkpoint.check_snapshot(PAPER_SNAPSHOT)
+    assert checkpoint.calibration_table(dem_input) == os.path.join(PROJECT, "dem", "resistance", "data",
+                                                                   "subgrid_calibration.dat")
+    step, last = checkpoint.snapshot_check(PAPER_SNAPSHOT, str(case_dir), dem_input)
+    assert step == 800 and last > step
+    assert checkpoint.snapshot_table(snap, PAPER_SNAPSHOT, dem_input) == PREVIOUS_TABLE
+    copy = checkpoint.use_table(dem_input, PREVIOUS_TABLE)
+    assert copy == str(case_dir / "dem" / os.path.basename(PREVIOUS_TABLE))
+    assert checkpoint.calibration_table(dem_input) == copy
+    assert checkpoint._table_identity(copy)["sha256"] == snap["calibration"]["sha256"]
+    assert checkpoint.snapshot_table(snap, PAPER_SNAPSHOT, dem_input) is None
+    # only the pair style's line changed
+    before = open(os.path.join(PAPER_SNAPSHOT, "in.poiseuille")).read().split("\n")
+    after = open(dem_input).read().split("\n")
+    changed = [(a, b) for a, b in zip(before, after) if a != b]
+    assert len(before) == len(after) and len(changed) == 1
+    assert changed[0][1] == changed[0][0].replace("fdm/subgrid ", "fdm/subgrid calibration %s "
+                                                  % os.path.basename(PREVIOUS_TABLE), 1)
+    # a second use_table replaces the keyword instead of adding another
+    checkpoint.use_table(dem_input, PREVIOUS_TABLE)
+    assert open(dem_input).read().count("calibration ") == 1
+    # a snapshot naming a hash the project does not keep
+    bogus = tmp_path / "bogus"
+    shutil.copytree(PAPER_SNAPSHOT, bogus)
+    record = bogus / checkpoint.SNAPSHOT_CALIBRATION
+    record.write_text(json.dumps(dict(table="dem/resistance/data/subgrid_calibration.dat", sha256="ab" * 32)))
+    shutil.copyfile(os.path.join(PAPER_SNAPSHOT, "in.poiseuille"), dem_input)
+    with pytest.raises(checkpoint.CheckpointError) as e:
+        checkpoint.snapshot_check(str(bogus), str(case_dir), dem_input)
+    message = str(e.value)
+    assert str(record) in message and "ab" * 32 in message, message
+    assert "no table of the project (dem/resistance/data/subgrid_calibration*.dat) has sha256" in message
+
+
+def test_resume_finds_the_table_the_run_started_with(tmp_path, monkeypatch):
+    """A run started with the previous shipped table (its record names it by path and hash) and resumed where the
+    shipped table is the new one: check_stamp points the input at a copy of the previous table and records it; a
+    further resume finds the same table; a record with a hash the project does not keep is refused, naming it."""
+    monkeypatch.setenv("FDM_ROOT", PROJECT)
+    case_dir = tmp_path / "run"
+    (case_dir / "dem").mkdir(parents=True)
+    dem_input = str(case_dir / "dem" / "in.scene")
+    with open(dem_input, "w") as f:
+        f.write("pair_style fdm/subgrid model calibrated contact 1 1 0.5 0.005 # the shipped table\nrun 10 upto\n")
+    stamp = case_dir / checkpoint.CALIBRATION_STAMP
+    previous = checkpoint._table_identity(PREVIOUS_TABLE)["sha256"]
+    stamp.write_text(json.dumps(dict(table="/elsewhere/dem/resistance/data/subgrid_calibration.dat",
+                                     sha256=previous)))
+    line = checkpoint.check_stamp(str(case_dir), dem_input)
+    assert line.startswith("continues with the calibration table it started with (sha256 %s)" % previous[:12]), line
+    copy = str(case_dir / "dem" / os.path.basename(PREVIOUS_TABLE))
+    assert checkpoint.calibration_table(dem_input) == copy
+    assert json.load(open(stamp)) == dict(table=copy, sha256=previous)
+    assert checkpoint.check_stamp(str(case_dir), dem_input) == "the same calibration table as at the start"
+    stamp.write_text(json.dumps(dict(table=copy, sha256="cd" * 32)))
+    with pytest.raises(checkpoint.CheckpointError) as e:
+        checkpoint.check_stamp(str(case_dir), dem_input)
+    assert "cd" * 32 in str(e.value) and str(stamp) in str(e.value)
+
+
 def test_fdmRun_refuses_a_resume_whose_table_changed_and_loses_nothing(tmp_path, env, reference):
     """fdmRun --resume on a run whose record names another table than the input reads: refused before the
     records are cut (every file as it was); with --new-calibration it resumes (here the cut-off model reads no

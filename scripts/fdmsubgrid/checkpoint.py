@@ -21,7 +21,9 @@ each code keeps its two newest.
                                                  starts with (its path and SHA-256, CASE/.fdmRun-calibration)
     python3 -m fdmsubgrid.checkpoint check-stamp CASE INPUT [--new-calibration]
                                                  on a resume: refuse if that table changed since (a run
-                                                 never mixes two sub-grid models), unless asked
+                                                 never mixes two sub-grid models), unless asked; if the
+                                                 project keeps the table the run started with (by its
+                                                 SHA-256: table_by_hash), the input is pointed at it
 
 A compact snapshot (docs/coupling.md, "Compact snapshot") is the particle state of the newest checkpoint
 in a small folder of plain files, to keep (e.g. in git) when the run folder may be lost; fdmRun
@@ -37,7 +39,9 @@ recomputed from the particles:
     python3 -m fdmsubgrid.checkpoint snapshot-check DEST CASE INPUT [L]
                                                  fdmRun --from-snapshot, before anything changes: DEST is
                                                  complete and of CASE's scene (input, particles, box,
-                                                 calibration table), the run goes on after its step; prints
+                                                 calibration table: the one the snapshot's run used, by
+                                                 SHA-256, or the project keeps it), the run goes on after
+                                                 its step; prints
                                                  "STEP LAST" (L: --until)
     python3 -m fdmsubgrid.checkpoint snapshot-install DEST CASE INPUT NP_FLUID [L]
                                                  then, once meshed (and decomposed): the same mesh; DEM
@@ -369,6 +373,68 @@ def _table_identity(table: str | None) -> dict:
         return dict(table=table, sha256=hashlib.sha256(f.read()).hexdigest())
 
 
+# Where the project keeps its shipped table and, beside it, each earlier one a run or a snapshot may have
+# started with, named by the first 8 hex digits of its SHA-256 (subgrid_calibration_<8 hex>.dat)
+TABLE_FOLDER = os.path.join("dem", "resistance", "data")
+
+
+def table_by_hash(sha256: str | None) -> str | None:
+    """The project's calibration table whose bytes have this SHA-256: the shipped one or an earlier one kept
+    beside it (TABLE_FOLDER/subgrid_calibration*.dat, the one named by the hash's first 8 hex digits first);
+    None if none has it."""
+    from .environment import project_dir
+    root = project_dir()
+    if not sha256 or root is None:
+        return None
+    folder = os.path.join(root, TABLE_FOLDER)
+    named = os.path.join(folder, "subgrid_calibration_%s.dat" % sha256[:8])
+    others = sorted(os.path.join(folder, n) for n in os.listdir(folder)
+                    if n.startswith("subgrid_calibration") and n.endswith(".dat")) if os.path.isdir(folder) else []
+    for path in [named] + [o for o in others if o != named]:
+        if os.path.isfile(path) and _table_identity(path)["sha256"] == sha256:
+            return path
+    return None
+
+
+def _searched_tables() -> str:
+    """Where table_by_hash looks, for a message."""
+    return os.path.join(TABLE_FOLDER, "subgrid_calibration*.dat")
+
+
+def use_table(dem_input: str, table: str) -> str:
+    """Make the LIGGGHTS input read `table`: a copy of it beside the input (its file name kept) named by every
+    `pair_style fdm/subgrid` line's `calibration` (replaced, or added after the style's name). Returns the
+    copy's path; CheckpointError if the input does not read it afterwards."""
+    folder = os.path.dirname(os.path.abspath(dem_input))
+    name = os.path.basename(table)
+    copy = os.path.join(folder, name)
+    if os.path.abspath(table) != copy:
+        shutil.copyfile(table, copy)
+    with open(dem_input) as f:
+        lines = f.read().split("\n")
+    k = 0
+    while k < len(lines):
+        words = lines[k].split("#", 1)[0].split()
+        end = k
+        while end + 1 < len(lines) and lines[end].split("#", 1)[0].rstrip().endswith("&"):
+            end += 1
+        if words[:2] == ["pair_style", "fdm/subgrid"]:
+            found = False
+            for j in range(k, end + 1):
+                code, sep, comment = lines[j].partition("#")
+                code, n = re.subn(r"(\bcalibration\s+)\S+", lambda m: m.group(1) + name, code)
+                if n:
+                    lines[j], found = code + sep + comment, True
+            if not found:
+                lines[k] = re.sub(r"(pair_style\s+fdm/subgrid)", r"\1 calibration " + name, lines[k], count=1)
+        k = end + 1
+    write_atomically(dem_input, "\n".join(lines))
+    if calibration_table(dem_input) != copy:
+        raise CheckpointError("%s: could not point pair_style fdm/subgrid at the calibration table %s"
+                              % (dem_input, copy))
+    return copy
+
+
 def stamp(case_dir: str, dem_input: str) -> str:
     """Record in CASE/.fdmRun-calibration the calibration table the run starts with; returns a line for the log."""
     identity = _table_identity(calibration_table(dem_input))
@@ -380,8 +446,11 @@ def stamp(case_dir: str, dem_input: str) -> str:
 
 def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
     """On a resume: the table the input reads now against the one recorded when the run started. Raises
-    CheckpointError naming both if it changed (unless accept_new, which records the new one). A run started
-    before the record existed gets it now. Returns a line for the log."""
+    CheckpointError naming both if it changed (unless accept_new, which records the new one), except where the
+    project keeps the table the run started with (table_by_hash: an earlier table beside the shipped one): the
+    input is then pointed at a copy of it (use_table) and the record names the copy. The same bytes at another
+    path (the case or the project moved) are the same table. A run started before the record existed gets it
+    now. Returns a line for the log."""
     path = os.path.join(case_dir, CALIBRATION_STAMP)
     now = _table_identity(calibration_table(dem_input))
     if not os.path.isfile(path):
@@ -392,12 +461,22 @@ def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
     if then == now:
         return "the same calibration table as at the start"
     describe = lambda d: "no table" if d["table"] is None else "%s with sha256 %s" % (d["table"], d["sha256"][:12])
+    if now["sha256"] == then["sha256"]:         # the same bytes elsewhere (the case folder moved)
+        write_atomically(path, json.dumps(now))
+        return "the same calibration table as at the start, now %s" % now["table"]
+    earlier = None if accept_new else table_by_hash(then["sha256"])
+    if earlier is not None:
+        copy = use_table(dem_input, earlier)
+        write_atomically(path, json.dumps(_table_identity(copy)))
+        return ("continues with the calibration table it started with (sha256 %s): %s, copied to %s and named by "
+                "the input's pair_style (the input read %s)" % (then["sha256"][:12], earlier, copy, describe(now)))
     if not accept_new:
         raise CheckpointError(
             "the sub-grid calibration table changed since this run started: it began with %s (recorded in %s), "
-            "the input now reads %s. Resuming would mix two sub-grid models in one run: restore the table the run "
-            "started with (git log -- dem/resistance/data), or resume with --new-calibration to continue with "
-            "the new one knowingly" % (describe(then), path, describe(now)))
+            "the input now reads %s, and no table of the project (%s) has sha256 %s. Resuming would mix two "
+            "sub-grid models in one run: restore the table the run started with (git log -- dem/resistance/data), "
+            "or resume with --new-calibration to continue with the new one knowingly"
+            % (describe(then), path, describe(now), _searched_tables(), then["sha256"]))
     write_atomically(path, json.dumps(now))
     return "--new-calibration: continues with %s (it began with %s)" % (describe(now), describe(then))
 
@@ -633,10 +712,31 @@ def _data_scene(path: str) -> tuple[int, list[float], list[float]]:
     return atoms, lo, hi
 
 
+def snapshot_table(snap: dict, dest: str, dem_input: str) -> str | None:
+    """The calibration table a run continued from the snapshot (check_snapshot's `snap`, in dest) must read: None if
+    the input reads the one the snapshot's run used (the same SHA-256), else the project's table with that hash
+    (table_by_hash: an earlier table kept beside the shipped one, which snapshot_install points the input at).
+    CheckpointError naming the snapshot's record and the hash if the project has no such table."""
+    now = _table_identity(calibration_table(dem_input))
+    then = snap["calibration"]
+    if now["sha256"] == then.get("sha256"):
+        return None
+    earlier = table_by_hash(then.get("sha256"))
+    if earlier is not None:
+        return earlier
+    describe = lambda d: "no table" if d.get("table") is None else "%s (sha256 %s)" % (d["table"], d["sha256"][:12])
+    raise CheckpointError("the sub-grid calibration table differs from the run's: the snapshot's run used %s "
+                          "(recorded in %s), %s reads %s, and no table of the project (%s) has sha256 %s. Continuing "
+                          "would mix two sub-grid models in one run: check out the table the run used (git log -- "
+                          "dem/resistance/data)" % (describe(then), os.path.join(dest, SNAPSHOT_CALIBRATION), dem_input,
+                                                    describe(now), _searched_tables(), then.get("sha256")))
+
+
 def snapshot_check(dest: str, case_dir: str, dem_input: str, until: int | None = None) -> tuple[int, int]:
     """Before fdmRun --from-snapshot changes anything: the snapshot in dest is complete and of the scene in
     case_dir (its LIGGGHTS input the snapshot's but for the run command; the particle count and box of its
-    data file the checkpoint's; the calibration table it reads the one the run used, by SHA-256), and the
+    data file the checkpoint's; the calibration table it reads the one the run used, by SHA-256, or the project
+    keeps that one: snapshot_table), and the
     run goes on after the snapshot's step (to the input's last step, or `until`). Returns (step, last step)."""
     snap = check_snapshot(dest)
     step, header = snap["step"], snap["header"]
@@ -662,14 +762,7 @@ def snapshot_check(dest: str, case_dir: str, dem_input: str, until: int | None =
                 raise CheckpointError("%s: the box spans %.17g .. %.17g in %s, the snapshot %s's %.17g .. %.17g"
                                       % (data, lo[d], hi[d], "xyz"[d], snap["dem"], header["boxlo"][d],
                                          header["boxhi"][d]))
-    now = _table_identity(calibration_table(dem_input))
-    then = snap["calibration"]
-    if now["sha256"] != then.get("sha256"):
-        describe = lambda d: "no table" if d.get("table") is None else "%s (sha256 %s)" % (d["table"], d["sha256"][:12])
-        raise CheckpointError("the sub-grid calibration table differs from the run's: the snapshot's run used %s "
-                              "(recorded in %s), %s reads %s. Continuing would mix two sub-grid models in one run: "
-                              "check out the table the run used (git log -- dem/resistance/data)"
-                              % (describe(then), os.path.join(dest, SNAPSHOT_CALIBRATION), dem_input, describe(now)))
+    snapshot_table(snap, dest, dem_input)
     last = until if until is not None else _last_step(dem_input)
     if last <= step:
         raise CheckpointError("the snapshot is of step %d but %s runs to step %d: write the scene for a longer run, "
@@ -694,7 +787,9 @@ def snapshot_install(dest: str, case_dir: str, dem_input: str, np_fluid: int, un
     number of cells as the snapshot's run; then the snapshot installed as the case's checkpoint of its step:
     dem/checkpoint/dem.STEP (its last step the run's), fluid/checkpoint/fluid.STEP (the snapshot's time, time index and step count, this
     case's cells and processors, fromRest 1) with the files of 0/ copied to the step's time directory (each
-    processor's in parallel), and the calibration record of this case. Returns (step, last step)."""
+    processor's in parallel), the input pointed at the table the snapshot's run used if the project keeps it
+    beside the shipped one (snapshot_table, use_table), and the calibration record of this case. Returns (step,
+    last step)."""
     step, last = snapshot_check(dest, case_dir, dem_input, until)
     snap = check_snapshot(dest)
     marker = snap["marker"]
@@ -706,6 +801,9 @@ def snapshot_install(dest: str, case_dir: str, dem_input: str, np_fluid: int, un
                                  os.path.join(dest, "fluid.%d" % step), snap["scene"]))
     if until is not None:
         set_last_step(dem_input, until, step)
+    earlier = snapshot_table(snap, dest, dem_input)
+    if earlier is not None:
+        use_table(dem_input, earlier)
     bases = [fluid] if np_fluid == 1 else [os.path.join(fluid, "processor%d" % p) for p in range(np_fluid)]
     for base in bases:
         source, target = os.path.join(base, "0"), os.path.join(base, marker["timeName"])

@@ -15,8 +15,8 @@ which tends to 1 as x -> 0 (the solver resolves a finite resistance, the theory'
 beyond a few cells. Across the measured pair blocks (a1/Delta 3-5, a2/a1 1 and 1.4: u 1.5-2.92) Phi at a
 fixed x varies by a few hundredths and linearly with u (docs/resistance.md, "Sizes and resolutions outside
 the table"); at a fixed xi, linear in a1/Delta and a2/a1 as the resistance library interpolates inside its
-grid, the blocks collapse less well (held back one at a time, the pairs' worst error is 3.0 % against
-2.1 %, and 2.8-3.0 % against 0.6-1.7 % at the end of the table, a1/Delta 3). Pairs and walls differ beyond
+grid, the blocks collapse less well (held back one at a time, the pairs' worst error is 4.5 % against
+3.0 %, and 2.6-4.5 % against 1.5-3.0 % at the end of the table, a1/Delta 3). Pairs and walls differ beyond
 the lubrication region (their far fields do): each kind is interpolated from its own blocks.
 
 Interpolation. At every x the measured blocks' Phi (each from its fit, calibration.SqueezeCalibration.fit,
