@@ -285,3 +285,25 @@ def test_time_step_variants_take_a_spring_factor():
     for bad in ("0.05", "0.05:0", "-0.1:4", "0.1:4:0", "0.1:4:10:2", "a:b"):
         with pytest.raises(argparse.ArgumentTypeError, match=bad.replace(".", r"\.")):
             time_step.parse_variant(bad)
+
+
+def test_time_step_warning_cites_the_measured_steps_and_the_stability_map():
+    """No warning at the measured steps and springs (the defaults, the fluid every 8th step of the ladder); the
+    accuracy limits (particle step 0.05, fluid step 0.4) cite "The channel's time step", a particle step beyond
+    the stability map's 0.4 or springs outside its 0.1-10 times the recipe's cite "The channel's stability map";
+    the limits carry over to other sizes by suspension.time_step_factor."""
+    from fdmsubgrid import packing
+    assert poiseuille.time_step_warning(0.05, 4) is None and poiseuille.time_step_warning(0.05, 8) is None
+    assert poiseuille.time_step_warning(0.05, 8, spring_factors=(0.1, 10.0)) is None
+    accuracy = poiseuille.time_step_warning(0.1, 4)
+    assert "the particle step 0.1 above 0.05" in accuracy and "stability map" not in accuracy
+    assert "The channel's time step" in accuracy
+    assert "the fluid's step 0.8" in poiseuille.time_step_warning(0.05, 16)
+    beyond = poiseuille.time_step_warning(0.5, 1)
+    assert "beyond the stability map's 0.4" in beyond and "The channel's stability map" in beyond
+    assert poiseuille.time_step_warning(0.4, 1).count("stability map") == 0
+    springs = poiseuille.time_step_warning(0.05, 4, spring_factors=(20.0, 1.0))
+    assert "the springs 20 times the recipe's, outside the stability map's 0.1 to 10" in springs
+    assert "0.05 the springs" not in springs and "above 0.05" not in springs
+    # the paper's radii: the limits as measured; a wider distribution scales both particle limits
+    assert poiseuille.time_step_warning(0.05, 4, packing.PAPER_SUSPENSION) is None
