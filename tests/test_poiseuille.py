@@ -246,3 +246,64 @@ def test_channel_at_its_defaults_migrates_and_balances(case_module, tmp_path_fac
     assert r["phi_center"] > r["phi_center_initial"] + 0.01
     gaps = contacts.smallest_gaps(os.path.join(r["run_dir"], "dem", "particles.records"))
     assert gaps.min() > -0.005, gaps.min()
+
+
+def test_how_a_run_ended_is_read_from_its_logs_and_records(small_run, tmp_path):
+    """case.last_error and case.records_finite (the stability maps' reading of a run): the small run wrote
+    no error and finite records; an error appended to a copy of its logs is the line returned (fdmDEM's
+    `ERROR` as written, OpenFOAM's `FOAM FATAL` by the two lines after it, the last one of either log)."""
+    from fdmsubgrid import case
+    run_dir = small_run["run_dir"]
+    assert case.last_error(run_dir) is None and case.records_finite(run_dir) is True
+    copy = tmp_path / "run"
+    (copy / "dem").mkdir(parents=True)
+    assert case.last_error(str(copy)) is None and case.records_finite(str(copy)) is None
+    dem = open(os.path.join(run_dir, "log.dem")).read()
+    message = ("ERROR on proc 0: particles 39 and 50 overlap by 0.0512 m (0.0512 of the smaller radius) at step 223, "
+               "more than the 0.05 the fluid accepts")
+    (copy / "log.dem").write_text(dem + "ERROR: an earlier one\n" + message + "\nLast command: run 800 upto\n")
+    assert case.last_error(str(copy)) == message
+    (copy / "log.dem").write_text(dem)
+    (copy / "log.fluid").write_text("--> FOAM FATAL ERROR:\n    Cannot find patch wall\n\n    From function x\n")
+    assert case.last_error(str(copy)) == "Cannot find patch wall"
+
+
+def test_time_step_variants_take_a_spring_factor():
+    """timeStep.py's variants DT:K[:S] (the channel's stability map): S scales the recipe's k_n = k_t of the
+    channel's wall shear stress tau_w = 1 (2 F_max/h_r with F_max = 6 pi a2^2 tau_w, a2 = 1.4 a1); bad ones
+    are refused by value."""
+    import argparse
+    time_step = load_case_module("poiseuille", "timeStep")
+    assert time_step.parse_variant("0.05:8") == (0.05, 8, 1.0)
+    assert time_step.parse_variant("0.1:4:10") == (0.1, 4, 10.0)
+    assert time_step.variant_name(0.1, 4, 10.0) == "dt0.1_K4_k10" and time_step.variant_name(0.05, 8) == "dt0.05_K8"
+    assert time_step.spring_options(1.0, [8.0, 12.0, 8.0]) == []
+    kn = 2 * 6 * np.pi * 1.4 ** 2 * 1.0 / 0.005
+    options = time_step.spring_options(10.0, [8.0, 12.0, 8.0])
+    assert options[0] == "--kn" and options[2] == "--kt"
+    assert float(options[1]) == pytest.approx(10 * kn, rel=1e-12) and float(options[3]) == float(options[1])
+    for bad in ("0.05", "0.05:0", "-0.1:4", "0.1:4:0", "0.1:4:10:2", "a:b"):
+        with pytest.raises(argparse.ArgumentTypeError, match=bad.replace(".", r"\.")):
+            time_step.parse_variant(bad)
+
+
+def test_time_step_warning_cites_the_measured_steps_and_the_stability_map():
+    """No warning at the measured steps and springs (the defaults, the fluid every 8th step of the ladder); the
+    accuracy limits (particle step 0.05, fluid step 0.4) cite "The channel's time step", a particle step beyond
+    the stability map's 0.4 or springs outside its 0.1-10 times the recipe's cite "The channel's stability map";
+    the limits carry over to other sizes by suspension.time_step_factor."""
+    from fdmsubgrid import packing
+    assert poiseuille.time_step_warning(0.05, 4) is None and poiseuille.time_step_warning(0.05, 8) is None
+    assert poiseuille.time_step_warning(0.05, 8, spring_factors=(0.1, 10.0)) is None
+    accuracy = poiseuille.time_step_warning(0.1, 4)
+    assert "the particle step 0.1 above 0.05" in accuracy and "stability map" not in accuracy
+    assert "The channel's time step" in accuracy
+    assert "the fluid's step 0.8" in poiseuille.time_step_warning(0.05, 16)
+    beyond = poiseuille.time_step_warning(0.5, 1)
+    assert "beyond the stability map's 0.4" in beyond and "The channel's stability map" in beyond
+    assert poiseuille.time_step_warning(0.4, 1).count("stability map") == 0
+    springs = poiseuille.time_step_warning(0.05, 4, spring_factors=(20.0, 1.0))
+    assert "the springs 20 times the recipe's, outside the stability map's 0.1 to 10" in springs
+    assert "0.05 the springs" not in springs and "above 0.05" not in springs
+    # the paper's radii: the limits as measured; a wider distribution scales both particle limits
+    assert poiseuille.time_step_warning(0.05, 4, packing.PAPER_SUSPENSION) is None

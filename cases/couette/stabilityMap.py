@@ -23,36 +23,10 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
-from fdmsubgrid import couettescene, files, output, results
+from fdmsubgrid import case, couettescene, files, output, results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
-
-
-def last_error(run_dir: str) -> Optional[str]:
-    """The first line of the last error either code wrote, or None."""
-    for name in ("log.dem", "log.fluid"):
-        path = os.path.join(run_dir, name)
-        if not os.path.exists(path):
-            continue
-        lines = open(path, errors="replace").read().splitlines()
-        for k in range(len(lines) - 1, -1, -1):
-            if lines[k].startswith("ERROR") or "FOAM FATAL" in lines[k]:
-                text = lines[k] if lines[k].startswith("ERROR") else " ".join(lines[k + 1:k + 3]).strip()
-                return text[:400]
-    return None
-
-
-def records_finite(run_dir: str) -> Optional[bool]:
-    """Whether every value of the particle records is finite (None without records)."""
-    path = os.path.join(run_dir, "dem", "particles.records")
-    if not os.path.exists(path):
-        return None
-    try:
-        snapshots, _ = output.record_snapshots(path, 1.0)
-    except Exception:   # a record cut by the stop is dropped by the reader; anything else is reported
-        return None
-    return bool(all(np.all(np.isfinite(s.positions)) and np.all(np.isfinite(s.velocities)) for s in snapshots))
 
 
 def run_one(phi: float, dt: float, stiffness: float, args: argparse.Namespace) -> Dict:
@@ -75,8 +49,8 @@ def run_one(phi: float, dt: float, stiffness: float, args: argparse.Namespace) -
     run_dirs = sorted(glob.glob(os.path.join(workdir, "phi*")))
     run_dir = run_dirs[0] if run_dirs else None
     row["finished"] = proc.returncode == 0
-    row["error"] = None if proc.returncode == 0 else (last_error(run_dir) if run_dir else proc.stdout[-400:])
-    row["records_finite"] = records_finite(run_dir) if run_dir else None
+    row["error"] = None if proc.returncode == 0 else (case.last_error(run_dir) if run_dir else proc.stdout[-400:])
+    row["records_finite"] = case.records_finite(run_dir) if run_dir else None
     if run_dir and os.path.exists(os.path.join(run_dir, "fluid", "postProcessing", "fdm", "steps.dat")):
         steps = output.steps(os.path.join(run_dir, "fluid"))
         row["steps_done"] = int(len(steps["step"]))

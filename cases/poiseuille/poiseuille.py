@@ -187,7 +187,9 @@ def main(argv: list[str] | None = None) -> dict:
     tau_w = abs(grad) * width / 2
     springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt, sizes, model=args.model)
     print(springs.describe(dt))
-    warning = poiseuille.time_step_warning(args.dt, args.fluid_every, sizes)
+    recipe = suspension.choose_springs(tau_w, dt, delta, None, None, sizes, model=args.model)
+    warning = poiseuille.time_step_warning(args.dt, args.fluid_every, sizes,
+                                           (springs.kn / recipe.kn, springs.kt / recipe.kt))
     if warning:
         print(warning, file=sys.stderr)
 

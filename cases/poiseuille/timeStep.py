@@ -15,6 +15,12 @@ layer is h_r = 0.005 a1 deep; fdmDEM stops a run at an overlap of 0.05 a1).
   timeStep.py                              variants 0.025:1 (reference) 0.05:1 0.1:1 0.05:2 0.05:4 0.025:4
                                            0.2:1, 4 time units each
   timeStep.py --start RUN/dem/particles.records --variants 0.025:1 0.05:4
+  timeStep.py --start RUN/dem/particles.records --variants 0.05:8 0.1:4 0.2:2 0.05:8:10 0.1:4:10
+                                           the stability map (docs/benchmarks.md, "The channel's stability
+                                           map"): DT:K:S, the recipe's springs k_n = k_t times S
+
+A variant that stops (fdmDEM's overlap of 0.05 a1, or any other fault) is reported with its error and the
+smallest gap it reached; the runs it finished are compared.
 
 Writes <workdir>/<variant>.json per variant (a variant whose file exists is not run again) and --out
 (default docs/data/benchmarks_channelTimeStep.json) with a figure beside it.
@@ -28,7 +34,7 @@ from typing import Dict, List, Tuple
 
 import numpy as np
 
-from fdmsubgrid import contacts, output, poiseuille as channel
+from fdmsubgrid import case, contacts, output, poiseuille as channel, suspension
 import poiseuille
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -36,21 +42,40 @@ PROJECT = os.path.dirname(os.path.dirname(HERE))
 DEFAULT_VARIANTS = ["0.025:1", "0.05:1", "0.1:1", "0.05:2", "0.05:4", "0.025:4", "0.2:1"]
 
 
-def parse_variant(text: str) -> Tuple[float, int]:
-    """'DT:K' -> (DT, K)."""
+def parse_variant(text: str) -> Tuple[float, int, float]:
+    """'DT:K' or 'DT:K:S' -> (DT, K, S): the particle step, the fluid every K-th step, the recipe's springs
+    times S (default 1)."""
     try:
-        dt_text, k_text = text.split(":")
-        dt, k = float(dt_text), int(k_text)
+        parts = text.split(":")
+        if len(parts) not in (2, 3):
+            raise ValueError
+        dt, k = float(parts[0]), int(parts[1])
+        stiffness = float(parts[2]) if len(parts) == 3 else 1.0
     except ValueError:
-        raise argparse.ArgumentTypeError("a variant is DT:K (particle step, fluid every K-th step), got %r" % text)
-    if dt <= 0 or k < 1:
-        raise argparse.ArgumentTypeError("variant %r: DT must be positive and K at least 1" % text)
-    return dt, k
+        raise argparse.ArgumentTypeError("a variant is DT:K or DT:K:S (particle step, fluid every K-th step, "
+                                         "springs times S), got %r" % text)
+    if dt <= 0 or k < 1 or not stiffness > 0:
+        raise argparse.ArgumentTypeError("variant %r: DT and S must be positive and K at least 1" % text)
+    return dt, k, stiffness
 
 
-def run_variant(dt: float, k: int, start: str, args, workdir: str) -> Dict:
-    """One variant from the start records: its flow-rate curve, smallest gaps and cost."""
-    name = "dt%g_K%d" % (dt, k)
+def variant_name(dt: float, k: int, stiffness: float = 1.0) -> str:
+    return "dt%g_K%d%s" % (dt, k, "" if stiffness == 1 else "_k%g" % stiffness)
+
+
+def spring_options(stiffness: float, size: List[float]) -> List[str]:
+    """poiseuille.py's --kn and --kt: the recipe's springs of the channel (docs/contact.md, for its wall shear
+    stress tau_w and the paper's radii, which the records' spheres are) times `stiffness`; none at 1."""
+    if stiffness == 1:
+        return []
+    grad, _ = poiseuille.pressure_gradient(size[1])
+    rule = suspension.choose_springs(abs(grad) * size[1] / 2, 1.0, suspension.A1 / 3.0)
+    return ["--kn", repr(rule.kn * stiffness), "--kt", repr(rule.kt * stiffness)]
+
+
+def run_variant(dt: float, k: int, start: str, args, workdir: str, stiffness: float = 1.0) -> Dict:
+    """One variant from the start records: its flow-rate curve, smallest gaps and cost; how it ended."""
+    name = variant_name(dt, k, stiffness)
     path = os.path.join(workdir, name + ".json")
     if os.path.isfile(path):
         with open(path) as f:
@@ -62,14 +87,18 @@ def run_variant(dt: float, k: int, start: str, args, workdir: str) -> Dict:
         results = poiseuille.main(["--from-records", start, "--dt", str(dt), "--fluid-every", str(k),
                                    "--duration", str(args.duration), "--dump-every", str(dt * k),
                                    "--workdir", folder, "--out", os.path.join(folder, "results.json"),
-                                   "--overwrite", "--keep"] + (["--size", *map(str, args.size)]))
+                                   "--overwrite", "--keep"] + (["--size", *map(str, args.size)])
+                                  + spring_options(stiffness, args.size))
         run_dir = results["run_dir"]
     except SystemExit as e:
         error = str(e)
         runs = [os.path.join(folder, d) for d in os.listdir(folder)] if os.path.isdir(folder) else []
         run_dir = next((r for r in runs if os.path.isdir(r)), None)
     wall = time.time() - begin
-    out = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, wall_seconds=wall, error=error)
+    if error is not None and run_dir:
+        # the code's own message (the overlap that stopped fdmDEM names its particles)
+        error = case.last_error(run_dir) or error
+    out = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, stiffness_factor=stiffness, wall_seconds=wall, error=error)
     if run_dir and os.path.isdir(os.path.join(run_dir, "fluid", "postProcessing")):
         t, q = channel.flow_rate(run_dir)
         steps = output.steps(os.path.join(run_dir, "fluid"))
@@ -77,10 +106,15 @@ def run_variant(dt: float, k: int, start: str, args, workdir: str) -> Dict:
         out.update(time=t.tolist(), flow_rate=q.tolist(), fluid_steps=len(t),
                    solves_per_fluid_step=float(np.mean(steps["innerIterations"])),
                    fluid_seconds=float(np.sum(steps["fluidSeconds"])),
-                   smallest_gap=float(gaps.min()) if len(gaps) else None, run=os.path.basename(run_dir))
+                   smallest_gap=float(gaps.min()) if len(gaps) else None, run=os.path.basename(run_dir),
+                   time_reached=float(t[-1]) if len(t) else 0.0)
     with open(path, "w") as f:
         json.dump(out, f, indent=1)
     return out
+
+
+def _springs_label(r: Dict) -> str:
+    return "" if r.get("stiffness_factor", 1.0) == 1 else ", springs x%g" % r["stiffness_factor"]
 
 
 def compare(reference: Dict, variant: Dict, window: Tuple[float, float]) -> Dict:
@@ -106,7 +140,8 @@ def plot(path: str, runs: List[Dict], window) -> None:
     for r in runs:
         if r.get("time"):
             a.plot(r["time"], r["flow_rate"], color=colours[id(r)], lw=1.6 if r is runs[0] else 1.0,
-                   label="dt %g, K %d%s%s" % (r["dt"], r["fluid_every"], " (reference)" if r is runs[0] else "",
+                   label="dt %g, K %d%s%s%s" % (r["dt"], r["fluid_every"], _springs_label(r),
+                                                " (reference)" if r is runs[0] else "",
                                               " (failed)" if r.get("error") else ""))
     a.axvspan(*window, color="0.9", zorder=0)
     a.set_xlabel("t 2U_c/L_y from the dense state")
@@ -116,7 +151,7 @@ def plot(path: str, runs: List[Dict], window) -> None:
         if r.get("rms_difference") is not None:
             b.errorbar(r["wall_seconds"], 100 * r["mean_difference"], yerr=100 * r["rms_difference"], fmt="o",
                        capsize=3, color=colours[id(r)])
-            b.annotate("%g:%d" % (r["dt"], r["fluid_every"]), (r["wall_seconds"], 100 * r["mean_difference"]),
+            b.annotate("%g:%d%s" % (r["dt"], r["fluid_every"], _springs_label(r)), (r["wall_seconds"], 100 * r["mean_difference"]),
                        fontsize=8, xytext=(4, 4), textcoords="offset points")
     b.axhline(0, color="0.5", lw=0.8)
     b.set_xlabel("wall seconds")
@@ -148,22 +183,23 @@ def main(argv=None) -> Dict:
             poiseuille.main(["--workdir", start_dir, "--out", done, "--overwrite", "--size", *map(str, args.size)])
         run = [d for d in os.listdir(start_dir) if os.path.isdir(os.path.join(start_dir, d))][0]
         start = os.path.join(start_dir, run, "dem", "particles.records")
-    coarsest = max(dt * k for dt, k in args.variants)
+    coarsest = max(dt * k for dt, k, _ in args.variants)
     window = tuple(args.window) if args.window else (coarsest, args.duration)
     runs = []
-    for dt, k in args.variants:
-        r = run_variant(dt, k, start, args, args.workdir)
-        print("dt %g K %d: %s, %.0f s, smallest gap %s" % (dt, k, "failed: " + r["error"] if r.get("error") else "ran",
-                                                            r["wall_seconds"], r.get("smallest_gap")), flush=True)
+    for dt, k, stiffness in args.variants:
+        r = run_variant(dt, k, start, args, args.workdir, stiffness)
+        print("dt %g K %d springs x%g: %s, %.0f s, smallest gap %s" % (
+            dt, k, stiffness, "failed: " + r["error"] if r.get("error") else "ran", r["wall_seconds"],
+            r.get("smallest_gap")), flush=True)
         runs.append(r)
     for r in runs[1:]:
         r.update(compare(runs[0], r, window))
-    print("%-6s %-3s %-8s %-8s %-12s %-10s %-10s %s" % ("dt", "K", "wall s", "fluid s", "solves/step", "mean diff",
-                                                        "rms diff", "smallest gap"))
+    print("%-6s %-3s %-7s %-8s %-8s %-12s %-10s %-10s %s" % ("dt", "K", "springs", "wall s", "fluid s", "solves/step",
+                                                             "mean diff", "rms diff", "smallest gap"))
     for r in runs:
         md, rd = r.get("mean_difference"), r.get("rms_difference")
-        print("%-6g %-3d %-8.0f %-8.0f %-12.1f %-10s %-10s %s" % (
-            r["dt"], r["fluid_every"], r["wall_seconds"], r.get("fluid_seconds", float("nan")),
+        print("%-6g %-3d %-7s %-8.0f %-8.0f %-12.1f %-10s %-10s %s" % (
+            r["dt"], r["fluid_every"], "x%g" % r.get("stiffness_factor", 1.0), r["wall_seconds"], r.get("fluid_seconds", float("nan")),
             r.get("solves_per_fluid_step", float("nan")), "ref" if r is runs[0] else ("%+.2f %%" % (100 * md) if md is not None else "-"),
             "%.2f %%" % (100 * rd) if rd is not None else "-", r.get("smallest_gap")))
     given = list(argv if argv is not None else sys.argv[1:])

@@ -135,19 +135,37 @@ def packing_from_records(path: str, size) -> packing.Packing:
 MEASURED_PARTICLE_DT = 0.05
 MEASURED_FLUID_DT = 0.4
 DEFAULT_DT, DEFAULT_FLUID_EVERY = 0.05, 4
+# The channel's stability map (docs/benchmarks.md, "The channel's stability map"): from the steady dense core
+# (phi_center 0.58), every particle step up to 0.4 with the recipe's springs times 0.1 to 10 held its contacts
+# (the deepest overlap 3e-3 a1, at 0.4 and the springs times 0.1; fdmDEM stops at 0.05): beyond these the
+# contacts' stability is not known
+MAPPED_PARTICLE_DT = 0.4
+MAPPED_SPRING_FACTORS = (0.1, 10.0)
 
 
-def time_step_warning(dt: float, fluid_every: int, sizes: packing.SizeDistribution | None = None) -> str | None:
+def time_step_warning(dt: float, fluid_every: int, sizes: packing.SizeDistribution | None = None,
+                      spring_factors: tuple[float, ...] = (1.0,)) -> str | None:
     """A warning when the particle step dt or the fluid's step fluid_every*dt (in L_y/(2 U_c)) is beyond
-    what was measured good in the channel (with the paper's radii 1 and 1.4; for other sizes the particle step
-    carried over by suspension.time_step_factor), else None."""
+    what was measured good in the channel (with the paper's radii 1 and 1.4; for other sizes the particle steps
+    carried over by suspension.time_step_factor), or the step or the springs (spring_factors: k_n and k_t over
+    the recipe's) beyond the channel's stability map; else None."""
     beyond = []
     particle_dt = MEASURED_PARTICLE_DT if sizes is None else suspension.scaled_time_step(MEASURED_PARTICLE_DT, sizes)
+    mapped_dt = MAPPED_PARTICLE_DT if sizes is None else suspension.scaled_time_step(MAPPED_PARTICLE_DT, sizes)
     if dt > particle_dt * (1 + 1e-9):
         beyond.append("the particle step %g above %g (%sat 0.1 the bulk velocity of the dense core went 4 %% rms "
                       "off, at 0.2 8 %%)" % (dt, particle_dt, "" if particle_dt == MEASURED_PARTICLE_DT else
                                             "the measured %g times %.3g for these sizes, suspension.time_step_factor; "
                                             % (MEASURED_PARTICLE_DT, suspension.time_step_factor(sizes))))
+    if dt > mapped_dt * (1 + 1e-9):
+        beyond.append("the particle step %g beyond the stability map's %g (the contacts' stability not known: "
+                      "docs/benchmarks.md, \"The channel's stability map\")" % (dt, mapped_dt))
+    outside = [f for f in spring_factors
+               if not MAPPED_SPRING_FACTORS[0] * (1 - 1e-9) <= f <= MAPPED_SPRING_FACTORS[1] * (1 + 1e-9)]
+    if outside:
+        beyond.append("the springs %s times the recipe's, outside the stability map's %g to %g (docs/benchmarks.md, "
+                      "\"The channel's stability map\")" % (" and ".join("%.3g" % f for f in outside),
+                                                              *MAPPED_SPRING_FACTORS))
     if dt * fluid_every > MEASURED_FLUID_DT * (1 + 1e-9):
         beyond.append("the fluid's step %g (dt %g x fluid_every %d) above %g, not measured"
                       % (dt * fluid_every, dt, fluid_every, MEASURED_FLUID_DT))

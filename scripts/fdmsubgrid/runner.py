@@ -86,3 +86,34 @@ def delete_fields(run_dir):
     for d in os.listdir(fluid):
         if d != "0" and d.replace(".", "").replace("e-", "").isdigit():
             shutil.rmtree(os.path.join(fluid, d), ignore_errors=True)
+
+
+def last_error(run_dir: str) -> str | None:
+    """The first line of the last error either code wrote in its log (log.dem's `ERROR ...`, log.fluid's
+    `FOAM FATAL` with the two lines after it), at most 400 characters; None if neither wrote one."""
+    for name in ("log.dem", "log.fluid"):
+        path = os.path.join(run_dir, name)
+        if not os.path.exists(path):
+            continue
+        with open(path, errors="replace") as f:
+            lines = f.read().splitlines()
+        for k in range(len(lines) - 1, -1, -1):
+            if lines[k].startswith("ERROR") or "FOAM FATAL" in lines[k]:
+                text = lines[k] if lines[k].startswith("ERROR") else " ".join(lines[k + 1:k + 3]).strip()
+                return text[:400]
+    return None
+
+
+def records_finite(run_dir: str) -> bool | None:
+    """Whether every position and velocity of the run's particle records (dem/particles.records) is finite;
+    None without records or with records the reader cannot take (a block cut by a stop is dropped by it)."""
+    import numpy as np
+    from . import output
+    path = os.path.join(run_dir, "dem", "particles.records")
+    if not os.path.exists(path):
+        return None
+    try:
+        snapshots, _ = output.record_snapshots(path, 1.0)
+    except Exception:   # anything but a cut block: reported as unknown, the error itself is the run's
+        return None
+    return bool(all(np.all(np.isfinite(s.positions)) and np.all(np.isfinite(s.velocities)) for s in snapshots))

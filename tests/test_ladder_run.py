@@ -1,0 +1,70 @@
+"""cases/poiseuille/ladderRun, the ladder of channel sizes run in segments (and cases/poiseuille/paperRun, its
+paper rung): each rung's scene writes the run folder the script continues and saves from, paperRun is the
+ladder's paper rung with its own command line, and bad input is refused by name. Only scenes are written
+(poiseuille.py --write-only, a few seconds): nothing is run."""
+import os
+import subprocess
+
+import pytest
+
+from conftest import PROJECT, load_case_module
+
+CASE = os.path.join(PROJECT, "cases", "poiseuille")
+LADDER = os.path.join(CASE, "ladderRun")
+PAPER = os.path.join(CASE, "paperRun")
+
+
+def run(cmd, env):
+    return subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def scene(script, rung, workdir, env):
+    """The rung's poiseuille.py options and its run folder, as the script prints them."""
+    out = run([script] + ([rung] if rung else []) + ["--scene", "--workdir", str(workdir)], env)
+    assert out.returncode == 0, out.stderr
+    options, folder = out.stdout.splitlines()
+    return options.split(), folder
+
+
+@pytest.mark.parametrize("rung, size, spheres", [("L12", [12.0, 12.0, 8.0], 85), ("L20", [20.0, 20.0, 10.0], 293)])
+def test_each_rung_continues_the_run_folder_its_scene_writes(rung, size, spheres, tmp_path, env):
+    """The folder ladderRun resumes, saves and analyses is the one poiseuille.py writes from the rung's options:
+    the channel of the rung at phi_bulk 0.45 (seed 1: the same spheres every time), the particles at dt 0.05,
+    the fluid every 8th step."""
+    options, folder = scene(LADDER, rung, tmp_path, env)
+    assert os.path.dirname(folder) == str(tmp_path)
+    written = load_case_module("poiseuille").main(options + ["--write-only", "--workdir", str(tmp_path),
+                                                             "--out", str(tmp_path / "r.json")])
+    assert written["run_dir"] == folder and os.path.isdir(os.path.join(folder, "fluid"))
+    with open(os.path.join(folder, "dem", "in.poiseuille")) as f:
+        data = f.read()
+    assert "fluid_every 8" in data
+    assert options[options.index("--size") + 1:options.index("--size") + 4] == ["%g" % v for v in size]
+    assert os.path.basename(folder).startswith("phi0.45_%gx%gx%g_ad3_dt0.05_seed1" % tuple(size))
+    with open(os.path.join(folder, "dem", "packing.data")) as f:
+        assert "\n%d atoms\n" % spheres in f.read()
+
+
+def test_paper_run_is_the_ladders_paper_rung(tmp_path, env):
+    """paperRun keeps its command line: the same scene and run folder as `ladderRun paper`, the options of
+    the committed paper snapshot's scene command, its own help and its own name in a refusal."""
+    paper = scene(PAPER, None, tmp_path, env)
+    assert paper == scene(LADDER, "paper", tmp_path, env)
+    assert paper[1] == str(tmp_path / "phi0.45_40x40x20_ad3_dt0.05_seed1_calibrated_fluidEvery8")
+    with open(os.path.join(CASE, "paper", "snapshot", "scene")) as f:
+        committed = f.read().split()
+    assert committed[2:2 + len(paper[0])] == paper[0]
+    helped = run([PAPER, "--help"], env)
+    assert helped.returncode == 0 and helped.stdout.startswith("The paper's channel")
+    refused = run([PAPER, "--bogus"], env)
+    assert refused.returncode == 2 and "paperRun: unknown option --bogus" in refused.stderr
+
+
+def test_bad_rung_and_options_are_refused(tmp_path, env):
+    refused = run([LADDER, "L7"], env)
+    assert refused.returncode == 2 and "not 'L7'" in refused.stderr and "L12, L20 or paper" in refused.stderr
+    refused = run([LADDER, "L20", "--save", "--workdir", str(tmp_path)], env)
+    assert refused.returncode == 2 and "no run in %s" % tmp_path in refused.stderr
+    refused = run([LADDER, "L20", "--until", "100", "--workdir", str(tmp_path)], env)
+    assert refused.returncode == 2 and "--until continues a run folder's own checkpoint" in refused.stderr
+    assert not os.listdir(tmp_path)
