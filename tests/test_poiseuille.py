@@ -287,6 +287,19 @@ def test_time_step_variants_take_a_spring_factor():
             time_step.parse_variant(bad)
 
 
+def test_a_time_step_variant_too_short_for_the_analysis_still_compares(small_run, tmp_path):
+    """A coarse variant over a short --duration runs to its end with too few records for the channel's time
+    averages: timeStep.py keeps its flow-rate curve, compares it with the reference's and says why the
+    analysis was left out, instead of stopping with the analysis's error."""
+    time_step = load_case_module("poiseuille", "timeStep")
+    start = os.path.join(small_run["run_dir"], "dem", "particles.records")
+    out = time_step.main(["--start", start, "--variants", "0.4:1", "0.8:1", "--duration", "4",
+                          "--workdir", str(tmp_path), "--out", str(tmp_path / "timeStep.json")])
+    coarse = out["variants"][1]
+    assert coarse["error"] is None and "too few for time averages" in coarse["analysis"]
+    assert coarse["fluid_steps"] == 5 and np.isfinite(coarse["rms_difference"])
+
+
 def test_time_step_warning_cites_the_measured_steps_and_the_stability_map():
     """No warning at the measured steps and springs (the defaults, the fluid every 8th step of the ladder); the
     accuracy limits (particle step 0.05, fluid step 0.4) cite "The channel's time step", a particle step beyond
