@@ -121,6 +121,25 @@ def test_wall_loads_every_step_and_the_same_on_two_ranks(tiny_run, tiny_run_two_
         assert np.max(np.abs(a - b)) < 5e-3 * scale, (name, np.max(np.abs(a - b)))
 
 
+def test_a_couette_run_continues_from_a_compact_snapshot(couette, tiny_run, tmp_path):
+    """A long Couette row outlives its machine as a channel run does: the tiny run's compact snapshot (its
+    last checkpoint, step 20; the case script recorded the scene's command) continued to strain 0.6 by
+    `--from-snapshot` in a new folder starts at step 21, and the rheology of a run whose records begin at
+    strain 0.4 is analysed."""
+    from fdmsubgrid import checkpoint
+    dest = str(tmp_path / "snapshot")
+    assert checkpoint.snapshot(tiny_run["run_dir"], dest)["step"] == 20
+    scene = open(os.path.join(dest, "scene")).read()
+    assert scene.startswith("python3 cases/couette/couette.py --phi 0.25 ") and "--workdir" not in scene, scene
+    args = TINY[:TINY.index("--strain")] + ["--strain", "0.6"] + TINY[TINY.index("--strain") + 2:]
+    r = couette.main(args + OUTPUTS + ["--from-snapshot", dest, "--workdir", str(tmp_path / "work"),
+                                       "--out", str(tmp_path / "r.json")])
+    steps = output.steps(os.path.join(r["run_dir"], "fluid"))["step"].astype(int)
+    assert list(steps) == list(range(21, 31))
+    assert "==== fdmRun --from-snapshot %s: step 20 to 30" % dest in open(os.path.join(r["run_dir"], "log.fluid")).read()
+    assert np.isfinite(r["eta_s"]) and r["eta_s"] > 1
+
+
 def test_phi_too_high_is_refused_by_name(couette, tmp_path):
     with pytest.raises(packing.PackingError) as e:
         couette.main(["--phi", "0.62", "--size", "10", "10", "10", "--workdir", str(tmp_path)])

@@ -25,16 +25,20 @@ fdmsubgrid.couettescene's, on fdmsubgrid.suspension.write_case, shared with case
   couette.py --phi 0.47 --write-only the scene written, not run (fdmRun, or timeStepWithoutFluid.py --run)
   couette.py --radii 1 1.2 1.4 --volume-fractions 0.5 0.3 0.2
                                      three species (any radii the mesh and the calibration cover)
+  couette.py ... --from-snapshot DIR the scene of these options written afresh and the compact snapshot DIR
+                                     continued in it (its file `scene` holds the options; docs/coupling.md):
+                                     a long row continued on another machine
   couette.py --help                  every option
 Writes <workdir>/<run>/ (fluid/, dem/), results.json and results_couette.png here (docs/cases.md).
 """
 
 import argparse
 import os
+import sys
 import time
 from dataclasses import asdict
 
-from fdmsubgrid import case, shear, suspension
+from fdmsubgrid import case, checkpoint, shear, suspension
 from fdmsubgrid.results import Row, write_results
 from fdmsubgrid.couettescene import (A1, A2, ETA, FRICTION, MEASURED_DT_LIMITS, MEASURED_FLUID_DT,  # noqa: F401
                                      ROUGHNESS, SHEAR_RATE, TABLE8, UncalibratedScene, choose_springs, fluid_dt,
@@ -93,6 +97,10 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--write-only", action="store_true", help="write the scene's folder and stop (as --table8 does): "
                    "run it later with fdmRun, or its particle side alone with timeStepWithoutFluid.py --run")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
+    p.add_argument("--from-snapshot", metavar="SNAPSHOT", default=None,
+                   help="continue the compact snapshot in this folder (python3 -m fdmsubgrid.checkpoint snapshot RUN "
+                        "DEST) in the scene of these options, written afresh: the particles from its step, the fluid "
+                        "from rest (fdmRun --from-snapshot; docs/coupling.md \"Compact snapshot\")")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None,
                    help="analyse this run folder as it stands (a resumed, stopped or running run) and write --out")
     case.add_size_options(p)
@@ -146,12 +154,15 @@ def main(argv: list[str] | None = None) -> dict:
     except (UncalibratedScene, FileExistsError) as e:
         raise SystemExit(str(e))
     run_dir, name, springs, scene = written["run_dir"], written["name"], written["springs"], written["scene"]
+    # the command that writes this scene again, for a compact snapshot of its run
+    checkpoint.write_scene_command(run_dir, __file__, sys.argv[1:] if argv is None else list(argv))
+    from_snapshot = ("--from-snapshot", args.from_snapshot) if args.from_snapshot else ()
     if (args.table8 is not None and not args.run) or args.write_only:
         print("%s scene written, not run: fdmRun -f N -d M %s" % ("Table 8" if args.table8 is not None else "the",
-                                                                  run_dir))
+                                                                  " ".join(from_snapshot + (run_dir,))))
         return dict(run_dir=run_dir, **scene)
 
-    wall = case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem)
+    wall = case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem, extra=from_snapshot)
     results = shear.report(shear.read_run(run_dir), args.out,
                            dict(case="couette", run=name, run_dir=run_dir, acceleration=args.acceleration,
                                 tol_lambda=args.tol_lambda, n_max=args.n_max, a_over_delta=args.a_over_delta,
