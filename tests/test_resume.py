@@ -849,3 +849,25 @@ def test_snapshot_of_another_scene_is_refused(snapshot_dir, tmp_path, env):
     assert fdm_run(root, env, "--from-snapshot", dest).returncode == 0
     r = fdm_run(root, env, "--from-snapshot", dest)
     assert r.returncode != 0 and "--from-snapshot: %s holds a run" % root in r.stdout, r.stdout
+
+
+def test_a_snapshot_of_a_run_resumed_with_its_table_continues_in_a_fresh_scene(tmp_path, monkeypatch):
+    """fdmRun --resume names the table a run started with in its input (`pair_style fdm/subgrid calibration
+    FILE ...`); a snapshot of that run still continues in a scene written afresh, whose input has no such
+    keyword (the table is checked by its hash), while any other changed line is refused."""
+    monkeypatch.setenv("FDM_ROOT", PROJECT)
+    snap = tmp_path / "snapshot"
+    shutil.copytree(PAPER_SNAPSHOT, snap)
+    text = open(snap / "in.poiseuille").read()
+    assert "fdm/subgrid calibration" not in text
+    (snap / "in.poiseuille").write_text(text.replace("fdm/subgrid ", "fdm/subgrid calibration %s "
+                                                     % os.path.basename(PREVIOUS_TABLE), 1))
+    case_dir = tmp_path / "case"
+    (case_dir / "dem").mkdir(parents=True)
+    dem_input = str(case_dir / "dem" / "in.poiseuille")
+    (case_dir / "dem" / "in.poiseuille").write_text(text)
+    step, last = checkpoint.snapshot_check(str(snap), str(case_dir), dem_input)
+    assert step == checkpoint.check_snapshot(str(snap))["step"] and last > step
+    (case_dir / "dem" / "in.poiseuille").write_text(text.replace("model calibrated", "model cutoff", 1))
+    with pytest.raises(checkpoint.CheckpointError, match="is not the input of the snapshot's run"):
+        checkpoint.snapshot_check(str(snap), str(case_dir), dem_input)

@@ -669,9 +669,16 @@ def check_snapshot(dest: str) -> dict:
                 scene=os.path.join(dest, SCENE_FILE), calibration=calibration)
 
 
+# the table a pair style names (`calibration FILE`): fdmRun --resume adds it when a run goes on with the table it
+# started with; which table a snapshot's run read is checked by its hash (snapshot_table), not by its name
+_CALIBRATION_KEYWORD = re.compile(r"^([ \t]*pair_style[ \t]+fdm/subgrid)[ \t]+calibration[ \t]+\S+")
+
+
 def _without_run(text: str) -> list[str]:
-    """The input's lines, its run command masked (the run's length is the case's)."""
-    return ["run ..." if _RUN_COMMAND.fullmatch(line) else line for line in text.splitlines()]
+    """The input's lines, its run command masked (the run's length is the case's) and the pair style's
+    calibration keyword left out (the table is compared by its hash)."""
+    return ["run ..." if _RUN_COMMAND.fullmatch(line) else _CALIBRATION_KEYWORD.sub(r"\1", line)
+            for line in text.splitlines()]
 
 
 def _last_step(dem_input: str) -> int:
