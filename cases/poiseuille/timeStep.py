@@ -91,10 +91,11 @@ def run_variant(dt: float, k: int, start: str, args, workdir: str, stiffness: fl
                                    "--overwrite", "--keep"] + (["--size", *map(str, args.size)])
                                   + spring_options(stiffness, args.size))
         run_dir = results["run_dir"]
-    except (SystemExit, ValueError) as e:
-        # SystemExit: the run stopped; ValueError: it ran, but too few records for the channel's
-        # time averages (a coarse step over a short --duration): its flow-rate curve still compares
-        if isinstance(e, ValueError):
+    except (SystemExit, channel.PoiseuilleRunError) as e:
+        # SystemExit: the run stopped; PoiseuilleRunError: it ran, but the channel's analysis cannot take
+        # it (too few records for time averages: a coarse step over a short --duration); its flow-rate
+        # curve still compares
+        if isinstance(e, channel.PoiseuilleRunError):
             analysis_note = str(e)
         else:
             error = str(e)

@@ -602,7 +602,7 @@ def snapshot(case_dir: str, dest: str, scene: str | None = None, dem_input: str 
         from .environment import project_dir
         root = os.path.normpath(project_dir() or os.sep)
         table = os.path.normpath(identity["table"])
-        shipped = os.path.join("dem", "resistance", "data") + os.sep
+        shipped = TABLE_FOLDER + os.sep
         if project_dir() and table.startswith(root + os.sep):
             identity["table"] = os.path.relpath(table, root)
         elif shipped in table:      # the shipped table of another checkout of the project
@@ -671,13 +671,15 @@ def check_snapshot(dest: str) -> dict:
 
 # the table a pair style names (`calibration FILE`): fdmRun --resume adds it when a run goes on with the table it
 # started with; which table a snapshot's run read is checked by its hash (snapshot_table), not by its name
-_CALIBRATION_KEYWORD = re.compile(r"^([ \t]*pair_style[ \t]+fdm/subgrid)[ \t]+calibration[ \t]+\S+")
+_CALIBRATION_KEYWORD = re.compile(r"[ \t]+calibration[ \t]+\S+")
+_SUBGRID_PAIR_STYLE = re.compile(r"^[ \t]*pair_style[ \t]+fdm/subgrid\b")
 
 
 def _without_run(text: str) -> list[str]:
     """The input's lines, its run command masked (the run's length is the case's) and the pair style's
     calibration keyword left out (the table is compared by its hash)."""
-    return ["run ..." if _RUN_COMMAND.fullmatch(line) else _CALIBRATION_KEYWORD.sub(r"\1", line)
+    return ["run ..." if _RUN_COMMAND.fullmatch(line)
+            else _CALIBRATION_KEYWORD.sub("", line) if _SUBGRID_PAIR_STYLE.match(line) else line
             for line in text.splitlines()]
 
 

@@ -315,7 +315,7 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
         raise PoiseuilleRunError("%s/fluid/postProcessing/fdm/steps.dat: no step recorded yet" % run_dir)
     snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"), 1.0 / sc.time_unit)
     if len(snapshots) < MIN_SNAPSHOTS:
-        raise ValueError("%s: %d particle snapshots are too few for time averages (%d at least): run longer"
+        raise PoiseuilleRunError("%s: %d particle snapshots are too few for time averages (%d at least): run longer"
                          % (run_dir, len(snapshots), MIN_SNAPSHOTS))
     times = np.array([s.time for s in snapshots])
     mid = channel.y_mid
