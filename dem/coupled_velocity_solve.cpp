@@ -153,6 +153,9 @@ void CoupledVelocitySolve::finishStepUntimed(const std::vector<GatheredParticle>
 {
   results_.subgrid = system_->subgridForces();
   counts_.contactSlides += system_->slidingSwitches();
+  const ParticleVelocitySystem::SlidingCount sliding = system_->slidingAtEnd();
+  counts_.slidingAtEnd += sliding.sliding;
+  counts_.slidingAlongFriction += sliding.alongFriction;
   counts_.chordForceMax = std::max(counts_.chordForceMax, system_->largestChordForce());
   counts_.factorisations += system_->factorisations() - factorisationsCounted_;
   factorisationsCounted_ = system_->factorisations();

@@ -27,6 +27,8 @@ struct CouplingTiming {
   long gapCompromisesBounded = 0;       // steps whose compromise (no fallback) closed a gap below its bound
   double gapCompromiseMissMax = 0;      // and by how much, at most (relative to the gap)
   long contactSlides = 0;               // contacts that began to slide within their step (Coulomb's law at its end)
+  long slidingAtEnd = 0;                // contacts that slide at the end of their step
+  long slidingAlongFriction = 0;        // and of them those that slip along their friction force (contact.md 2c)
   long factorisations = 0;              // of Eq. (31) by the direct solvers: per step, and when the downdates grow too large
   long downdates = 0;                   // contacts that began to slide handled without a factorisation (Woodbury)
   long backSubstitutions = 0;           // of Eq. (31): one per Coulomb round of each solve

@@ -63,7 +63,15 @@ struct ParticleVelocitySystem::Matrices {
   Eigen::MatrixXd downdate;             // V (6N x r)
   Eigen::MatrixXd solvedDowndate;       // A^-1 V
   Eigen::LLT<Eigen::MatrixXd> capacitance;
-  std::vector<Eigen::VectorXd> leaving; // columns of V of the spring blocks that left the matrix in this round
+  // The spring blocks that left the matrix in this round, kept as blocks: their columns of V (6N long
+  // each) are built only if they are downdated, not when the step is factorised again anyway (in a
+  // dense packing a thousand contacts begin to slide in one step: 2000 columns of 6N zeros)
+  struct LeavingBlock {
+    int base[2];
+    int size;
+    double R[144];
+  };
+  std::vector<LeavingBlock> leaving;
 
   // x = (the factorised matrix)^-1 b
   Eigen::VectorXd factorisedSolve(Solver solver, const Eigen::VectorXd &b) const
@@ -504,18 +512,14 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   };
   auto removeBlock = [&](const int *base, int size, const double *R) {
     // R_t leaves the matrix (its entries exist: R_c had them), and gamma R_t U_n the known part;
-    // R_t = sum_k lambda_k v_k v_k^T (rank 2: the tangential plane) gives the columns sqrt(lambda_k) v_k of V
+    // its columns of V follow in downdateOrFactorise
     if (settings_.solver != cg) {
-      const Eigen::MatrixXd block = Eigen::Map<const Eigen::MatrixXd>(R, size, size);
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(block);
-      const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
-      for (int k = 0; k < size; k++) {
-        const double lambda = eigen.eigenvalues()(k);
-        if (!(lambda > 1e-12 * largest)) continue;
-        Eigen::VectorXd column = Eigen::VectorXd::Zero(6 * n_);
-        for (int i = 0; i < size; i++) column(base[i / 6] + i % 6) = std::sqrt(lambda) * eigen.eigenvectors()(i, k);
-        m.leaving.push_back(column);
-      }
+      Matrices::LeavingBlock block;
+      block.base[0] = base[0];
+      block.base[1] = size > 6 ? base[1] : base[0];
+      block.size = size;
+      std::copy(R, R + size * size, block.R);
+      m.leaving.push_back(block);
     }
     for (int i = 0; i < size; i++) {
       const int row = base[i / 6] + i % 6;
@@ -601,14 +605,36 @@ void ParticleVelocitySystem::downdateOrFactorise()
   // about 1e7 per column), and the capacitance grows; CG has no factorisation to downdate.
   const int maxDowndateColumns = 96;
   Matrices &m = *m_;
-  const std::vector<Eigen::VectorXd> &leaving = m.leaving;
-  const long r0 = long(m.downdate.cols()), r = r0 + long(leaving.size());
-  if (settings_.solver == cg || r > maxDowndateColumns) {
+  // R_t = sum_k lambda_k v_k v_k^T (rank 2: the tangential plane) gives the columns sqrt(lambda_k) v_k of V,
+  // at least one per block: more blocks than the room left means a factorisation, without them
+  const std::vector<Matrices::LeavingBlock> &leaving = m.leaving;
+  const long r0 = long(m.downdate.cols());
+  if (settings_.solver == cg || r0 + long(leaving.size()) > maxDowndateColumns) {
     factorise(" after contacts started to slide");
     return;
   }
-  Eigen::MatrixXd added(6 * n_, long(leaving.size()));
-  for (size_t k = 0; k < leaving.size(); k++) added.col(long(k)) = leaving[k];
+  std::vector<Eigen::VectorXd> columns;
+  for (const Matrices::LeavingBlock &leavingBlock : leaving) {
+    const int size = leavingBlock.size;
+    const Eigen::MatrixXd block = Eigen::Map<const Eigen::MatrixXd>(leavingBlock.R, size, size);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(block);
+    const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+    for (int k = 0; k < size; k++) {
+      const double lambda = eigen.eigenvalues()(k);
+      if (!(lambda > 1e-12 * largest)) continue;
+      Eigen::VectorXd column = Eigen::VectorXd::Zero(6 * n_);
+      for (int i = 0; i < size; i++)
+        column(leavingBlock.base[i / 6] + i % 6) = std::sqrt(lambda) * eigen.eigenvectors()(i, k);
+      columns.push_back(column);
+    }
+  }
+  const long r = r0 + long(columns.size());
+  if (r > maxDowndateColumns) {
+    factorise(" after contacts started to slide");
+    return;
+  }
+  Eigen::MatrixXd added(6 * n_, long(columns.size()));
+  for (size_t k = 0; k < columns.size(); k++) added.col(long(k)) = columns[k];
   const Eigen::MatrixXd solvedAdded = m.factorisedSolve(settings_.solver, added);
   m.downdate.conservativeResize(Eigen::NoChange, r);
   m.downdate.rightCols(r - r0) = added;
@@ -719,6 +745,27 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     addStress(p, f, branch, 1.0);
   }
   return out;
+}
+
+ParticleVelocitySystem::SlidingCount ParticleVelocitySystem::slidingAtEnd() const
+{
+  SlidingCount count;
+  forEachSpring([&](size_t record, const double *tail, const int *base, int size, bool wall) {
+    if (!springSlides_[record]) return;
+    count.sliding++;
+    // the sticking force at the solution, F_t - k_t c1 dt rho_t: F_t - it is k_t c1 dt rho_t (the slip)
+    const double ktc1dt = wall ? tail[4] : tail[5];
+    const double *ft = tail + 9, *n = tail, *t = &slideDirection_[3 * record];
+    double w[12], end[3];
+    for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
+    if (wall)
+      contact::wallTangentialForceAtEnd(n, tail[3], ktc1dt, tail[5], ft, tail + 12, w, end);
+    else
+      contact::pairTangentialForceAtEnd(n, tail[3], tail[4], ktc1dt, ft, w, end);
+    const double slipAlong = (ft[0] - end[0]) * t[0] + (ft[1] - end[1]) * t[1] + (ft[2] - end[2]) * t[2];
+    if (slipAlong > slideCap_[record] && slideCap_[record] > 0) count.alongFriction++;
+  });
+  return count;
 }
 
 std::vector<double> ParticleVelocitySystem::wallBlockForces() const

@@ -179,6 +179,13 @@ class ParticleVelocitySystem {
   // Contacts that stuck at the start of the step and slide within it (Coulomb's law at the end of
   // the step, docs/contact.md 2c), counted since the last assemble().
   long slidingSwitches() const { return slidingSwitches_; }
+  // After the last solve: the contacts that slide, and those of them whose slip over the step goes
+  // along their friction force by more than the cap's worth of spring (k_t c1 dt (rho_t . t) > cap:
+  // friction doing work on the slip, which the rounds do not undo: a known limit, docs/contact.md 2c)
+  struct SlidingCount {
+    long sliding = 0, alongFriction = 0;
+  };
+  SlidingCount slidingAtEnd() const;
   // The chord terms of this step (Eq. C5): the largest k_n dt^2 |rho_t|^2/(2r) of a pair spring [N]
   double largestChordForce() const { return largestChordForce_; }
   long springBlocks() const { return long(springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord); }

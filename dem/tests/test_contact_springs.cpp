@@ -436,6 +436,10 @@ TEST(ContactSprings, FrictionResistsAndNeverDrives)
   PulledPair pulled(10.0, false, 4.0);
   EXPECT_EQ(pulled.system.slidingSwitches(), 1);
   EXPECT_NEAR(pulled.u[1], (10.0 - 4.0) / pulled.zeta, 1e-11);
+  // the slide resists its slip: none slips along its friction force
+  EXPECT_EQ(pulled.system.slidingAtEnd().sliding, 1);
+  EXPECT_EQ(pulled.system.slidingAtEnd().alongFriction, 0);
+  EXPECT_EQ(reversed.system.slidingAtEnd().sliding, 0);
 }
 
 namespace {
