@@ -43,8 +43,8 @@ std::string timingLine(const char *what, const CouplingTiming &t, double wall, i
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves, c.solverName,
                 t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations,
                 t.downdates, t.backSubstitutions, t.coulombRoundsMax, c.pairBlocks, c.wallBlocks, c.contacts,
-                t.contactSlides, t.slidingAtEnd, t.slidingAlongFriction, chordStats.c_str(), c.adamsBashforth ? "ab2" : "euler", gapStats.c_str(),
-                notConverged.c_str(), fluidEvery.c_str());
+                t.contactSlides, t.slidingAtEnd, t.slidingAlongFriction, chordStats.c_str(),
+                c.adamsBashforth ? "ab2" : "euler", gapStats.c_str(), notConverged.c_str(), fluidEvery.c_str());
   return line;
 }
 

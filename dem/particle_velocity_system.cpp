@@ -753,7 +753,8 @@ ParticleVelocitySystem::SlidingCount ParticleVelocitySystem::slidingAtEnd() cons
   forEachSpring([&](size_t record, const double *tail, const int *base, int size, bool wall) {
     if (!springSlides_[record]) return;
     count.sliding++;
-    // the sticking force at the solution, F_t - k_t c1 dt rho_t: F_t - it is k_t c1 dt rho_t (the slip)
+    // the force the contact would have if it stuck, F_t,end = F_t - k_t c1 dt rho_t: F_t - F_t,end is the
+    // slip over the step in units of force, k_t c1 dt rho_t
     const double ktc1dt = wall ? tail[4] : tail[5];
     const double *ft = tail + 9, *n = tail, *t = &slideDirection_[3 * record];
     double w[12], end[3];
