@@ -477,6 +477,15 @@ double ParticleVelocitySystem::springVelocity(int k) const
   return u_[size_t(k)] - (springGamma_ != 0 ? springGamma_ * springPrevious_[size_t(k)] : 0.0);
 }
 
+void ParticleVelocitySystem::stickingForce(const double *tail, const double *w, bool wall, double end[3]) const
+{
+  const double *n = tail, *ft = tail + 9;
+  if (wall)
+    contact::wallTangentialForceAtEnd(n, tail[3], tail[4], tail[5], ft, tail + 12, w, end);
+  else
+    contact::pairTangentialForceAtEnd(n, tail[3], tail[4], tail[5], ft, w, end);
+}
+
 bool ParticleVelocitySystem::slideOverloadedContacts()
 {
   // Coulomb's law at the end of the step (docs/contact.md 2c), a return mapping: a sticking
@@ -544,10 +553,7 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
         std::max(0.0, normalStart - knc1dt * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]) - chord);
     const double cap = mu * std::min(normalStart, normalEnd);
     if (!springSlides_[record]) {  // sticking: does its implicit force stay under the cap?
-      if (wall)
-        contact::wallTangentialForceAtEnd(n, tail[3], ktc1dt, tail[5], ft, tail + 12, w, end);
-      else
-        contact::pairTangentialForceAtEnd(n, tail[3], tail[4], ktc1dt, ft, w, end);
+      stickingForce(tail, w, wall, end);
       const double norm = std::sqrt(end[0] * end[0] + end[1] * end[1] + end[2] * end[2]);
       if (!(norm > cap * (1 + 1e-9)) || !(norm > 0)) return;
       springSlides_[record] = 1;
@@ -753,16 +759,12 @@ ParticleVelocitySystem::SlidingCount ParticleVelocitySystem::slidingAtEnd() cons
   forEachSpring([&](size_t record, const double *tail, const int *base, int size, bool wall) {
     if (!springSlides_[record]) return;
     count.sliding++;
-    // the force the contact would have if it stuck, F_t,end = F_t - k_t c1 dt rho_t: F_t - F_t,end is the
-    // slip over the step in units of force, k_t c1 dt rho_t
-    const double ktc1dt = wall ? tail[4] : tail[5];
-    const double *ft = tail + 9, *n = tail, *t = &slideDirection_[3 * record];
+    // F_t - F_t,end (the sticking force at the solution) is the slip over the step in units of force,
+    // k_t c1 dt rho_t
+    const double *ft = tail + 9, *t = &slideDirection_[3 * record];
     double w[12], end[3];
     for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
-    if (wall)
-      contact::wallTangentialForceAtEnd(n, tail[3], ktc1dt, tail[5], ft, tail + 12, w, end);
-    else
-      contact::pairTangentialForceAtEnd(n, tail[3], tail[4], ktc1dt, ft, w, end);
+    stickingForce(tail, w, wall, end);
     const double slipAlong = (ft[0] - end[0]) * t[0] + (ft[1] - end[1]) * t[1] + (ft[2] - end[2]) * t[2];
     if (slipAlong > slideCap_[record] && slideCap_[record] > 0) count.alongFriction++;
   });

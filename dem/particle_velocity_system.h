@@ -212,6 +212,9 @@ class ParticleVelocitySystem {
   template <class Visit>
   void forEachSpring(Visit &&visit) const;
   double springVelocity(int k) const;  // u - gamma U_n, the unknowns' part of the contact displacement
+  // The tangential force at the end of the step of a contact that sticks (docs/contact.md 2c), from its
+  // friction tail and w = u - gamma U_n of its unknowns (12, or 6 for a wall)
+  void stickingForce(const double *tail, const double *w, bool wall, double end[3]) const;
 
   struct Matrices;                     // Eigen's, in the .cpp
   Settings settings_;
