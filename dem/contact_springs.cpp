@@ -74,6 +74,52 @@ void wallSpringBlock(const double n[3], double lever, double kn, double kt, doub
 
 namespace {
 
+// kt [t t^T + (1 - keep)(I - n n^T - t t^T)] with kt = 1: the tangential spring's part that leaves
+void slideStiffness(const double n[3], const double t[3], double keep, double K[3][3])
+{
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++)
+      K[a][b] = t[a] * t[b] + (1 - keep) * ((a == b ? 1.0 : 0.0) - n[a] * n[b] - t[a] * t[b]);
+}
+
+}  // namespace
+
+void pairSlideBlock(const double n[3], double leverI, double leverJ, const double t[3], double keep, double ktc1dt,
+                    double R[144])
+{
+  double K[3][3], C[3][3], B[36];
+  slideStiffness(n, t, keep, K);
+  cross(n, C);
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) {
+      B[12 * a + b] = a == b ? 1.0 : 0.0;
+      B[12 * a + 3 + b] = leverI * C[a][b];
+      B[12 * a + 6 + b] = a == b ? -1.0 : 0.0;
+      B[12 * a + 9 + b] = leverJ * C[a][b];
+    }
+  congruence(B, 12, K, ktc1dt, R);
+}
+
+void wallSlideBlock(const double n[3], double lever, const double t[3], double keep, double ktc1dt, double ktdt,
+                    const double wallVelocity[3], double R[36], double wallTerm[6])
+{
+  double K[3][3], C[3][3], B[18];
+  slideStiffness(n, t, keep, K);
+  cross(n, C);
+  for (int a = 0; a < 3; a++)
+    for (int b = 0; b < 3; b++) {
+      B[6 * a + b] = a == b ? 1.0 : 0.0;
+      B[6 * a + 3 + b] = lever * C[a][b];
+    }
+  congruence(B, 6, K, ktc1dt, R);
+  double f[3];
+  for (int a = 0; a < 3; a++)
+    f[a] = ktdt * (K[a][0] * wallVelocity[0] + K[a][1] * wallVelocity[1] + K[a][2] * wallVelocity[2]);
+  for (int r = 0; r < 6; r++) wallTerm[r] = B[r] * f[0] + B[6 + r] * f[1] + B[12 + r] * f[2];
+}
+
+namespace {
+
 // the tangential part (I - n n^T) of v
 void tangential(const double n[3], double v[3])
 {

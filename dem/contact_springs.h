@@ -39,6 +39,17 @@ void pairSpringBlock(const double n[3], double leverI, double leverJ, double kn,
 void wallSpringBlock(const double n[3], double lever, double kn, double kt, double c1dt, double dt,
                      const double wallVelocity[3], double R[36], double wallTerm[6]);
 
+// The part of a contact's tangential spring that leaves Eq. (31) when it slides along the unit
+// tangent t with Coulomb's law solved consistently (docs/contact.md 2c, coulomb_solve consistent):
+// c1 dt B^T kt [t t^T + (1 - keep)(I - n n^T - t t^T)] B, the spring along t and (1 - keep) of it
+// across t; what stays, keep kt across t, is the Jacobian of the capped force cap T/|T| at the trial
+// force T (keep = cap/|T|). keep = 0 takes the whole tangential spring out. For a wall, the
+// wall-velocity term of that part, dt B^T K_part U_w, too (ktdt = kt dt).
+void pairSlideBlock(const double n[3], double leverI, double leverJ, const double t[3], double keep, double ktc1dt,
+                    double R[144]);
+void wallSlideBlock(const double n[3], double lever, const double t[3], double keep, double ktc1dt, double ktdt,
+                    const double wallVelocity[3], double R[36], double wallTerm[6]);
+
 // Coulomb's law inside the step (docs/contact.md 2c). u_rel: the unknowns' part of the contact points'
 // displacement rate, u - gamma U_n, of the pair (12) or the particle (6). The tangential force of a
 // sticking contact at the end of the step, F_t,end = F_t - kt dt (I - n n^T) rho with

@@ -20,6 +20,7 @@ ParticleVelocitySystem::Settings CoupleOptions::systemSettings() const
   s.solver = solver;
   s.tolerance = tolerance;
   s.coulombTolerance = coulombTolerance;
+  s.coulombConsistent = coulombConsistent;
   for (int d = 0; d < 3; d++) s.gravity[d] = gravity[d];
   s.stresslets = stresslets;
   return s;
@@ -78,6 +79,7 @@ CoupleOptions parseCoupleOptions(const std::vector<std::string> &args)
       .number("tolerance", o.tolerance, {fraction, "tolerance (relative residual of Eq. 31) must be in (0, 1)"})
       .number("coulomb_tolerance", o.coulombTolerance,
               {fraction, "coulomb_tolerance (of the sliding contacts' forces) must be in (0, 1)"})
+      .choice<bool>("coulomb_solve", {{"frozen", false}, {"consistent", true}}, o.coulombConsistent)
       .yesNo("contact_chord", o.contactChord);
   // outputs, checkpoints, particle steps between fluid steps
   table.yesNo("stresslets", o.stresslets)

@@ -29,6 +29,7 @@ struct CoupleOptions {
   ParticleVelocitySystem::Solver solver = ParticleVelocitySystem::cholmod;
   double tolerance = 1e-10;          // relative residual of the conjugate-gradient solve of Eq. (31)
   double coulombTolerance = ParticleVelocitySystem::Settings().coulombTolerance;
+  bool coulombConsistent = false;    // coulomb_solve consistent|frozen (docs/contact.md 2c)
   bool contactChord = true;          // the chord term of the pair springs (Eq. C5 of docs/contact.md)
   long long checkpointEvery = 0;     // 0: no checkpoints
   std::string wallFile;              // the particles' loads on the walls (empty: none)

@@ -156,6 +156,10 @@ void CoupledVelocitySolve::finishStepUntimed(const std::vector<GatheredParticle>
   const ParticleVelocitySystem::SlidingCount sliding = system_->slidingAtEnd();
   counts_.slidingAtEnd += sliding.sliding;
   counts_.slidingAlongFriction += sliding.alongFriction;
+  counts_.stuckAgain += system_->stickingSwitches();
+  const ParticleVelocitySystem::CoulombConsistency law = system_->coulombConsistency();
+  counts_.offCoulomb += law.inconsistent;
+  counts_.offCoulombWorst = std::max(counts_.offCoulombWorst, law.worst);
   counts_.chordForceMax = std::max(counts_.chordForceMax, system_->largestChordForce());
   counts_.factorisations += system_->factorisations() - factorisationsCounted_;
   factorisationsCounted_ = system_->factorisations();

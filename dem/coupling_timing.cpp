@@ -31,19 +31,22 @@ std::string timingLine(const char *what, const CouplingTiming &t, double wall, i
                              std::to_string(t.fluidSteps) + " of the steps" +
                              (c.heldExtrapolated ? ", the held drag extrapolated" : "")
                        : "";
-  char line[1500];
+  char coulomb[200];
+  std::snprintf(coulomb, sizeof coulomb, ", %ld stuck again within their step, %ld off Coulomb's law by more than 1e-3 "
+                "(worst %.2g)", t.stuckAgain, t.offCoulomb, t.offCoulombWorst);
+  char line[1700];
   std::snprintf(line, sizeof line,
                 "fdm/couple timing %s (%d run%s, %ld steps, %.4g s): particle solve %.4g s (%.1f %%), "
                 "exchange incl. fluid %.4g s (%.1f %%), gather/scatter %.4g s (%.1f %%); Eq. 31: %ld solves, "
                 "%s iterations mean %.1f max %ld, %ld factorisations, %ld low-rank downdates, %ld back-substitutions "
                 "(Coulomb rounds, at most %ld in a solve); last step %ld sub-grid pair blocks, %ld wall blocks, "
                 "%ld contacts; %ld contacts began to slide within their step, %ld slid at its end (%ld of them along "
-                "their friction force)%s; position update %s%s%s%s\n",
+                "their friction force)%s%s; position update %s%s%s%s\n",
                 what, runs, runs == 1 ? "" : "s", t.steps, wall, t.solve, t.solve * percent, t.exchange,
                 t.exchange * percent, t.gatherScatter, t.gatherScatter * percent, t.solves, c.solverName,
                 t.solves ? double(t.solverIterations) / t.solves : 0.0, t.solverIterationsMax, t.factorisations,
                 t.downdates, t.backSubstitutions, t.coulombRoundsMax, c.pairBlocks, c.wallBlocks, c.contacts,
-                t.contactSlides, t.slidingAtEnd, t.slidingAlongFriction, chordStats.c_str(),
+                t.contactSlides, t.slidingAtEnd, t.slidingAlongFriction, coulomb, chordStats.c_str(),
                 c.adamsBashforth ? "ab2" : "euler", gapStats.c_str(), notConverged.c_str(), fluidEvery.c_str());
   return line;
 }

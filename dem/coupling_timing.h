@@ -29,6 +29,9 @@ struct CouplingTiming {
   long contactSlides = 0;               // contacts that began to slide within their step (Coulomb's law at its end)
   long slidingAtEnd = 0;                // contacts that slide at the end of their step
   long slidingAlongFriction = 0;        // and of them those that slip along their friction force (contact.md 2c)
+  long stuckAgain = 0;                  // sliding contacts that stuck again within their step (coulomb_solve consistent)
+  long offCoulomb = 0;                  // contacts whose force at the end of their step is off Coulomb's law by > 1e-3
+  double offCoulombWorst = 0;           // and the largest such relative difference
   long factorisations = 0;              // of Eq. (31) by the direct solvers: per step, and when the downdates grow too large
   long downdates = 0;                   // contacts that began to slide handled without a factorisation (Woodbury)
   long backSubstitutions = 0;           // of Eq. (31): one per Coulomb round of each solve

@@ -8,6 +8,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Eigen/IterativeLinearSolvers>
+#include <Eigen/LU>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
@@ -63,6 +64,12 @@ struct ParticleVelocitySystem::Matrices {
   Eigen::MatrixXd downdate;             // V (6N x r)
   Eigen::MatrixXd solvedDowndate;       // A^-1 V
   Eigen::LLT<Eigen::MatrixXd> capacitance;
+  // Consistent slides also put springs back (a contact that sticks again, a slide's Jacobian renewed):
+  // matrix = A - V S V^T with S = diag(+-1) (+1: out of the matrix), (A - V S V^T)^-1 = A^-1 +
+  // A^-1 V (S - V^T A^-1 V)^-1 V^T A^-1; while every sign is +1 this is the LLT above
+  std::vector<double> downdateSign;
+  bool signedUpdate = false;
+  Eigen::PartialPivLU<Eigen::MatrixXd> signedCapacitance;
   // The spring blocks that left the matrix in this round, kept as blocks: their columns of V (6N long
   // each) are built only if they are downdated, not when the step is factorised again anyway (in a
   // dense packing a thousand contacts begin to slide in one step: 2000 columns of 6N zeros)
@@ -88,7 +95,11 @@ struct ParticleVelocitySystem::Matrices {
   Eigen::VectorXd directSolve(Solver solver, const Eigen::VectorXd &b) const
   {
     Eigen::VectorXd x = factorisedSolve(solver, b);
-    if (downdate.cols() > 0) x += solvedDowndate * capacitance.solve(downdate.transpose() * x);
+    if (downdate.cols() > 0) {
+      const Eigen::VectorXd projected = downdate.transpose() * x;
+      x += solvedDowndate * (signedUpdate ? Eigen::VectorXd(signedCapacitance.solve(projected))
+                                          : Eigen::VectorXd(capacitance.solve(projected)));
+    }
     return x;
   }
 };
@@ -202,7 +213,12 @@ void ParticleVelocitySystem::assemble(std::vector<Particle> particles, std::vect
   slideForce_.assign(3 * springRecords, 0.0);
   slideDirection_.assign(3 * springRecords, 0.0);
   slideCap_.assign(springRecords, 0.0);
+  slideKeep_.assign(springRecords, 0.0);
+  coulombFlips_.assign(springRecords, 0);
+  coulombRenewals_.assign(springRecords, 0);
+  coulombFrozen_.assign(springRecords, 0);
   slidingSwitches_ = 0;
+  stickingSwitches_ = 0;
   for (size_t b = 0; b < springPairs_.size(); b += springs::pairRecord) {
     const double *rec = &springPairs_[b];
     const int i1 = tagIndex(rec[0]), i2 = tagIndex(rec[1]);
@@ -335,6 +351,8 @@ void ParticleVelocitySystem::factorise(const std::string &when)
   Matrices &m = *m_;
   m.downdate.resize(6 * n_, 0);
   m.solvedDowndate.resize(6 * n_, 0);
+  m.downdateSign.clear();
+  m.signedUpdate = false;
   if (settings_.solver != cg) {
     const bool factorised = settings_.solver == cholmod ? factoriseDirect(m.cholmod, m.matrix, m.analysed)
                                                         : factoriseDirect(m.ldlt, m.matrix, m.analysed);
@@ -408,12 +426,16 @@ const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<doubl
   coulombMixing_->reset();  // a new right-hand side: a new map of the caps
   lastCoulombResidual_ = HUGE_VAL;
   rounds_ = 0;
+  std::fill(coulombFlips_.begin(), coulombFlips_.end(), 0);
+  std::fill(coulombRenewals_.begin(), coulombRenewals_.end(), 0);
+  std::fill(coulombFrozen_.begin(), coulombFrozen_.end(), 0);
   const int maxCoulombRounds = 100;  // each round a back-substitution (a downdate if contacts began to slide)
   for (int round = 0;; round++) {
     solveLinear(rhs + m.springRhs + m.frictionRhs + m.chordRhs);
     backSubstitutions_++;
     rounds_++;
-    if (round == maxCoulombRounds || !slideOverloadedContacts()) break;
+    if (round == maxCoulombRounds) break;
+    if (!(settings_.coulombConsistent ? consistentCoulombRound() : slideOverloadedContacts())) break;
   }
   return u_;
 }
@@ -519,27 +541,7 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     for (int k = 0; k < size; k++) m.frictionRhs(base[k / 6] + k % 6) += f[k];
     rhsChanged = true;
   };
-  auto removeBlock = [&](const int *base, int size, const double *R) {
-    // R_t leaves the matrix (its entries exist: R_c had them), and gamma R_t U_n the known part;
-    // its columns of V follow in downdateOrFactorise
-    if (settings_.solver != cg) {
-      Matrices::LeavingBlock block;
-      block.base[0] = base[0];
-      block.base[1] = size > 6 ? base[1] : base[0];
-      block.size = size;
-      std::copy(R, R + size * size, block.R);
-      m.leaving.push_back(block);
-    }
-    for (int i = 0; i < size; i++) {
-      const int row = base[i / 6] + i % 6;
-      for (int j = 0; j < size; j++) {
-        const int col = base[j / 6] + j % 6;
-        m.matrix.coeffRef(row, col) -= R[size * i + j];
-        if (row / 6 == col / 6) m.subgridBlock[size_t(36) * (row / 6) + 6 * (row % 6) + col % 6] -= R[size * i + j];
-        if (springGamma_ != 0) m.springRhs(row) -= springGamma_ * R[size * i + j] * springPrevious_[size_t(col)];
-      }
-    }
-  };
+  auto removeBlock = [&](const int *base, int size, const double *R) { takeOutOfMatrix(base, size, R); };
   // one contact: w = u - gamma U_n of its particles, normalRate = n . (the contact points' approach rate)
   auto coulomb = [&](size_t record, const double *tail, const int *base, int size, bool wall) {
     const double ktc1dt = wall ? tail[4] : tail[5];
@@ -604,6 +606,246 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   return matrixChanged || rhsChanged;
 }
 
+void ParticleVelocitySystem::takeOutOfMatrix(const int *base, int size, const double *R)
+{
+  // R leaves the matrix (its entries exist: R_c had them), and gamma R U_n the known part
+  Matrices &m = *m_;
+  if (settings_.solver != cg) {
+    Matrices::LeavingBlock block;
+    block.base[0] = base[0];
+    block.base[1] = size > 6 ? base[1] : base[0];
+    block.size = size;
+    std::copy(R, R + size * size, block.R);
+    m.leaving.push_back(block);
+  }
+  for (int i = 0; i < size; i++) {
+    const int row = base[i / 6] + i % 6;
+    for (int j = 0; j < size; j++) {
+      const int col = base[j / 6] + j % 6;
+      m.matrix.coeffRef(row, col) -= R[size * i + j];
+      if (row / 6 == col / 6) m.subgridBlock[size_t(36) * (row / 6) + 6 * (row % 6) + col % 6] -= R[size * i + j];
+      if (springGamma_ != 0) m.springRhs(row) -= springGamma_ * R[size * i + j] * springPrevious_[size_t(col)];
+    }
+  }
+}
+
+void ParticleVelocitySystem::removedSpring(size_t record, const double *tail, bool wall, double *R, double *wallTerm) const
+{
+  double term[6];
+  if (!settings_.coulombConsistent) {  // the whole tangential spring
+    if (wall)
+      contact::wallSpringBlock(tail, tail[3], 0.0, 1.0, tail[4], tail[5], tail + 12, R, wallTerm ? wallTerm : term);
+    else
+      contact::pairSpringBlock(tail, tail[3], tail[4], 0.0, 1.0, tail[5], R);
+    return;
+  }
+  const double *t = &slideDirection_[3 * record], keep = slideKeep_[record];
+  if (wall)
+    contact::wallSlideBlock(tail, tail[3], t, keep, tail[4], tail[5], tail + 12, R, wallTerm ? wallTerm : term);
+  else
+    contact::pairSlideBlock(tail, tail[3], tail[4], t, keep, tail[5], R);
+}
+
+void ParticleVelocitySystem::slidingForce(size_t record, const double *tail, const double *w, bool wall,
+                                          double force[3]) const
+{
+  // F_t + g + keep (I - n n^T - t t^T)(T - F_t): the rhs term and what the matrix still holds of the spring
+  const double *n = tail, *ft = tail + 9, *g = &slideForce_[3 * record], *t = &slideDirection_[3 * record];
+  const double keep = slideKeep_[record];
+  double T[3];
+  stickingForce(tail, w, wall, T);
+  const double d[3] = {T[0] - ft[0], T[1] - ft[1], T[2] - ft[2]};
+  const double dn = n[0] * d[0] + n[1] * d[1] + n[2] * d[2], dt = t[0] * d[0] + t[1] * d[1] + t[2] * d[2];
+  for (int a = 0; a < 3; a++) force[a] = ft[a] + g[a] + keep * (d[a] - dn * n[a] - dt * t[a]);
+}
+
+double ParticleVelocitySystem::coulombCap(size_t record, const double *tail, const double *w, bool wall) const
+{
+  const double *n = tail, mu = tail[6], normalStart = tail[7], knc1dt = tail[8];
+  const double rel[3] = {w[0] - (wall ? 0.0 : w[6]), w[1] - (wall ? 0.0 : w[7]), w[2] - (wall ? 0.0 : w[8])};
+  const double chord = wall ? 0.0 : chordForce_[record];  // Eq. (C5): pairs only
+  const double normalEnd = std::max(0.0, normalStart - knc1dt * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]) - chord);
+  return mu * std::min(normalStart, normalEnd);
+}
+
+bool ParticleVelocitySystem::consistentCoulombRound()
+{
+  // Coulomb's law at the end of the step kept at every contact (docs/contact.md 2c): the tangential force
+  // is P(T), the projection of the trial force T (the sticking spring's force at the end of the step) onto
+  // the disc of radius cap. A contact that sticks has its spring in the matrix; one that slides along t
+  // has the spring along t out and keep = cap/|T| of it across t in: the Jacobian of cap T/|T|, so that
+  // each round is a step of semismooth Newton, its right-hand side term g = P(T) - F_t - keep (I - n n^T -
+  // t t^T)(T - F_t) at the last solution. A contact whose state changes, or whose slide turned or whose
+  // |T| moved by more than `stretch` since its Jacobian was set, changes the matrix (a low-rank update of
+  // the factorisation, signed: a spring may return); otherwise the rounds iterate g, Anderson-mixed.
+  // A contact changes state at most maxFlips times in a solve, then slides on (at the cap along T).
+  const int maxFlips = 3, maxRenewals = 2, freezeAfter = 20;
+  const double turn = 0.95, stretch = 2.0;
+  Matrices &m = *m_;
+  m.leaving.clear();
+  std::vector<double> next(slideForce_);  // G(x): the rhs terms at this solution
+  bool matrixChanged = false, converged = true;
+  forEachSpring([&](size_t r, const double *tail, const int *base, int size, bool wall) {
+    const double *n = tail, *ft = tail + 9;
+    const double ktc1dt = wall ? tail[4] : tail[5], mu = tail[6];
+    if (!(mu > 0) || !(ktc1dt > 0)) return;  // no tangential spring: no friction (F_t = 0)
+    double w[12], T[3];
+    for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
+    const double cap = coulombCap(r, tail, w, wall);
+    stickingForce(tail, w, wall, T);
+    const double norm = std::sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2]);
+    const bool over = norm > cap * (1 + 1e-9) && norm > 0;
+    double *t0 = &slideDirection_[3 * r];
+    auto block = [&](const double *t, double keep, double *R, double *term) {
+      if (wall)
+        contact::wallSlideBlock(n, tail[3], t, keep, ktc1dt, tail[5], tail + 12, R, term);
+      else
+        contact::pairSlideBlock(n, tail[3], tail[4], t, keep, ktc1dt, R);
+    };
+    double R[144], term[6] = {0, 0, 0, 0, 0, 0}, before[144], termBefore[6] = {0, 0, 0, 0, 0, 0};
+    if (!springSlides_[r]) {
+      if (!over) return;  // sticks: exactly in the matrix
+      for (int a = 0; a < 3; a++) t0[a] = T[a] / norm;
+      slideKeep_[r] = cap / norm;
+      block(t0, slideKeep_[r], R, term);
+      takeOutOfMatrix(base, size, R);
+      if (wall)
+        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k];  // its wall term leaves F^tot
+      springSlides_[r] = 1;
+      slidingSwitches_++;
+      coulombFlips_[r]++;
+      matrixChanged = true;
+    } else if (coulombFrozen_[r]) {
+      // slides along t0 for the rest of the solve (below)
+    } else if ((!over || T[0] * t0[0] + T[1] * t0[1] + T[2] * t0[2] < cap) && coulombFlips_[r] < maxFlips) {
+      // sticks again: under the cap, or its slip turned against the way it slid (T . t < cap: with the spring
+      // out along t, a contact the friction can hold shows a slip that flips back and forth); the spring
+      // back, the rhs term gone
+      block(t0, slideKeep_[r], before, termBefore);
+      for (int k = 0; k < size * size; k++) before[k] = -before[k];
+      takeOutOfMatrix(base, size, before);
+      if (wall)
+        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) += termBefore[k];
+      springSlides_[r] = 0;
+      stickingSwitches_++;
+      coulombFlips_[r]++;
+      matrixChanged = true;
+      for (int a = 0; a < 3; a++) next[3 * r + a] = 0;
+      return;
+    } else if (over) {
+      const double t[3] = {T[0] / norm, T[1] / norm, T[2] / norm}, keep = cap / norm, keep0 = slideKeep_[r];
+      // (at most maxRenewals in a solve: a contact whose Jacobian would swing between two states every round
+      // keeps the last, its slide then converging as a chord step, Anderson-mixed)
+      const bool renew = coulombRenewals_[r] < maxRenewals &&
+                         (t[0] * t0[0] + t[1] * t0[1] + t[2] * t0[2] < turn || keep > stretch * keep0 || keep0 > stretch * keep);
+      if (renew) {  // the Jacobian at this solution: the difference of the two parts out
+        coulombRenewals_[r]++;
+        block(t0, keep0, before, termBefore);
+        block(t, keep, R, term);
+        for (int k = 0; k < size * size; k++) R[k] -= before[k];
+        takeOutOfMatrix(base, size, R);
+        if (wall)
+          for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k] - termBefore[k];
+        for (int a = 0; a < 3; a++) t0[a] = t[a];
+        slideKeep_[r] = keep;
+        matrixChanged = true;
+      }
+    }
+    // the rhs term at this solution (a contact past its flips slides at the cap along T even under it; a
+    // frozen one along t0)
+    auto rhsTerm = [&](double *g) {
+      const double keep = slideKeep_[r];
+      const double d[3] = {T[0] - ft[0], T[1] - ft[1], T[2] - ft[2]};
+      const double dn = n[0] * d[0] + n[1] * d[1] + n[2] * d[2], dt = t0[0] * d[0] + t0[1] * d[1] + t0[2] * d[2];
+      double fSize = 0, ftSize = 0, change = 0;
+      for (int a = 0; a < 3; a++) {
+        const double f = coulombFrozen_[r] ? cap * t0[a] : norm > 0 ? cap * T[a] / norm : 0.0;
+        g[a] = f - ft[a] - keep * (d[a] - dn * n[a] - dt * t0[a]);
+        fSize += f * f;
+        ftSize += ft[a] * ft[a];
+        change = std::max(change, std::fabs(g[a] - slideForce_[3 * r + a]));
+      }
+      return change > settings_.coulombTolerance * (std::sqrt(fSize) + std::sqrt(ftSize)) + 1e-300;
+    };
+    bool moves = rhsTerm(&next[3 * r]);
+    if (moves && !coulombFrozen_[r] && coulombRenewals_[r] >= maxRenewals && rounds_ >= freezeAfter) {
+      // still moving with its Jacobian renewed as often as allowed: it slides on along t0, its whole
+      // spring out (the frozen slide of coulomb_solve frozen, for this contact and this solve)
+      block(t0, slideKeep_[r], before, termBefore);
+      block(t0, 0.0, R, term);
+      for (int k = 0; k < size * size; k++) R[k] -= before[k];
+      takeOutOfMatrix(base, size, R);
+      if (wall)
+        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k] - termBefore[k];
+      slideKeep_[r] = 0;
+      coulombFrozen_[r] = 1;
+      matrixChanged = true;
+      moves = rhsTerm(&next[3 * r]);
+    }
+    if (moves) converged = false;
+  });
+  double residual = 0;
+  for (size_t k = 0; k < next.size(); k++) residual = std::max(residual, std::fabs(next[k] - slideForce_[k]));
+  if (converged && !matrixChanged) return false;
+  // the next rhs terms: G(x), or its Anderson mixture with the last rounds' (restarted as the caps' are:
+  // when the matrix changed, a new map, and when the terms moved more than in the round before)
+  const bool restart = matrixChanged || !settings_.coulombAcceleration || !(residual < lastCoulombResidual_);
+  lastCoulombResidual_ = matrixChanged ? HUGE_VAL : residual;
+  if (restart) {
+    coulombMixing_->reset();
+    if (!matrixChanged && settings_.coulombAcceleration) coulombMixing_->mix(slideForce_.data(), next.data(), next.size());
+  } else {
+    coulombMixing_->mix(slideForce_.data(), next.data(), next.size());
+  }
+  forEachSpring([&](size_t r, const double *tail, const int *base, int size, bool wall) {
+    double change[3], f[12];
+    bool differs = false;
+    for (int a = 0; a < 3; a++) {
+      change[a] = next[3 * r + a] - slideForce_[3 * r + a];
+      differs = differs || change[a] != 0;
+    }
+    if (!differs) return;
+    for (int a = 0; a < 3; a++) slideForce_[3 * r + a] += change[a];
+    if (wall)
+      contact::wallGeneralisedForce(tail, tail[3], change, f);
+    else
+      contact::pairGeneralisedForce(tail, tail[3], tail[4], change, f);
+    for (int k = 0; k < size; k++) m.frictionRhs(base[k / 6] + k % 6) += f[k];
+  });
+  if (matrixChanged) downdateOrFactorise();
+  return true;
+}
+
+ParticleVelocitySystem::CoulombConsistency ParticleVelocitySystem::coulombConsistency() const
+{
+  CoulombConsistency c;
+  forEachSpring([&](size_t r, const double *tail, const int *base, int size, bool wall) {
+    const double ktc1dt = wall ? tail[4] : tail[5], mu = tail[6], *ft = tail + 9;
+    if (!(mu > 0) || !(ktc1dt > 0)) return;
+    double w[12], T[3], f[3], law[3];
+    for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
+    const double cap = coulombCap(r, tail, w, wall);
+    stickingForce(tail, w, wall, T);
+    const double norm = std::sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2]);
+    for (int a = 0; a < 3; a++) law[a] = norm > cap ? cap * T[a] / norm : T[a];
+    if (springSlides_[r])
+      slidingForce(r, tail, w, wall, f);
+    else
+      std::copy(T, T + 3, f);
+    double error = 0, size2 = 0, ft2 = 0;
+    for (int a = 0; a < 3; a++) {
+      error += (f[a] - law[a]) * (f[a] - law[a]);
+      size2 += law[a] * law[a];
+      ft2 += ft[a] * ft[a];
+    }
+    const double relative = std::sqrt(error) / (std::sqrt(size2) + std::sqrt(ft2) + 1e-300);
+    c.contacts++;
+    if (relative > 1e-3) c.inconsistent++;
+    c.worst = std::max(c.worst, relative);
+  });
+  return c;
+}
+
 void ParticleVelocitySystem::downdateOrFactorise()
 {
   // Beyond maxDowndateColumns the column solves cost about as much as a factorisation of the
@@ -619,7 +861,9 @@ void ParticleVelocitySystem::downdateOrFactorise()
     factorise(" after contacts started to slide");
     return;
   }
+  // (a block that returns to the matrix, consistent slides, has negative eigenvalues: columns of sign -1)
   std::vector<Eigen::VectorXd> columns;
+  std::vector<double> signs;
   for (const Matrices::LeavingBlock &leavingBlock : leaving) {
     const int size = leavingBlock.size;
     const Eigen::MatrixXd block = Eigen::Map<const Eigen::MatrixXd>(leavingBlock.R, size, size);
@@ -627,11 +871,12 @@ void ParticleVelocitySystem::downdateOrFactorise()
     const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
     for (int k = 0; k < size; k++) {
       const double lambda = eigen.eigenvalues()(k);
-      if (!(lambda > 1e-12 * largest)) continue;
+      if (!(std::fabs(lambda) > 1e-12 * largest)) continue;
       Eigen::VectorXd column = Eigen::VectorXd::Zero(6 * n_);
       for (int i = 0; i < size; i++)
-        column(leavingBlock.base[i / 6] + i % 6) = std::sqrt(lambda) * eigen.eigenvectors()(i, k);
+        column(leavingBlock.base[i / 6] + i % 6) = std::sqrt(std::fabs(lambda)) * eigen.eigenvectors()(i, k);
       columns.push_back(column);
+      signs.push_back(lambda > 0 ? 1.0 : -1.0);
     }
   }
   const long r = r0 + long(columns.size());
@@ -646,12 +891,21 @@ void ParticleVelocitySystem::downdateOrFactorise()
   m.downdate.rightCols(r - r0) = added;
   m.solvedDowndate.conservativeResize(Eigen::NoChange, r);
   m.solvedDowndate.rightCols(r - r0) = solvedAdded;
+  m.downdateSign.insert(m.downdateSign.end(), signs.begin(), signs.end());
+  const bool allOut = std::all_of(m.downdateSign.begin(), m.downdateSign.end(), [](double sign) { return sign > 0; });
   Eigen::MatrixXd capacitance = -m.downdate.transpose() * m.solvedDowndate;
-  capacitance.diagonal().array() += 1.0;
-  m.capacitance.compute(capacitance);
+  if (allOut) {
+    capacitance.diagonal().array() += 1.0;
+    m.signedUpdate = false;
+    m.capacitance.compute(capacitance);
+  } else {
+    for (long k = 0; k < r; k++) capacitance(k, k) += m.downdateSign[size_t(k)];
+    m.signedUpdate = true;
+    m.signedCapacitance.compute(capacitance);
+  }
   // A - V V^T stays positive definite while the particles keep their drag; if the capacitance says
   // otherwise (round-off near a singular system), the matrix is factorised as it stands
-  if (m.capacitance.info() != Eigen::Success)
+  if (allOut ? m.capacitance.info() != Eigen::Success : !(m.signedCapacitance.rcond() > 1e-12))
     factorise(" after contacts started to slide");
   else
     downdates_++;
@@ -716,8 +970,8 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     const double *R = rec + 2, *branch = rec + 146, weight = rec[149];
     double w[12], f[12], Rt[144], slid[12] = {0};
     const bool slides = springSlides_[record];
-    if (slides) {  // the tangential spring left the matrix, the capped force replaced F_t
-      contact::pairSpringBlock(tail, tail[3], tail[4], 0.0, 1.0, tail[5], Rt);
+    if (slides) {  // the tangential spring (or its part, consistent slides) left the matrix, the rhs term replaced F_t
+      removedSpring(record, tail, false, Rt, nullptr);
       contact::pairGeneralisedForce(tail, tail[3], tail[4], &slideForce_[3 * record], slid);
     }
     for (int k = 0; k < 12; k++) w[k] = springVelocity(6 * p[k / 6] + k % 6);
@@ -739,7 +993,7 @@ std::vector<double> ParticleVelocitySystem::springForces(std::vector<double> *st
     double f[6], Rt[36], termT[6], slid[6] = {0};
     const bool slides = springSlides_[record];
     if (slides) {
-      contact::wallSpringBlock(tail, tail[3], 0.0, 1.0, tail[4], tail[5], tail + 12, Rt, termT);
+      removedSpring(record, tail, true, Rt, termT);
       contact::wallGeneralisedForce(tail, tail[3], &slideForce_[3 * record], slid);
     }
     for (int i = 0; i < 6; i++) {
@@ -765,6 +1019,14 @@ ParticleVelocitySystem::SlidingCount ParticleVelocitySystem::slidingAtEnd() cons
     double w[12], end[3];
     for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
     stickingForce(tail, w, wall, end);
+    if (settings_.coulombConsistent) {  // the force it applies, its direction and size
+      double f[3];
+      slidingForce(record, tail, w, wall, f);
+      const double size = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+      const double slipAlong = size > 0 ? ((ft[0] - end[0]) * f[0] + (ft[1] - end[1]) * f[1] + (ft[2] - end[2]) * f[2]) / size : 0.0;
+      if (slipAlong > size && size > 0) count.alongFriction++;
+      return;
+    }
     const double slipAlong = (ft[0] - end[0]) * t[0] + (ft[1] - end[1]) * t[1] + (ft[2] - end[2]) * t[2];
     if (slipAlong > slideCap_[record] && slideCap_[record] > 0) count.alongFriction++;
   });

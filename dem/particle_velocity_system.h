@@ -76,6 +76,13 @@ class ParticleVelocitySystem {
     // its size (plus its F_t at the start); Anderson-mixed rounds unless coulombAcceleration is off
     double coulombTolerance = 1e-6;
     bool coulombAcceleration = true;
+    // How a contact slides (docs/contact.md 2c). frozen: along the direction of its force in the round
+    // it began to slide, for the rest of the step, its whole tangential spring out of the matrix (a slide
+    // may then follow its friction: the known limit there). consistent: every round takes the law
+    // itself, the force cap T/|T| of the trial force T (T under the cap: the contact sticks again, its
+    // spring back in the matrix); the matrix holds the law's Jacobian, cap/|T| of the spring across the
+    // slide (semismooth Newton), renewed where a contact's direction or |T| moved too far since.
+    bool coulombConsistent = false;
   };
 
   // What Eq. (32) needs of a particle besides the fluid; index = tag - 1.
@@ -186,6 +193,17 @@ class ParticleVelocitySystem {
     long sliding = 0, alongFriction = 0;
   };
   SlidingCount slidingAtEnd() const;
+  // After the last solve: how far the contact forces are from Coulomb's law at the solution, each
+  // friction contact's tangential force f against the projection P(T) of its trial force T onto the
+  // disc of radius cap: |f - P(T)| / (|P(T)| + |F_t|), its largest value and the contacts beyond 1e-3.
+  // 0 for a consistent solve (to its tolerance); frozen slides show the known limit.
+  struct CoulombConsistency {
+    long contacts = 0, inconsistent = 0;
+    double worst = 0;
+  };
+  CoulombConsistency coulombConsistency() const;
+  // Sliding contacts that stuck again within their step (coulomb_solve consistent), since the last assemble().
+  long stickingSwitches() const { return stickingSwitches_; }
   // The chord terms of this step (Eq. C5): the largest k_n dt^2 |rho_t|^2/(2r) of a pair spring [N]
   double largestChordForce() const { return largestChordForce_; }
   long springBlocks() const { return long(springPairs_.size() / springs::pairRecord + springWalls_.size() / springs::wallRecord); }
@@ -200,6 +218,21 @@ class ParticleVelocitySystem {
   // leaves the matrix, the capped force along the trial direction replaces F_t in F^tot); true if
   // any did (their blocks then leave by downdateOrFactorise).
   bool slideOverloadedContacts();
+  // The same with Coulomb's law kept consistently (Settings::coulombConsistent): one round, true if
+  // the rhs or the matrix changed (then solve again).
+  bool consistentCoulombRound();
+  // The part of a sliding contact's tangential spring that is out of the matrix (12 x 12 or 6 x 6) and,
+  // for a wall, its wall-velocity term: the whole spring (frozen slides), or along slideDirection_ and
+  // (1 - slideKeep_) of it across (consistent slides)
+  void removedSpring(size_t record, const double *tail, bool wall, double *R, double *wallTerm) const;
+  // The tangential force a sliding contact applies at w (its unknowns' u - gamma U_n): F_t + the rhs term
+  // + the part of its spring still in the matrix
+  void slidingForce(size_t record, const double *tail, const double *w, bool wall, double force[3]) const;
+  // mu_s times the smaller of the normal force at the start and at the end of the step (docs/contact.md 2c)
+  double coulombCap(size_t record, const double *tail, const double *w, bool wall) const;
+  // A symmetric block (12 x 12 or 6 x 6) out of the matrix (negative: back into it), and out of the known
+  // part gamma R U_n; its columns of V follow in downdateOrFactorise
+  void takeOutOfMatrix(const int *base, int size, const double *R);
   // The tangential spring blocks that left the matrix (columns of V, R_t = V V^T): a low-rank
   // downdate of the factorisation (Woodbury), or a new factorisation once the downdate grows large.
   void downdateOrFactorise();
@@ -230,7 +263,11 @@ class ParticleVelocitySystem {
   std::vector<double> slideForce_;     // per spring record: capped force - F_t (3) of a contact that slides
   std::vector<double> slideDirection_; // per spring record: the direction of its sliding force (3)
   std::vector<double> slideCap_;       // per spring record: the cap of a contact that slides, as in the last solve
-  long slidingSwitches_;
+  std::vector<double> slideKeep_;      // per spring record: the fraction of its spring across slideDirection_ kept in the matrix
+  std::vector<int> coulombFlips_;      // per spring record: stick/slide changes in this solve (consistent slides)
+  std::vector<int> coulombRenewals_;   // per spring record: its slide's Jacobian renewed in this solve
+  std::vector<char> coulombFrozen_;    // per spring record: slides along slideDirection_ for the rest of this solve
+  long slidingSwitches_, stickingSwitches_ = 0;
   int pairRecord_, wallRecord_;
   long pairBlocks_, wallBlocks_;
   std::vector<RigidVolume> volumes_;   // of this step, for the messages

@@ -302,7 +302,7 @@ struct PullParameters {
 struct PulledPair : PullParameters {
   ParticleVelocitySystem system;
   std::vector<double> u;
-  PulledPair(double F, bool ab2, double ftStart = 0) : system(settings())
+  PulledPair(double F, bool ab2, double ftStart = 0, bool consistent = false) : system(settings(consistent))
   {
     std::vector<ParticleVelocitySystem::Particle> particles(2);
     for (int p = 0; p < 2; p++) {
@@ -334,11 +334,12 @@ struct PulledPair : PullParameters {
     system.setVolumes({zeta, zeta}, {zetaR, zetaR});
     u = system.solve(std::vector<double>(12, 0.0));
   }
-  static ParticleVelocitySystem::Settings settings()
+  static ParticleVelocitySystem::Settings settings(bool consistent = false)
   {
     ParticleVelocitySystem::Settings s;
     s.alphaLambda = 1;
     s.rhoFluid = 1;
+    s.coulombConsistent = consistent;
     return s;
   }
 };
@@ -529,38 +530,140 @@ namespace {
 // each neighbour pair), random loads that make most contacts slide and press or part them along
 // their normals: each sliding contact's cap mu_s F_n(end) depends on the velocities, which the other
 // caps change through the shared spheres. Returns the velocities of one solve.
-std::vector<double> loadedChain(ParticleVelocitySystem &system, int M, unsigned seed)
+// The chain's spring records and loads (its spheres have Vu = 2, Ju = 3: rigid blocks diag(2, 2, 2, 3, 3, 3)).
+struct Chain {
+  std::vector<ParticleVelocitySystem::Particle> particles;
+  ParticleVelocitySystem::Springs springs;
+  std::vector<double> fluid;
+};
+
+Chain chainProblem(int M, unsigned seed)
 {
   const double knc1dt = 50, ktc1dt = 2000, mu = 0.5, lever = 1.0025;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> load(-10, 10), normal(4, 8);
-  std::vector<ParticleVelocitySystem::Particle> particles;
+  Chain c;
   std::vector<Eigen::Vector3d> x;
-  particles.resize(size_t(M));
+  c.particles.resize(size_t(M));
   x.resize(size_t(M));
   for (int i = 0; i < M; i++) {
-    particles[size_t(i)].radius = particles[size_t(i)].mass = particles[size_t(i)].density = 1;
+    c.particles[size_t(i)].radius = c.particles[size_t(i)].mass = c.particles[size_t(i)].density = 1;
     x[size_t(i)] = Eigen::Vector3d(1.8 * i, 0.9 * (i % 2), 0.3 * (i % 3));
   }
-  ParticleVelocitySystem::Springs s;
   for (int i = 0; i + 1 < M; i++) {
     const Eigen::Vector3d branch = x[size_t(i) + 1] - x[size_t(i)], n = -branch.normalized();  // n from 2 to 1
     double R[144];
     contact::pairSpringBlock(n.data(), lever, lever, knc1dt, ktc1dt, 1.0, R);
-    s.pairs.insert(s.pairs.end(), {double(i + 1), double(i + 2)});
-    s.pairs.insert(s.pairs.end(), R, R + 144);
-    s.pairs.insert(s.pairs.end(), {branch(0), branch(1), branch(2), 0.5});
-    s.pairs.insert(s.pairs.end(), {n(0), n(1), n(2), lever, lever, ktc1dt, mu, normal(rng), knc1dt, 0, 0, 0});
+    c.springs.pairs.insert(c.springs.pairs.end(), {double(i + 1), double(i + 2)});
+    c.springs.pairs.insert(c.springs.pairs.end(), R, R + 144);
+    c.springs.pairs.insert(c.springs.pairs.end(), {branch(0), branch(1), branch(2), 0.5});
+    c.springs.pairs.insert(c.springs.pairs.end(), {n(0), n(1), n(2), lever, lever, ktc1dt, mu, normal(rng), knc1dt, 0, 0, 0});
   }
-  system.assemble(particles, {}, {}, s);
-  system.setVolumes(std::vector<double>(size_t(M), 2.0), std::vector<double>(size_t(M), 3.0));
-  std::vector<double> fluid(size_t(6) * M, 0.0);
+  c.fluid.assign(size_t(6) * M, 0.0);
   for (int i = 0; i < M; i++)
-    for (int d = 0; d < 3; d++) fluid[size_t(6) * i + d] = load(rng);
-  return system.solve(fluid);
+    for (int d = 0; d < 3; d++) c.fluid[size_t(6) * i + d] = load(rng);
+  return c;
+}
+
+std::vector<double> loadedChain(ParticleVelocitySystem &system, int M, unsigned seed)
+{
+  const Chain c = chainProblem(M, seed);
+  system.assemble(c.particles, {}, {}, c.springs);
+  system.setVolumes(std::vector<double>(size_t(M), 2.0), std::vector<double>(size_t(M), 3.0));
+  return system.solve(c.fluid);
+}
+
+// The chain's equations at u, written out from its records alone (not from the solver's state): the
+// rigid blocks' force diag(2, 2, 2, 3, 3, 3) u less the fluid's and the contacts', each contact's normal
+// spring implicit and its tangential force P(T), the projection of its trial force onto the disc of
+// radius mu_s min(F_n(start), F_n(end)) (docs/contact.md 2c). Returns the largest residual over the
+// largest load.
+double chainResidual(const Chain &c, const std::vector<double> &u)
+{
+  std::vector<double> residual(u.size());
+  for (size_t k = 0; k < u.size(); k++) residual[k] = (k % 6 < 3 ? 2.0 : 3.0) * u[k] - c.fluid[k];
+  const int record = springs::pairRecord;
+  for (size_t b = 0; b < c.springs.pairs.size(); b += size_t(record)) {
+    const double *rec = &c.springs.pairs[b], *tail = rec + springs::pairFriction, *n = tail;
+    const int base[2] = {6 * (int(rec[0]) - 1), 6 * (int(rec[1]) - 1)};
+    double w[12], Rn[144], T[3], f[3], generalised[12];
+    for (int k = 0; k < 12; k++) w[k] = u[size_t(base[k / 6] + k % 6)];
+    contact::pairSpringBlock(n, tail[3], tail[4], tail[8], 0.0, 1.0, Rn);  // the normal spring (kn c1 dt, c1 dt = 1)
+    contact::pairTangentialForceAtEnd(n, tail[3], tail[4], tail[5], tail + 9, w, T);
+    const double approach = n[0] * (w[0] - w[6]) + n[1] * (w[1] - w[7]) + n[2] * (w[2] - w[8]);
+    const double cap = tail[6] * std::min(tail[7], std::max(0.0, tail[7] - tail[8] * approach));
+    const double size = std::sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2]);
+    for (int a = 0; a < 3; a++) f[a] = size > cap ? cap * T[a] / size : T[a];
+    contact::pairGeneralisedForce(n, tail[3], tail[4], f, generalised);
+    for (int i = 0; i < 12; i++) {
+      double normal = 0;
+      for (int j = 0; j < 12; j++) normal -= Rn[12 * i + j] * w[j];
+      residual[size_t(base[i / 6] + i % 6)] -= normal + generalised[i];
+    }
+  }
+  double worst = 0, load = 0;
+  for (size_t k = 0; k < u.size(); k++) {
+    worst = std::max(worst, std::fabs(residual[k]));
+    load = std::max(load, std::fabs(c.fluid[k]));
+  }
+  return worst / load;
 }
 
 }  // namespace
+
+TEST(ContactSprings, ConsistentSlidesSolveCoulombsLawAtEveryContact)
+{
+  // coulomb_solve consistent (docs/contact.md 2c): the chain's equations, written out from its records
+  // with every contact's force the projection of its trial force, hold at the solution to the rounds'
+  // tolerance; no slide follows its friction. The frozen slides (the default) do not solve them: a
+  // direction fixed in the round a contact began to slide, no contact sticking again.
+  const int M = 16;
+  long frozenOff = 0;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const Chain c = chainProblem(M, seed);
+    ParticleVelocitySystem::Settings settings = PulledPair::settings(true);
+    settings.coulombTolerance = 1e-10;
+    ParticleVelocitySystem consistent(settings);
+    const std::vector<double> u = loadedChain(consistent, M, seed);
+    EXPECT_LT(chainResidual(c, u), 1e-8) << seed;
+    EXPECT_GE(consistent.slidingAtEnd().sliding, M / 4) << seed;
+    EXPECT_EQ(consistent.slidingAtEnd().alongFriction, 0) << seed;
+    EXPECT_EQ(consistent.coulombConsistency().inconsistent, 0) << seed;
+    EXPECT_LT(consistent.coulombConsistency().worst, 1e-8) << seed;
+    EXPECT_LT(consistent.lastRounds(), 100) << seed;
+    // the default tolerance, 1e-6 of the contact forces
+    ParticleVelocitySystem byDefault(PulledPair::settings(true));
+    EXPECT_LT(chainResidual(c, loadedChain(byDefault, M, seed)), 1e-4) << seed;
+    ParticleVelocitySystem frozen(PulledPair::settings());
+    const std::vector<double> frozenAnswer = loadedChain(frozen, M, seed);
+    frozenOff += frozen.coulombConsistency().inconsistent;
+    std::printf("seed %u: consistent %ld rounds, %ld factorisations, %ld downdates, %ld stuck again, residual %.2g; "
+                "frozen %ld rounds, %ld contacts off the law, residual %.2g\n",
+                seed, consistent.lastRounds(), consistent.factorisations(), consistent.downdates(),
+                consistent.stickingSwitches(), chainResidual(c, u), frozen.lastRounds(),
+                frozen.coulombConsistency().inconsistent, chainResidual(c, frozenAnswer));
+  }
+  EXPECT_GT(frozenOff, 0);
+}
+
+TEST(ContactSprings, ConsistentSlidesOfASimplePull)
+{
+  // one contact: the frozen and the consistent slides agree (its direction does not turn); under the cap
+  // it sticks, a reversed load sticks it
+  for (bool ab2 : {false, true}) {
+    PulledPair pulled(10.0, ab2, 0, true);
+    EXPECT_EQ(pulled.system.slidingSwitches(), 1) << ab2;
+    EXPECT_EQ(pulled.system.factorisations(), 1) << ab2;
+    EXPECT_NEAR(pulled.u[1], (10.0 - pulled.cap) / pulled.zeta, 1e-10) << ab2;
+    EXPECT_NEAR(pulled.u[5], -pulled.lever * pulled.cap / pulled.zetaR, 1e-10) << ab2;
+    EXPECT_NEAR(pulled.system.springForces()[1], -pulled.cap, 1e-10) << ab2;
+    PulledPair held(3.0, ab2, 0, true);
+    EXPECT_EQ(held.system.slidingSwitches(), 0) << ab2;
+  }
+  PulledPair reversed(-2.0, false, -4.0, true);
+  EXPECT_EQ(reversed.system.slidingAtEnd().sliding, 0);
+  EXPECT_EQ(reversed.system.coulombConsistency().inconsistent, 0);
+}
 
 TEST(ContactSprings, CoulombRoundsAreAcceleratedToTheSameAnswer)
 {
