@@ -285,21 +285,39 @@ def calibration_boxes(ratio: float) -> Tuple[float, float]:
     return (6.0 * ratio, 8.0 * ratio)
 
 
+def whole_cell_box(L: float, a_over_delta: float, depth: float = 1.0) -> float:
+    """The smallest box size >= L (in a1) whose extents L and depth L are whole numbers of cells of a1/a_over_delta
+    (the mesh is cubic cells; at a1/Delta 5.6 the 8 a1 box would be 44.8 cells: 8.0357 a1, 45 cells)."""
+    first = math.ceil(L * a_over_delta - 1e-9)
+    for cells in range(first, first + 400):
+        if abs(depth * cells - round(depth * cells)) < 1e-9:
+            return cells / a_over_delta
+    raise ValueError("no box of about %g a1 at a1/Delta %g has whole numbers of cells along L and %g L"
+                     % (L, a_over_delta, depth))
+
+
+def _depth(kind: str) -> float:
+    return 1.0 if kind == "pair" else 1.25        # the wall's channel is L x 1.25 L x L
+
+
 def measure_command(kind: str, a_over_delta: float, ratio: float) -> str:
-    """The one command that calibrates (kind, a1/Delta, a2/a1) directly."""
+    """The one command that calibrates (kind, a1/Delta, a2/a1) directly (its boxes in whole cells)."""
     words = ["python3 -m fdmsubgrid.calibration", "--a-over-delta", "%g" % a_over_delta]
+    boxes = calibration_boxes(ratio) if kind == "pair" else calibration.BOXES
+    sizes = [whole_cell_box(L, a_over_delta, _depth(kind)) for L in boxes]
     if kind == "wall":
         words += ["--no-pairs"]
     else:
-        words += ["--ratios", "%g" % ratio, "--no-wall", "--boxes"] + ["%g" % L for L in calibration_boxes(ratio)]
+        words += ["--ratios", "%g" % ratio, "--no-wall"]
+    if kind == "pair" or sizes != list(boxes):
+        words += ["--boxes"] + ["%.10g" % L for L in sizes]
     return " ".join(words + ["--out", "my_calibration.dat"])
 
 
 def calibration_cells(kind: str, a_over_delta: float, ratio: float) -> float:
     """Mesh cells of one direct calibration, summed over its two boxes (the wall's channel is L x 1.25 L x L)."""
     boxes = calibration_boxes(ratio) if kind == "pair" else calibration.BOXES
-    depth = 1.0 if kind == "pair" else 1.25
-    return sum(depth * (L * a_over_delta) ** 3 for L in boxes)
+    return sum(_depth(kind) * (whole_cell_box(L, a_over_delta, _depth(kind)) * a_over_delta) ** 3 for L in boxes)
 
 
 def cost_model(summaries: Sequence[Dict]) -> Tuple[float, float]:
