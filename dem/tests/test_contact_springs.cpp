@@ -385,9 +385,11 @@ TEST(ContactSprings, CoulombLawOnAWall)
 {
   // a sphere on the wall y = 0 (n = +y) moving at U_w along x, pushed along x by F: it slides on
   // the wall, carried by mu_s F_n of friction toward the wall's velocity
+  // (frozen and consistent slides alike)
   const double zeta = 2, zetaR = 3, cap = 1.5, ktc1dt = 5000, ktdt = ktc1dt, dt = 1.0, lever = 1;
+  for (bool consistent : {false, true})
   for (double F : {3.0, -6.0}) {  // sticking needs 0.6 of friction at F = 3, 6 at F = -6
-    ParticleVelocitySystem system(PulledPair::settings());
+    ParticleVelocitySystem system(PulledPair::settings(consistent));
     std::vector<ParticleVelocitySystem::Particle> particles(1);
     particles[0].radius = particles[0].mass = particles[0].density = 1;
     particles[0].force[0] = F;
@@ -408,11 +410,12 @@ TEST(ContactSprings, CoulombLawOnAWall)
     const std::vector<double> force = system.springForces();
     EXPECT_LE(force[0], cap * (1 + 1e-9)) << F;
     if (F == -6.0) {
-      EXPECT_EQ(system.slidingSwitches(), 1);
-      EXPECT_NEAR(force[0], cap, 1e-12);
-      EXPECT_NEAR(u[0], (F + cap) / zeta, 1e-11);
+      EXPECT_EQ(system.slidingSwitches(), 1) << consistent;
+      EXPECT_NEAR(force[0], cap, 1e-10) << consistent;
+      EXPECT_NEAR(u[0], (F + cap) / zeta, 1e-10) << consistent;
+      EXPECT_EQ(system.coulombConsistency().inconsistent, 0) << consistent;
     } else {
-      EXPECT_EQ(system.slidingSwitches(), 0);
+      EXPECT_EQ(system.slidingSwitches(), 0) << consistent;
     }
   }
 }
