@@ -190,6 +190,12 @@ def test_fluid_every_puts_every_snapshot_on_a_fluid_step(couette, tmp_path):
                                     "--workdir", str(tmp_path / "constant")])
     fix = next(l for l in open(os.path.join(constant["run_dir"], "dem", "in.couette")) if "fdm/couple" in l)
     assert fix.split()[-4:] == ["fluid_every", "3", "held_drag", "constant"] and constant["held_drag"] == "constant"
+    # coulomb_solve consistent: written into the fix, the folder named after it; frozen (the default) is not written
+    assert "coulomb_solve" not in fix and scene["coulomb_solve"] == "frozen"
+    consistent = couette.main(TINY + ["--fluid-every", "3", "--coulomb-solve", "consistent", "--write-only",
+                                      "--workdir", str(tmp_path / "consistent")])
+    fix = next(l for l in open(os.path.join(consistent["run_dir"], "dem", "in.couette")) if "fdm/couple" in l)
+    assert fix.split()[-2:] == ["coulomb_solve", "consistent"] and consistent["run_dir"].endswith("_coulombConsistent")
     control = open(os.path.join(scene["run_dir"], "fluid", "system", "controlDict")).read()
     assert "writeInterval   9;" in control
     pack = packing.read_data(os.path.join(scene["run_dir"], "dem", "packing.data"), walls=(1,))
@@ -646,6 +652,12 @@ def test_table8_finds_the_run_of_its_fluid_every(tmp_path):
     assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated") == str(tmp_path / base)
     assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated", 2) == str(tmp_path / (base + "_fluidEvery2"))
     assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated", 4) is None
+    # and the run with coulomb_solve consistent is another row again
+    assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated", 2, "consistent") is None
+    (tmp_path / (base + "_fluidEvery2_coulombConsistent")).mkdir()
+    assert table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated", 2) == str(tmp_path / (base + "_fluidEvery2"))
+    assert (table8.find_run(str(tmp_path), 0.47, 3, 0.01, 1, "calibrated", 2, "consistent")
+            == str(tmp_path / (base + "_fluidEvery2_coulombConsistent")))
 
 
 def test_table8_runs_rows_at_once_and_names_a_stopped_one(tmp_path, monkeypatch):

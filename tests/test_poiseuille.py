@@ -274,15 +274,18 @@ def test_time_step_variants_take_a_spring_factor():
     are refused by value."""
     import argparse
     time_step = load_case_module("poiseuille", "timeStep")
-    assert time_step.parse_variant("0.05:8") == (0.05, 8, 1.0)
-    assert time_step.parse_variant("0.1:4:10") == (0.1, 4, 10.0)
+    assert time_step.parse_variant("0.05:8") == (0.05, 8, 1.0, "frozen")
+    assert time_step.parse_variant("0.1:4:10") == (0.1, 4, 10.0, "frozen")
+    assert time_step.parse_variant("0.05:4:consistent") == (0.05, 4, 1.0, "consistent")
+    assert time_step.parse_variant("0.1:4:10:consistent") == (0.1, 4, 10.0, "consistent")
     assert time_step.variant_name(0.1, 4, 10.0) == "dt0.1_K4_k10" and time_step.variant_name(0.05, 8) == "dt0.05_K8"
+    assert time_step.variant_name(0.05, 4, 1.0, "consistent") == "dt0.05_K4_consistent"
     assert time_step.spring_options(1.0, [8.0, 12.0, 8.0]) == []
     kn = 2 * 6 * np.pi * 1.4 ** 2 * 1.0 / 0.005
     options = time_step.spring_options(10.0, [8.0, 12.0, 8.0])
     assert options[0] == "--kn" and options[2] == "--kt"
     assert float(options[1]) == pytest.approx(10 * kn, rel=1e-12) and float(options[3]) == float(options[1])
-    for bad in ("0.05", "0.05:0", "-0.1:4", "0.1:4:0", "0.1:4:10:2", "a:b"):
+    for bad in ("0.05", "0.05:0", "-0.1:4", "0.1:4:0", "0.1:4:10:2", "a:b", "0.05:4:sticky", "0.05:consistent"):
         with pytest.raises(argparse.ArgumentTypeError, match=bad.replace(".", r"\.")):
             time_step.parse_variant(bad)
 

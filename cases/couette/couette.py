@@ -78,6 +78,9 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
                    help="with --fluid-every: the held force's drag target extrapolated from the last two fluid "
                    "steps (default) or constant (fix fdm/couple held_drag, docs/dem.md)")
+    p.add_argument("--coulomb-solve", choices=suspension.COULOMB_SOLVE, default=suspension.COULOMB_SOLVE[0],
+                   help="how a contact slides within its step (fix fdm/couple coulomb_solve, docs/contact.md 2c): "
+                   "frozen (default) or consistent")
     p.add_argument("--strain", type=float, default=3.0, help="strain units to run")
     p.add_argument("--seed", type=int, default=1, help="seed of the random packing")
     p.add_argument("--dump-every", type=float, default=0.1, help="strain between two particle snapshots")
@@ -150,7 +153,7 @@ def main(argv: list[str] | None = None) -> dict:
                             tol_lambda=args.tol_lambda, acceleration=args.acceleration, n_max=args.n_max,
                             text_dump=args.text_dump, model=args.model, fluid_every=args.fluid_every,
                             held_drag=args.held_drag, kn=args.kn, kt=args.kt, table8=args.table8 is not None,
-                            overwrite=args.overwrite, sizes=sizes)
+                            overwrite=args.overwrite, sizes=sizes, coulomb_solve=args.coulomb_solve)
     except (UncalibratedScene, FileExistsError) as e:
         raise SystemExit(str(e))
     run_dir, name, springs, scene = written["run_dir"], written["name"], written["springs"], written["scene"]

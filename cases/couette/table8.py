@@ -114,11 +114,12 @@ def makespan(walls: List[float], jobs: int) -> float:
 
 
 def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int, model: str,
-             fluid_every: int = 1) -> Optional[str]:
-    """The run folder couette.py --table8 wrote for this row, sub-grid model and fluid_every, if any (a
-    folder without the model in its name is from before the name said it: the cut-off model's)."""
+             fluid_every: int = 1, coulomb_solve: str = "frozen") -> Optional[str]:
+    """The run folder couette.py --table8 wrote for this row, sub-grid model, fluid_every and coulomb_solve, if
+    any (a folder without the model in its name is from before the name said it: the cut-off model's)."""
     pattern = os.path.join(workdir, "table8_phi%g_*_ad%g_dt%g_seed%d" % (phi, a_over_delta, dt, seed))
     every = "_fluidEvery%d" % fluid_every if fluid_every > 1 else ""
+    every += "" if coulomb_solve == "frozen" else "_coulomb" + coulomb_solve.capitalize()
     found = sorted(d for d in glob.glob(pattern + "_" + model + every)
                    + (glob.glob(pattern + every) if model == "cutoff" else []) if os.path.isdir(d))
     return found[0] if found else None
@@ -254,7 +255,7 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
     never started a second time."""
     dt = row_dt(phi, args)
     every = row_fluid_every(phi, args)
-    run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every)
+    run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every, args.coulomb_solve)
     if run_dir is not None and running_elsewhere(run_dir):
         print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
         while running_elsewhere(run_dir):
@@ -263,8 +264,9 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
         subprocess.run([sys.executable, os.path.join(HERE, "couette.py"), "--table8", str(phi), "--dt", str(dt),
                         "--strain", str(args.strain), "--a-over-delta", str(args.a_over_delta),
                         "--seed", str(args.seed), "--n-max", str(args.n_max), "--tol-lambda", str(args.tol_lambda),
-                        "--model", args.model, "--fluid-every", str(every), "--workdir", args.workdir], check=True)
-        run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every)
+                        "--model", args.model, "--fluid-every", str(every), "--coulomb-solve", args.coulomb_solve,
+                        "--workdir", args.workdir], check=True)
+        run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every, args.coulomb_solve)
     if steps_done(run_dir) < steps_planned(run_dir):
         # to the input's last step: an extension killed before its first checkpoint resumes from one
         # written for the shorter run, which fdmDEM accepts only with -until
@@ -466,6 +468,8 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                    "couettescene.fluid_dt(phi), %s)" % ", ".join(
                        "%d at %g" % (couettescene.fluid_every(phi), phi) for phi in sorted(couettescene.TABLE8)))
     p.add_argument("--a-over-delta", type=float, default=3.0)
+    p.add_argument("--coulomb-solve", choices=("frozen", "consistent"), default="frozen",
+                   help="how a contact slides within its step (fix fdm/couple coulomb_solve, docs/contact.md 2c)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",
                    help="pair_style fdm/subgrid's sub-grid model (docs/dem.md); the rows of docs/validation.md "
@@ -538,7 +542,8 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                     analysed[phi] = row
         stop_progress.set()
     rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args),
-                                                            args.seed, args.model, row_fluid_every(phi, args)), args)
+                                                            args.seed, args.model, row_fluid_every(phi, args),
+                                                            args.coulomb_solve), args)
             for phi in args.phis]
     rows = sorted(rows + earlier_rows(args.rows_from, args.phis), key=lambda r: r["phi_bulk_table8"])
     summary = summarise(rows, args)

@@ -99,6 +99,9 @@ def main(argv: list[str] | None = None) -> dict:
                         "(fix fdm/couple fluid_every; docs/benchmarks.md, 'The channel's time step')")
     p.add_argument("--held-drag", choices=suspension.HELD_DRAG, default=suspension.HELD_DRAG[0],
                    help="with --fluid-every: the held drag extrapolated from the last two fluid steps, or constant")
+    p.add_argument("--coulomb-solve", choices=suspension.COULOMB_SOLVE, default=suspension.COULOMB_SOLVE[0],
+                   help="how a contact slides within its step (fix fdm/couple coulomb_solve, docs/contact.md 2c): "
+                   "frozen (default) or consistent")
     p.add_argument("--budget", metavar="RUN_DIR", default=None,
                    help="predict the wall time of --duration from a short run of the same scene (RUN_DIR: at least "
                         "two fluid steps, e.g. --paper --run --duration 1) and exit")
@@ -197,6 +200,8 @@ def main(argv: list[str] | None = None) -> dict:
                                                  "records" if args.from_records else "seed%d" % args.seed,
                                                  "_" + args.model,
                                                  "_fluidEvery%d" % args.fluid_every if args.fluid_every > 1 else "")
+    if args.coulomb_solve != suspension.COULOMB_SOLVE[0]:
+        name += "_coulomb" + args.coulomb_solve.capitalize()
     name += couettescene.sizes_tag(sizes)
     run_dir = os.path.join(args.workdir, name)
     if os.path.exists(run_dir):
@@ -211,7 +216,7 @@ def main(argv: list[str] | None = None) -> dict:
     scene = suspension.write_case(run_dir, pack, springs, args.a_over_delta, dt, steps, every, args.tol_lambda,
                                   args.acceleration, args.n_max, write_every, model=args.model,
                                   grad_p0=(grad, 0.0, 0.0), name="in.poiseuille", fluid_every=K,
-                                  held_drag=args.held_drag, calibration=calibration)
+                                  held_drag=args.held_drag, calibration=calibration, coulomb_solve=args.coulomb_solve)
     # the command that writes this scene again, for a compact snapshot of its run
     checkpoint.write_scene_command(run_dir, __file__, sys.argv[1:] if argv is None else list(argv))
     print("wrote %s: %d spheres (%s), phi %.4f, channel %s a1, %d cells, dP0/dx = %.4g Pa/m (U_c = %g), "

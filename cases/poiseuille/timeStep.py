@@ -18,6 +18,9 @@ layer is h_r = 0.005 a1 deep; fdmDEM stops a run at an overlap of 0.05 a1).
   timeStep.py --start RUN/dem/particles.records --variants 0.05:8 0.1:4 0.2:2 0.05:8:10 0.1:4:10
                                            the stability map (docs/benchmarks.md, "The channel's stability
                                            map"): DT:K:S, the recipe's springs k_n = k_t times S
+  timeStep.py --start RUN/dem/particles.records --variants 0.025:1 0.05:4 0.025:1:consistent 0.05:4:consistent
+                                           a variant ending in :consistent slides its contacts with fix
+                                           fdm/couple coulomb_solve consistent (docs/contact.md 2c)
 
 A variant that stops (fdmDEM's overlap of 0.05 a1, or any other fault) is reported with its error and the
 smallest gap it reached; the runs it finished are compared.
@@ -42,25 +45,30 @@ PROJECT = os.path.dirname(os.path.dirname(HERE))
 DEFAULT_VARIANTS = ["0.025:1", "0.05:1", "0.1:1", "0.05:2", "0.05:4", "0.025:4", "0.2:1"]
 
 
-def parse_variant(text: str) -> Tuple[float, int, float]:
-    """'DT:K' or 'DT:K:S' -> (DT, K, S): the particle step, the fluid every K-th step, the recipe's springs
-    times S (default 1)."""
+def parse_variant(text: str) -> Tuple[float, int, float, str]:
+    """'DT:K', 'DT:K:S', each optionally ending in ':consistent' (or ':frozen') -> (DT, K, S, C): the particle
+    step, the fluid every K-th step, the recipe's springs times S (default 1), fix fdm/couple's coulomb_solve C
+    (default frozen; docs/contact.md 2c)."""
     try:
         parts = text.split(":")
+        coulomb = suspension.COULOMB_SOLVE[0]
+        if len(parts) > 2 and parts[-1] in suspension.COULOMB_SOLVE:
+            coulomb = parts.pop()
         if len(parts) not in (2, 3):
             raise ValueError
         dt, k = float(parts[0]), int(parts[1])
         stiffness = float(parts[2]) if len(parts) == 3 else 1.0
     except ValueError:
         raise argparse.ArgumentTypeError("a variant is DT:K or DT:K:S (particle step, fluid every K-th step, "
-                                         "springs times S), got %r" % text)
+                                         "springs times S), optionally ending in :consistent, got %r" % text)
     if dt <= 0 or k < 1 or not stiffness > 0:
         raise argparse.ArgumentTypeError("variant %r: DT and S must be positive and K at least 1" % text)
-    return dt, k, stiffness
+    return dt, k, stiffness, coulomb
 
 
-def variant_name(dt: float, k: int, stiffness: float = 1.0) -> str:
-    return "dt%g_K%d%s" % (dt, k, "" if stiffness == 1 else "_k%g" % stiffness)
+def variant_name(dt: float, k: int, stiffness: float = 1.0, coulomb: str = suspension.COULOMB_SOLVE[0]) -> str:
+    return "dt%g_K%d%s%s" % (dt, k, "" if stiffness == 1 else "_k%g" % stiffness,
+                             "" if coulomb == suspension.COULOMB_SOLVE[0] else "_" + coulomb)
 
 
 def spring_options(stiffness: float, size: List[float]) -> List[str]:
@@ -73,9 +81,10 @@ def spring_options(stiffness: float, size: List[float]) -> List[str]:
     return ["--kn", repr(rule.kn * stiffness), "--kt", repr(rule.kt * stiffness)]
 
 
-def run_variant(dt: float, k: int, start: str, args, workdir: str, stiffness: float = 1.0) -> Dict:
+def run_variant(dt: float, k: int, start: str, args, workdir: str, stiffness: float = 1.0,
+                coulomb: str = suspension.COULOMB_SOLVE[0]) -> Dict:
     """One variant from the start records: its flow-rate curve, smallest gaps and cost; how it ended."""
-    name = variant_name(dt, k, stiffness)
+    name = variant_name(dt, k, stiffness, coulomb)
     path = os.path.join(workdir, name + ".json")
     if os.path.isfile(path):
         with open(path) as f:
@@ -88,7 +97,7 @@ def run_variant(dt: float, k: int, start: str, args, workdir: str, stiffness: fl
         results = poiseuille.main(["--from-records", start, "--dt", str(dt), "--fluid-every", str(k),
                                    "--duration", str(args.duration), "--dump-every", str(dt * k),
                                    "--workdir", folder, "--out", os.path.join(folder, "results.json"),
-                                   "--overwrite", "--keep"] + (["--size", *map(str, args.size)])
+                                   "--overwrite", "--keep", "--coulomb-solve", coulomb] + (["--size", *map(str, args.size)])
                                   + spring_options(stiffness, args.size))
         run_dir = results["run_dir"]
     except (SystemExit, channel.PoiseuilleRunError) as e:
@@ -105,7 +114,8 @@ def run_variant(dt: float, k: int, start: str, args, workdir: str, stiffness: fl
     if error is not None and run_dir:
         # the code's own message (the overlap that stopped fdmDEM names its particles)
         error = case.last_error(run_dir) or error
-    out = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, stiffness_factor=stiffness, wall_seconds=wall, error=error)
+    out = dict(dt=dt, fluid_every=k, fluid_dt=dt * k, stiffness_factor=stiffness, coulomb_solve=coulomb,
+               wall_seconds=wall, error=error)
     if analysis_note:
         out["analysis"] = analysis_note
     if run_dir and os.path.isdir(os.path.join(run_dir, "fluid", "postProcessing")):
@@ -192,23 +202,24 @@ def main(argv=None) -> Dict:
             poiseuille.main(["--workdir", start_dir, "--out", done, "--overwrite", "--size", *map(str, args.size)])
         run = [d for d in os.listdir(start_dir) if os.path.isdir(os.path.join(start_dir, d))][0]
         start = os.path.join(start_dir, run, "dem", "particles.records")
-    coarsest = max(dt * k for dt, k, _ in args.variants)
+    coarsest = max(dt * k for dt, k, _, _ in args.variants)
     window = tuple(args.window) if args.window else (coarsest, args.duration)
     runs = []
-    for dt, k, stiffness in args.variants:
-        r = run_variant(dt, k, start, args, args.workdir, stiffness)
-        print("dt %g K %d springs x%g: %s, %.0f s, smallest gap %s" % (
-            dt, k, stiffness, "failed: " + r["error"] if r.get("error") else "ran", r["wall_seconds"],
+    for dt, k, stiffness, coulomb in args.variants:
+        r = run_variant(dt, k, start, args, args.workdir, stiffness, coulomb)
+        print("dt %g K %d springs x%g coulomb_solve %s: %s, %.0f s, smallest gap %s" % (
+            dt, k, stiffness, coulomb, "failed: " + r["error"] if r.get("error") else "ran", r["wall_seconds"],
             r.get("smallest_gap")), flush=True)
         runs.append(r)
     for r in runs[1:]:
         r.update(compare(runs[0], r, window))
-    print("%-6s %-3s %-7s %-8s %-8s %-12s %-10s %-10s %s" % ("dt", "K", "springs", "wall s", "fluid s", "solves/step",
-                                                             "mean diff", "rms diff", "smallest gap"))
+    print("%-6s %-3s %-7s %-10s %-8s %-8s %-12s %-10s %-10s %s" % ("dt", "K", "springs", "coulomb", "wall s", "fluid s",
+                                                                   "solves/step", "mean diff", "rms diff", "smallest gap"))
     for r in runs:
         md, rd = r.get("mean_difference"), r.get("rms_difference")
-        print("%-6g %-3d %-7s %-8.0f %-8.0f %-12.1f %-10s %-10s %s" % (
-            r["dt"], r["fluid_every"], "x%g" % r.get("stiffness_factor", 1.0), r["wall_seconds"], r.get("fluid_seconds", float("nan")),
+        print("%-6g %-3d %-7s %-10s %-8.0f %-8.0f %-12.1f %-10s %-10s %s" % (
+            r["dt"], r["fluid_every"], "x%g" % r.get("stiffness_factor", 1.0), r.get("coulomb_solve", "frozen"),
+            r["wall_seconds"], r.get("fluid_seconds", float("nan")),
             r.get("solves_per_fluid_step", float("nan")), "ref" if r is runs[0] else ("%+.2f %%" % (100 * md) if md is not None else "-"),
             "%.2f %%" % (100 * rd) if rd is not None else "-", r.get("smallest_gap")))
     given = list(argv if argv is not None else sys.argv[1:])

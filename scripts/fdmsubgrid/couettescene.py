@@ -146,7 +146,8 @@ def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs,
                strain: float, dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50,
                write_every: int = 100000, text_dump: bool = False, model: str = "calibrated",
                fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated",
-               calibration: deminput.SceneCalibration | None = None) -> dict:
+               calibration: deminput.SceneCalibration | None = None,
+               coulomb_solve: str = suspension.COULOMB_SOLVE[0]) -> dict:
     """fluid/ and dem/ of the run (suspension.write_case with the walls at -U and +U); returns the
     scene's description. fluid_options: more arguments of case.write_fluid_case; fluid_every: particle
     steps per fluid step; held_drag: how the steps between hold the fluid's force (fix fdm/couple);
@@ -156,7 +157,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs,
     scene = suspension.write_case(run_dir, pack, springs, a_over_delta, dt, steps, dump_every, tol_lambda,
                                   acceleration, n_max, write_every, text_dump, model, wall_velocities=(-U, U),
                                   name="in.couette", fluid_options=fluid_options, fluid_every=fluid_every,
-                                  held_drag=held_drag, calibration=calibration)
+                                  held_drag=held_drag, calibration=calibration, coulomb_solve=coulomb_solve)
     scene.update(wall_velocity=U)
     return scene
 
@@ -187,7 +188,7 @@ def sizes_tag(sizes: packing.SizeDistribution | None) -> str:
 
 def run_name(phi: float, size, a_over_delta: float, dt: float, seed: int, acceleration: str = "anderson",
              model: str = "calibrated", fluid_every: int = 1, table8: bool = False,
-             sizes: packing.SizeDistribution | None = None) -> str:
+             sizes: packing.SizeDistribution | None = None, coulomb_solve: str = suspension.COULOMB_SOLVE[0]) -> str:
     """The run folder's name: the scene's phi_bulk (the packing's, or Table 8's row), box, mesh, step, seed and
     the options that change the run (the size distribution if not the paper's: sizes_tag)."""
     name = "phi%g_%gx%gx%g_ad%g_dt%g_seed%d%s" % (phi, *size, a_over_delta, dt, seed,
@@ -195,6 +196,8 @@ def run_name(phi: float, size, a_over_delta: float, dt: float, seed: int, accele
                                                   + "_" + model)
     if fluid_every > 1:
         name += "_fluidEvery%d" % fluid_every
+    if coulomb_solve != suspension.COULOMB_SOLVE[0]:
+        name += "_coulomb" + coulomb_solve.capitalize()
     name += sizes_tag(sizes)
     if table8:
         name = "table8_" + name
@@ -206,7 +209,8 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
               tol_lambda: float = 1e-3, acceleration: str = "anderson", n_max: int = 50, text_dump: bool = False,
               model: str = "calibrated", fluid_every: int = 1, held_drag: str = suspension.HELD_DRAG[0],
               kn: float | None = None, kt: float | None = None, table8: bool = False,
-              overwrite: bool = False, sizes: packing.SizeDistribution | None = None) -> dict:
+              overwrite: bool = False, sizes: packing.SizeDistribution | None = None,
+              coulomb_solve: str = suspension.COULOMB_SOLVE[0]) -> dict:
     """One Couette scene written in workdir/<run_name>/ (fluid/ and dem/), printing the packing, the springs
     and a warning if dt is beyond the measured limit: the random packing of phi_bulk `phi` (or of
     n_particles spheres, a Table 8 row: table8 names the folder after it) in the box `size` (a1), the springs
@@ -233,7 +237,7 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
         print(warning, flush=True)
 
     name = run_name(pack.phi if n_particles is None else phi, size, a_over_delta, dt, seed, acceleration, model,
-                    fluid_every, table8, sizes)
+                    fluid_every, table8, sizes, coulomb_solve)
     run_dir = os.path.join(workdir, name)
     if os.path.exists(run_dir):
         if not overwrite:
@@ -245,7 +249,7 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
     write_every_steps = K * max(1, int(round(write_every / (SHEAR_RATE * dt * K))))
     scene = write_case(run_dir, pack, springs, a_over_delta, dt, strain, every, tol_lambda, acceleration, n_max,
                        write_every_steps, text_dump, model, fluid_every=fluid_every, held_drag=held_drag,
-                       calibration=calibration)
+                       calibration=calibration, coulomb_solve=coulomb_solve)
     print("wrote %s: %d spheres (%s), phi %.4f, box %s a1, %d cells, %d steps of dt %g, a snapshot every %d steps"
           % (run_dir, pack.n, species_text(pack), pack.phi, " x ".join("%g" % v for v in size), scene["cells"],
              scene["steps"], dt, every))

@@ -151,6 +151,8 @@ def choose_springs(stress: float, dt: float, delta: float, kn: float | None = No
 # fix fdm/couple's held_drag: how the particle steps between fluid steps hold the fluid's force; the first
 # is what the toolkit writes (closer to solving the fluid at every step, docs/benchmarks.md)
 HELD_DRAG = ("extrapolated", "constant")
+# fix fdm/couple's coulomb_solve: how a contact slides within its step (docs/contact.md 2c); the first is the default
+COULOMB_SOLVE = ("frozen", "consistent")
 
 
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, steps: int,
@@ -158,7 +160,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                text_dump: bool = False, model: str = "calibrated", wall_velocities: tuple[float, float] = (0.0, 0.0),
                grad_p0: tuple[float, float, float] = (0.0, 0.0, 0.0), name: str = "in.suspension",
                fluid_options: dict | None = None, fluid_every: int = 1, held_drag: str = "extrapolated",
-               calibration: deminput.SceneCalibration | None = None) -> dict:
+               calibration: deminput.SceneCalibration | None = None, coulomb_solve: str = COULOMB_SOLVE[0]) -> dict:
     """fluid/ and dem/ of the run; returns the scene's description. wall_velocities: the x velocities of
     the walls y = 0 and y = L_y; grad_p0: the uniform pressure gradient (Eq. 58) [Pa/m]. model:
     pair_style fdm/subgrid's sub-grid model (calibrated, the default: what the solver resolves, measured;
@@ -173,11 +175,14 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     the fluid's force (fix fdm/couple ... held_drag: extrapolated, from the last two fluid steps, or constant;
     docs/benchmarks.md "The held drag extrapolated"). calibration: the table the scene runs with
     (deminput.scene_calibration; None or the shipped one: the pair style's default), written into dem/ and
-    named by the pair style's `calibration` keyword when it holds interpolated blocks."""
+    named by the pair style's `calibration` keyword when it holds interpolated blocks. coulomb_solve: fix
+    fdm/couple's coulomb_solve (written when not the default frozen)."""
     if fluid_every < 1:
         raise ValueError("fluid_every must be at least 1, got %r" % fluid_every)
     if held_drag not in HELD_DRAG:
         raise ValueError("held_drag must be one of %s, got %r" % (", ".join(HELD_DRAG), held_drag))
+    if coulomb_solve not in COULOMB_SOLVE:
+        raise ValueError("coulomb_solve must be one of %s, got %r" % (", ".join(COULOMB_SOLVE), coulomb_solve))
     for what, every in (("dump_every", dump_every), ("write_every", write_every)):
         if every % fluid_every and every <= steps:
             raise ValueError("%s = %d steps is not a multiple of fluid_every = %d: a snapshot would fall between "
@@ -206,7 +211,8 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     deminput.write_dem_input(os.path.join(run_dir, "dem"), box, spheres, dt=dt, pair_style=pair,
                          fix_options="stresslets yes checkpoint %d walls walls.dat%s"
                          % (10 * dump_every, " fluid_every %d held_drag %s" % (fluid_every, held_drag)
-                            if fluid_every > 1 else ""), runs=runs,
+                            if fluid_every > 1 else "")
+                         + ("" if coulomb_solve == COULOMB_SOLVE[0] else " coulomb_solve %s" % coulomb_solve), runs=runs,
                          name=name)
     packing.write_data(os.path.join(run_dir, "dem", "packing.data"), pack)
     if table is not None:
@@ -214,7 +220,7 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
     scene = dict(box=[Lx, Ly, Lz], cells=box.n[0] * box.n[1] * box.n[2], mesh=list(box.n), steps=steps,
                  wall_velocities=[u_lo, u_hi], grad_p0=list(grad_p0), dt=dt, dump_every=dump_every,
                  write_every=write_every, subgrid_model=model, fluid_every=fluid_every,
-                 held_drag=held_drag if fluid_every > 1 else None)
+                 held_drag=held_drag if fluid_every > 1 else None, coulomb_solve=coulomb_solve)
     if table is not None:
         # the interpolated blocks the run reads (dem/<table>), each with its measured error bound
         scene["calibration_interpolated"] = [dict(kind=e.kind, radii=[e.pair[0]] if e.kind == "wall" else list(e.pair),
