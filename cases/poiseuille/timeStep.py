@@ -133,7 +133,9 @@ def run_variant(dt: float, k: int, start: str, args, workdir: str, stiffness: fl
 
 
 def _springs_label(r: Dict) -> str:
-    return "" if r.get("stiffness_factor", 1.0) == 1 else ", springs x%g" % r["stiffness_factor"]
+    """What sets a variant apart besides DT and K: its springs' factor, its coulomb_solve if not frozen."""
+    return (("" if r.get("stiffness_factor", 1.0) == 1 else ", springs x%g" % r["stiffness_factor"])
+            + ("" if r.get("coulomb_solve", "frozen") == "frozen" else ", " + r["coulomb_solve"]))
 
 
 def compare(reference: Dict, variant: Dict, window: Tuple[float, float]) -> Dict:
