@@ -35,45 +35,6 @@ void congruence(const double *B, int m, const double K[3][3], double s, double *
     for (int c = r + 1; c < m; c++) R[m * c + r] = R[m * r + c] = 0.5 * (R[m * r + c] + R[m * c + r]);
 }
 
-}  // namespace
-
-void pairSpringBlock(const double n[3], double leverI, double leverJ, double kn, double kt, double c1dt,
-                     double R[144])
-{
-  // Eq. (C1): v_r = U_i - U_j - (l_i Omega_i + l_j Omega_j) x n = U_i + l_i n x Omega_i - U_j + l_j n x Omega_j
-  double K[3][3], C[3][3], B[36];
-  stiffness(n, kn, kt, K);
-  cross(n, C);
-  for (int a = 0; a < 3; a++)
-    for (int b = 0; b < 3; b++) {
-      B[12 * a + b] = a == b ? 1.0 : 0.0;
-      B[12 * a + 3 + b] = leverI * C[a][b];
-      B[12 * a + 6 + b] = a == b ? -1.0 : 0.0;
-      B[12 * a + 9 + b] = leverJ * C[a][b];
-    }
-  congruence(B, 12, K, c1dt, R);
-}
-
-void wallSpringBlock(const double n[3], double lever, double kn, double kt, double c1dt, double dt,
-                     const double wallVelocity[3], double R[36], double wallTerm[6])
-{
-  double K[3][3], C[3][3], B[18];
-  stiffness(n, kn, kt, K);
-  cross(n, C);
-  for (int a = 0; a < 3; a++)
-    for (int b = 0; b < 3; b++) {
-      B[6 * a + b] = a == b ? 1.0 : 0.0;
-      B[6 * a + 3 + b] = lever * C[a][b];
-    }
-  congruence(B, 6, K, c1dt, R);
-  // dt B^T K U_w (Eq. C2)
-  double f[3];
-  for (int a = 0; a < 3; a++) f[a] = dt * (K[a][0] * wallVelocity[0] + K[a][1] * wallVelocity[1] + K[a][2] * wallVelocity[2]);
-  for (int r = 0; r < 6; r++) wallTerm[r] = B[r] * f[0] + B[6 + r] * f[1] + B[12 + r] * f[2];
-}
-
-namespace {
-
 // kt [t t^T + (1 - keep)(I - n n^T - t t^T)] with kt = 1: the tangential spring's part that leaves
 void slideStiffness(const double n[3], const double t[3], double keep, double K[3][3])
 {
@@ -82,13 +43,11 @@ void slideStiffness(const double n[3], const double t[3], double keep, double K[
       K[a][b] = t[a] * t[b] + (1 - keep) * ((a == b ? 1.0 : 0.0) - n[a] * n[b] - t[a] * t[b]);
 }
 
-}  // namespace
-
-void pairSlideBlock(const double n[3], double leverI, double leverJ, const double t[3], double keep, double ktc1dt,
-                    double R[144])
+// s B^T K B of a pair (Eq. C1: v_r = U_i - U_j - (l_i Omega_i + l_j Omega_j) x n
+// = U_i + l_i n x Omega_i - U_j + l_j n x Omega_j)
+void pairBlock(const double n[3], double leverI, double leverJ, const double K[3][3], double s, double R[144])
 {
-  double K[3][3], C[3][3], B[36];
-  slideStiffness(n, t, keep, K);
+  double C[3][3], B[36];
   cross(n, C);
   for (int a = 0; a < 3; a++)
     for (int b = 0; b < 3; b++) {
@@ -97,25 +56,58 @@ void pairSlideBlock(const double n[3], double leverI, double leverJ, const doubl
       B[12 * a + 6 + b] = a == b ? -1.0 : 0.0;
       B[12 * a + 9 + b] = leverJ * C[a][b];
     }
-  congruence(B, 12, K, ktc1dt, R);
+  congruence(B, 12, K, s, R);
 }
 
-void wallSlideBlock(const double n[3], double lever, const double t[3], double keep, double ktc1dt, double ktdt,
-                    const double wallVelocity[3], double R[36], double wallTerm[6])
+// s B^T K B of a particle and a wall, and the wall-velocity term dt B^T K U_w (Eq. C2)
+void wallBlock(const double n[3], double lever, const double K[3][3], double s, double dt, const double wallVelocity[3],
+               double R[36], double wallTerm[6])
 {
-  double K[3][3], C[3][3], B[18];
-  slideStiffness(n, t, keep, K);
+  double C[3][3], B[18];
   cross(n, C);
   for (int a = 0; a < 3; a++)
     for (int b = 0; b < 3; b++) {
       B[6 * a + b] = a == b ? 1.0 : 0.0;
       B[6 * a + 3 + b] = lever * C[a][b];
     }
-  congruence(B, 6, K, ktc1dt, R);
+  congruence(B, 6, K, s, R);
   double f[3];
-  for (int a = 0; a < 3; a++)
-    f[a] = ktdt * (K[a][0] * wallVelocity[0] + K[a][1] * wallVelocity[1] + K[a][2] * wallVelocity[2]);
+  for (int a = 0; a < 3; a++) f[a] = dt * (K[a][0] * wallVelocity[0] + K[a][1] * wallVelocity[1] + K[a][2] * wallVelocity[2]);
   for (int r = 0; r < 6; r++) wallTerm[r] = B[r] * f[0] + B[6 + r] * f[1] + B[12 + r] * f[2];
+}
+
+}  // namespace
+
+void pairSpringBlock(const double n[3], double leverI, double leverJ, double kn, double kt, double c1dt,
+                     double R[144])
+{
+  double K[3][3];
+  stiffness(n, kn, kt, K);
+  pairBlock(n, leverI, leverJ, K, c1dt, R);
+}
+
+void wallSpringBlock(const double n[3], double lever, double kn, double kt, double c1dt, double dt,
+                     const double wallVelocity[3], double R[36], double wallTerm[6])
+{
+  double K[3][3];
+  stiffness(n, kn, kt, K);
+  wallBlock(n, lever, K, c1dt, dt, wallVelocity, R, wallTerm);
+}
+
+void pairSlideBlock(const double n[3], double leverI, double leverJ, const double t[3], double keep, double ktc1dt,
+                    double R[144])
+{
+  double K[3][3];
+  slideStiffness(n, t, keep, K);
+  pairBlock(n, leverI, leverJ, K, ktc1dt, R);
+}
+
+void wallSlideBlock(const double n[3], double lever, const double t[3], double keep, double ktc1dt, double ktdt,
+                    const double wallVelocity[3], double R[36], double wallTerm[6])
+{
+  double K[3][3];
+  slideStiffness(n, t, keep, K);
+  wallBlock(n, lever, K, ktc1dt, ktdt, wallVelocity, R, wallTerm);
 }
 
 namespace {

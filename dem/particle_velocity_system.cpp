@@ -526,20 +526,8 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
   bool converged = true;
   auto setSlideForce = [&](size_t record, const double target[3], const double *ft, const int *base, int size,
                            const double *tail, bool wall) {
-    double change[3], f[12];
-    bool differs = false;
-    for (int a = 0; a < 3; a++) {
-      change[a] = target[a] - ft[a] - slideForce_[3 * record + a];
-      differs = differs || change[a] != 0;
-    }
-    if (!differs) return;
-    for (int a = 0; a < 3; a++) slideForce_[3 * record + a] += change[a];
-    if (wall)
-      contact::wallGeneralisedForce(tail, tail[3], change, f);
-    else
-      contact::pairGeneralisedForce(tail, tail[3], tail[4], change, f);
-    for (int k = 0; k < size; k++) m.frictionRhs(base[k / 6] + k % 6) += f[k];
-    rhsChanged = true;
+    const double term[3] = {target[0] - ft[0], target[1] - ft[1], target[2] - ft[2]};
+    rhsChanged = setSlideTerm(record, term, tail, base, size, wall) || rhsChanged;
   };
   auto removeBlock = [&](const int *base, int size, const double *R) { takeOutOfMatrix(base, size, R); };
   // one contact: w = u - gamma U_n of its particles, normalRate = n . (the contact points' approach rate)
@@ -627,6 +615,26 @@ void ParticleVelocitySystem::takeOutOfMatrix(const int *base, int size, const do
       if (springGamma_ != 0) m.springRhs(row) -= springGamma_ * R[size * i + j] * springPrevious_[size_t(col)];
     }
   }
+}
+
+bool ParticleVelocitySystem::setSlideTerm(size_t record, const double term[3], const double *tail, const int *base,
+                                          int size, bool wall)
+{
+  // F^tot gets B^T of the change (the rhs term of a sliding contact: what replaces its F_t)
+  double change[3], f[12];
+  bool differs = false;
+  for (int a = 0; a < 3; a++) {
+    change[a] = term[a] - slideForce_[3 * record + a];
+    differs = differs || change[a] != 0;
+  }
+  if (!differs) return false;
+  for (int a = 0; a < 3; a++) slideForce_[3 * record + a] += change[a];
+  if (wall)
+    contact::wallGeneralisedForce(tail, tail[3], change, f);
+  else
+    contact::pairGeneralisedForce(tail, tail[3], tail[4], change, f);
+  for (int k = 0; k < size; k++) m_->frictionRhs(base[k / 6] + k % 6) += f[k];
+  return true;
 }
 
 void ParticleVelocitySystem::removedSpring(size_t record, const double *tail, bool wall, double *R, double *wallTerm) const
@@ -798,19 +806,7 @@ bool ParticleVelocitySystem::consistentCoulombRound()
     coulombMixing_->mix(slideForce_.data(), next.data(), next.size());
   }
   forEachSpring([&](size_t r, const double *tail, const int *base, int size, bool wall) {
-    double change[3], f[12];
-    bool differs = false;
-    for (int a = 0; a < 3; a++) {
-      change[a] = next[3 * r + a] - slideForce_[3 * r + a];
-      differs = differs || change[a] != 0;
-    }
-    if (!differs) return;
-    for (int a = 0; a < 3; a++) slideForce_[3 * r + a] += change[a];
-    if (wall)
-      contact::wallGeneralisedForce(tail, tail[3], change, f);
-    else
-      contact::pairGeneralisedForce(tail, tail[3], tail[4], change, f);
-    for (int k = 0; k < size; k++) m.frictionRhs(base[k / 6] + k % 6) += f[k];
+    setSlideTerm(r, &next[3 * r], tail, base, size, wall);
   });
   if (matrixChanged) downdateOrFactorise();
   return true;

@@ -233,6 +233,9 @@ class ParticleVelocitySystem {
   // A symmetric block (12 x 12 or 6 x 6) out of the matrix (negative: back into it), and out of the known
   // part gamma R U_n; its columns of V follow in downdateOrFactorise
   void takeOutOfMatrix(const int *base, int size, const double *R);
+  // A sliding contact's rhs term (slideForce_) set to `term`, F^tot changed by B^T of the difference; false if
+  // it was that already
+  bool setSlideTerm(size_t record, const double term[3], const double *tail, const int *base, int size, bool wall);
   // The tangential spring blocks that left the matrix (columns of V, R_t = V V^T): a low-rank
   // downdate of the factorisation (Woodbury), or a new factorisation once the downdate grows large.
   void downdateOrFactorise();
