@@ -139,6 +139,8 @@ void FixFdmCouple::writeCheckpoint()
     c.arrays["heldDrag"] = {heldDrag_.extrapolated() ? 1.0 : 0.0, double(held.lastStep), double(held.beforeStep)};
     c.arrays["heldDragLast"] = held.last;
     c.arrays["heldDragBefore"] = held.before;
+    // coulomb_solve: a resume must slide its contacts as the run did (docs/contact.md 2c)
+    c.arrays["coulombSolve"] = {options_.coulombConsistent ? 1.0 : 0.0};
     const std::string file = std::string(directory) + "/" + prefix + std::to_string((long long) c.step);
     try {
       ::mkdir(directory, 0755);
@@ -218,6 +220,15 @@ void FixFdmCouple::readResumeCheckpoint()
       problem = resumeFile_ + " was written with held_drag " + (extrapolated ? "extrapolated" : "constant") +
                 " but the input has held_drag " + (heldDrag_.extrapolated() ? "extrapolated" : "constant") +
                 ": a resumed run must hold the fluid's force between fluid steps as the run it continues";
+  }
+  if (problem.empty()) {
+    // written before coulomb_solve existed: the slides were frozen
+    const auto coulomb = c.arrays.find("coulombSolve");
+    const bool consistent = coulomb != c.arrays.end() && !coulomb->second.empty() && coulomb->second[0] != 0;
+    if (consistent != options_.coulombConsistent)
+      problem = resumeFile_ + " was written with coulomb_solve " + (consistent ? "consistent" : "frozen") +
+                " but the input has coulomb_solve " + (options_.coulombConsistent ? "consistent" : "frozen") +
+                ": a resumed run must slide its contacts as the run it continues (docs/contact.md 2c)";
   }
   if (!problem.empty()) error->all(FLERR, ("fdm/couple: cannot resume: " + problem).c_str());
 

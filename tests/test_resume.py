@@ -677,6 +677,27 @@ def test_resume_with_another_held_drag_is_refused_and_loses_nothing(tmp_path, en
     assert r.returncode == 0, r.stdout
 
 
+def test_resume_with_another_coulomb_solve_is_refused_and_loses_nothing(tmp_path, env):
+    """A run killed with the frozen slides (the default), its input then changed to coulomb_solve consistent:
+    the resume is refused naming both (the checkpoint records how the contacts slid), and the checkpoints stay
+    for a resume with the input as it was."""
+    root = make_scene(str(tmp_path))
+    assert run_and_kill(root, env, "fdmDEM", 9) != 0
+    path = os.path.join(root, "dem", "in.couette")
+    text = open(path).read()
+    with open(path, "w") as f:
+        f.write(re.sub(r"(fix\s+\S+\s+all\s+fdm/couple[^\n]*)", r"\1 coulomb_solve consistent", text, count=1))
+    checkpoints = sorted(os.listdir(os.path.join(root, "dem", "checkpoint")))
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode != 0
+    assert "was written with coulomb_solve frozen but the input has coulomb_solve consistent" in r.stdout, r.stdout[-3000:]
+    assert sorted(os.listdir(os.path.join(root, "dem", "checkpoint"))) == checkpoints
+    with open(path, "w") as f:
+        f.write(text)
+    r = fdm_run(root, env, "--resume")
+    assert r.returncode == 0, r.stdout
+
+
 # ------------------------------------------------------------------------------------------------
 # compact snapshot: the particles of a checkpoint in a few plain files, continued in a fresh case
 # with the fluid from rest (fdmRun --from-snapshot; docs/coupling.md "Compact snapshot")
