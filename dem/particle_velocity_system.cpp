@@ -779,15 +779,17 @@ bool ParticleVelocitySystem::consistentCoulombRound()
     if (moves && !coulombFrozen_[r] && coulombRenewals_[r] >= maxRenewals && rounds_ >= freezeAfter) {
       // still moving with its Jacobian renewed as often as allowed: it slides on along t0, its whole
       // spring out (the frozen slide of coulomb_solve frozen, for this contact and this solve)
-      block(t0, slideKeep_[r], before, termBefore);
-      block(t0, 0.0, R, term);
-      for (int k = 0; k < size * size; k++) R[k] -= before[k];
-      takeOutOfMatrix(base, size, R);
-      if (wall)
-        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k] - termBefore[k];
-      slideKeep_[r] = 0;
+      if (slideKeep_[r] != 0) {
+        block(t0, slideKeep_[r], before, termBefore);
+        block(t0, 0.0, R, term);
+        for (int k = 0; k < size * size; k++) R[k] -= before[k];
+        takeOutOfMatrix(base, size, R);
+        if (wall)
+          for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k] - termBefore[k];
+        slideKeep_[r] = 0;
+        matrixChanged = true;
+      }
       coulombFrozen_[r] = 1;
-      matrixChanged = true;
       moves = rhsTerm(&next[3 * r]);
     }
     if (moves) converged = false;
@@ -880,6 +882,9 @@ void ParticleVelocitySystem::downdateOrFactorise()
     factorise(" after contacts started to slide");
     return;
   }
+  // blocks that change nothing (a consistent slide frozen with its spring already all out): no column, no
+  // solve (CHOLMOD refuses a right-hand side of no columns)
+  if (columns.empty()) return;
   Eigen::MatrixXd added(6 * n_, long(columns.size()));
   for (size_t k = 0; k < columns.size(); k++) added.col(long(k)) = columns[k];
   const Eigen::MatrixXd solvedAdded = m.factorisedSolve(settings_.solver, added);
