@@ -657,24 +657,31 @@ def test_extrapolated_held_drag_killed_run_resumes_to_the_same_trajectory(tmp_pa
     assert largest_difference(root, reference_extrapolated) < 1e-8 * 8
 
 
-def test_resume_with_another_held_drag_is_refused_and_loses_nothing(tmp_path, env):
-    """A run killed with the drag held constant, its input then changed to held_drag extrapolated: the resume
-    is refused naming both, and the checkpoints stay for a resume with the input as it was."""
-    root = make_scene(str(tmp_path), fix_extra="fluid_every 2")
-    assert run_and_kill(root, env, "fdmDEM", 9) != 0
+def refused_resume_loses_nothing(root, env, change, message):
+    """The input of a killed run changed by `change` (text -> text): its resume is refused with `message`, the
+    checkpoints stay, and the run resumes once the input is as it was."""
     path = os.path.join(root, "dem", "in.couette")
     text = open(path).read()
     with open(path, "w") as f:
-        f.write(text.replace("fluid_every 2", EXTRAPOLATED))
+        f.write(change(text))
     checkpoints = sorted(os.listdir(os.path.join(root, "dem", "checkpoint")))
     r = fdm_run(root, env, "--resume")
     assert r.returncode != 0
-    assert "was written with held_drag constant but the input has held_drag extrapolated" in r.stdout, r.stdout[-3000:]
+    assert message in r.stdout, r.stdout[-3000:]
     assert sorted(os.listdir(os.path.join(root, "dem", "checkpoint"))) == checkpoints
     with open(path, "w") as f:
         f.write(text)
     r = fdm_run(root, env, "--resume")
     assert r.returncode == 0, r.stdout
+
+
+def test_resume_with_another_held_drag_is_refused_and_loses_nothing(tmp_path, env):
+    """A run killed with the drag held constant, its input then changed to held_drag extrapolated: the resume
+    is refused naming both, and the checkpoints stay for a resume with the input as it was."""
+    root = make_scene(str(tmp_path), fix_extra="fluid_every 2")
+    assert run_and_kill(root, env, "fdmDEM", 9) != 0
+    refused_resume_loses_nothing(root, env, lambda text: text.replace("fluid_every 2", EXTRAPOLATED),
+                                 "was written with held_drag constant but the input has held_drag extrapolated")
 
 
 def test_resume_with_another_coulomb_solve_is_refused_and_loses_nothing(tmp_path, env):
@@ -683,19 +690,10 @@ def test_resume_with_another_coulomb_solve_is_refused_and_loses_nothing(tmp_path
     for a resume with the input as it was."""
     root = make_scene(str(tmp_path))
     assert run_and_kill(root, env, "fdmDEM", 9) != 0
-    path = os.path.join(root, "dem", "in.couette")
-    text = open(path).read()
-    with open(path, "w") as f:
-        f.write(re.sub(r"(fix\s+\S+\s+all\s+fdm/couple[^\n]*)", r"\1 coulomb_solve consistent", text, count=1))
-    checkpoints = sorted(os.listdir(os.path.join(root, "dem", "checkpoint")))
-    r = fdm_run(root, env, "--resume")
-    assert r.returncode != 0
-    assert "was written with coulomb_solve frozen but the input has coulomb_solve consistent" in r.stdout, r.stdout[-3000:]
-    assert sorted(os.listdir(os.path.join(root, "dem", "checkpoint"))) == checkpoints
-    with open(path, "w") as f:
-        f.write(text)
-    r = fdm_run(root, env, "--resume")
-    assert r.returncode == 0, r.stdout
+    refused_resume_loses_nothing(
+        root, env,
+        lambda text: re.sub(r"(fix\s+\S+\s+all\s+fdm/couple[^\n]*)", r"\1 coulomb_solve consistent", text, count=1),
+        "was written with coulomb_solve frozen but the input has coulomb_solve consistent")
 
 
 # ------------------------------------------------------------------------------------------------
