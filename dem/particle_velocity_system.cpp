@@ -529,19 +529,14 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
     const double term[3] = {target[0] - ft[0], target[1] - ft[1], target[2] - ft[2]};
     rhsChanged = setSlideTerm(record, term, tail, base, size, wall) || rhsChanged;
   };
-  auto removeBlock = [&](const int *base, int size, const double *R) { takeOutOfMatrix(base, size, R); };
   // one contact: w = u - gamma U_n of its particles, normalRate = n . (the contact points' approach rate)
   auto coulomb = [&](size_t record, const double *tail, const int *base, int size, bool wall) {
     const double ktc1dt = wall ? tail[4] : tail[5];
-    const double mu = tail[6], normalStart = tail[7], knc1dt = tail[8], *ft = tail + 9, *n = tail;
+    const double mu = tail[6], normalStart = tail[7], *ft = tail + 9;
     if (!(mu > 0) || !(ktc1dt > 0)) return;  // no tangential spring: no friction (F_t = 0)
     double w[12], end[3];
     for (int k = 0; k < size; k++) w[k] = springVelocity(base[k / 6] + k % 6);
-    const double rel[3] = {w[0] - (wall ? 0.0 : w[6]), w[1] - (wall ? 0.0 : w[7]), w[2] - (wall ? 0.0 : w[8])};
-    const double chord = wall ? 0.0 : chordForce_[record];  // Eq. (C5): pairs only
-    const double normalEnd =
-        std::max(0.0, normalStart - knc1dt * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]) - chord);
-    const double cap = mu * std::min(normalStart, normalEnd);
+    const double cap = coulombCap(record, tail, w, wall);
     if (!springSlides_[record]) {  // sticking: does its implicit force stay under the cap?
       stickingForce(tail, w, wall, end);
       const double norm = std::sqrt(end[0] * end[0] + end[1] * end[1] + end[2] * end[2]);
@@ -550,13 +545,10 @@ bool ParticleVelocitySystem::slideOverloadedContacts()
       slidingSwitches_++;
       for (int a = 0; a < 3; a++) slideDirection_[3 * record + a] = end[a] / norm;
       double Rt[144], term[6];
-      if (wall) {
-        contact::wallSpringBlock(n, tail[3], 0.0, 1.0, ktc1dt, tail[5], tail + 12, Rt, term);
+      removedSpring(record, tail, wall, Rt, term);
+      if (wall)
         for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k];  // its wall term leaves F^tot
-      } else {
-        contact::pairSpringBlock(n, tail[3], tail[4], 0.0, 1.0, ktc1dt, Rt);
-      }
-      removeBlock(base, size, Rt);
+      takeOutOfMatrix(base, size, Rt);
       matrixChanged = true;
     }
     caps[record] = cap;
@@ -647,9 +639,14 @@ void ParticleVelocitySystem::removedSpring(size_t record, const double *tail, bo
       contact::pairSpringBlock(tail, tail[3], tail[4], 0.0, 1.0, tail[5], R);
     return;
   }
-  const double *t = &slideDirection_[3 * record], keep = slideKeep_[record];
+  slidePart(tail, wall, &slideDirection_[3 * record], slideKeep_[record], R, wallTerm ? wallTerm : term);
+}
+
+void ParticleVelocitySystem::slidePart(const double *tail, bool wall, const double *t, double keep, double *R,
+                                       double *wallTerm)
+{
   if (wall)
-    contact::wallSlideBlock(tail, tail[3], t, keep, tail[4], tail[5], tail + 12, R, wallTerm ? wallTerm : term);
+    contact::wallSlideBlock(tail, tail[3], t, keep, tail[4], tail[5], tail + 12, R, wallTerm);
   else
     contact::pairSlideBlock(tail, tail[3], tail[4], t, keep, tail[5], R);
 }
@@ -704,40 +701,38 @@ bool ParticleVelocitySystem::consistentCoulombRound()
     const double norm = std::sqrt(T[0] * T[0] + T[1] * T[1] + T[2] * T[2]);
     const bool over = norm > cap * (1 + 1e-9) && norm > 0;
     double *t0 = &slideDirection_[3 * r];
-    auto block = [&](const double *t, double keep, double *R, double *term) {
-      if (wall)
-        contact::wallSlideBlock(n, tail[3], t, keep, ktc1dt, tail[5], tail + 12, R, term);
-      else
-        contact::pairSlideBlock(n, tail[3], tail[4], t, keep, ktc1dt, R);
-    };
-    double R[144], term[6] = {0, 0, 0, 0, 0, 0}, before[144], termBefore[6] = {0, 0, 0, 0, 0, 0};
-    if (!springSlides_[r]) {
-      if (!over) return;  // sticks: exactly in the matrix
-      for (int a = 0; a < 3; a++) t0[a] = T[a] / norm;
-      slideKeep_[r] = cap / norm;
-      block(t0, slideKeep_[r], R, term);
+    // the part of its spring out of the matrix goes from (t0, keep of slideKeep_; none if it sticks) to
+    // (t, keep; none: it sticks again): the difference leaves the matrix, its wall term F^tot
+    auto changeOut = [&](bool slides, const double *t, double keep) {
+      double R[144] = {0}, term[6] = {0}, before[144] = {0}, termBefore[6] = {0};
+      if (springSlides_[r]) slidePart(tail, wall, t0, slideKeep_[r], before, termBefore);
+      if (slides) slidePart(tail, wall, t, keep, R, term);
+      for (int k = 0; k < size * size; k++) R[k] -= before[k];
       takeOutOfMatrix(base, size, R);
       if (wall)
-        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k];  // its wall term leaves F^tot
-      springSlides_[r] = 1;
+        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k] - termBefore[k];
+      if (slides) {
+        for (int a = 0; a < 3; a++) t0[a] = t[a];
+        slideKeep_[r] = keep;
+      }
+      springSlides_[r] = slides;
+      matrixChanged = true;
+    };
+    if (!springSlides_[r]) {
+      if (!over) return;  // sticks: exactly in the matrix
+      const double t[3] = {T[0] / norm, T[1] / norm, T[2] / norm};
+      changeOut(true, t, cap / norm);
       slidingSwitches_++;
       coulombFlips_[r]++;
-      matrixChanged = true;
     } else if (coulombFrozen_[r]) {
       // slides along t0 for the rest of the solve (below)
     } else if ((!over || T[0] * t0[0] + T[1] * t0[1] + T[2] * t0[2] < cap) && coulombFlips_[r] < maxFlips) {
       // sticks again: under the cap, or its slip turned against the way it slid (T . t < cap: with the spring
       // out along t, a contact the friction can hold shows a slip that flips back and forth); the spring
       // back, the rhs term gone
-      block(t0, slideKeep_[r], before, termBefore);
-      for (int k = 0; k < size * size; k++) before[k] = -before[k];
-      takeOutOfMatrix(base, size, before);
-      if (wall)
-        for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) += termBefore[k];
-      springSlides_[r] = 0;
+      changeOut(false, t0, 0.0);
       stickingSwitches_++;
       coulombFlips_[r]++;
-      matrixChanged = true;
       for (int a = 0; a < 3; a++) next[3 * r + a] = 0;
       return;
     } else if (over) {
@@ -746,17 +741,9 @@ bool ParticleVelocitySystem::consistentCoulombRound()
       // keeps the last, its slide then converging as a chord step, Anderson-mixed)
       const bool renew = coulombRenewals_[r] < maxRenewals &&
                          (t[0] * t0[0] + t[1] * t0[1] + t[2] * t0[2] < turn || keep > stretch * keep0 || keep0 > stretch * keep);
-      if (renew) {  // the Jacobian at this solution: the difference of the two parts out
+      if (renew) {  // the Jacobian at this solution
         coulombRenewals_[r]++;
-        block(t0, keep0, before, termBefore);
-        block(t, keep, R, term);
-        for (int k = 0; k < size * size; k++) R[k] -= before[k];
-        takeOutOfMatrix(base, size, R);
-        if (wall)
-          for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k] - termBefore[k];
-        for (int a = 0; a < 3; a++) t0[a] = t[a];
-        slideKeep_[r] = keep;
-        matrixChanged = true;
+        changeOut(true, t, keep);
       }
     }
     // the rhs term at this solution (a contact past its flips slides at the cap along T even under it; a
@@ -780,14 +767,8 @@ bool ParticleVelocitySystem::consistentCoulombRound()
       // still moving with its Jacobian renewed as often as allowed: it slides on along t0, its whole
       // spring out (the frozen slide of coulomb_solve frozen, for this contact and this solve)
       if (slideKeep_[r] != 0) {
-        block(t0, slideKeep_[r], before, termBefore);
-        block(t0, 0.0, R, term);
-        for (int k = 0; k < size * size; k++) R[k] -= before[k];
-        takeOutOfMatrix(base, size, R);
-        if (wall)
-          for (int k = 0; k < 6; k++) m.frictionRhs(base[0] + k) -= term[k] - termBefore[k];
-        slideKeep_[r] = 0;
-        matrixChanged = true;
+        const double t[3] = {t0[0], t0[1], t0[2]};
+        changeOut(true, t, 0.0);
       }
       coulombFrozen_[r] = 1;
       moves = rhsTerm(&next[3 * r]);

@@ -225,6 +225,9 @@ class ParticleVelocitySystem {
   // for a wall, its wall-velocity term: the whole spring (frozen slides), or along slideDirection_ and
   // (1 - slideKeep_) of it across (consistent slides)
   void removedSpring(size_t record, const double *tail, bool wall, double *R, double *wallTerm) const;
+  // The part of a contact's tangential spring out of the matrix while it slides along t keeping `keep` of it
+  // across t (contact::pairSlideBlock, wallSlideBlock; the wall term into wallTerm)
+  static void slidePart(const double *tail, bool wall, const double *t, double keep, double *R, double *wallTerm);
   // The tangential force a sliding contact applies at w (its unknowns' u - gamma U_n): F_t + the rhs term
   // + the part of its spring still in the matrix
   void slidingForce(size_t record, const double *tail, const double *w, bool wall, double force[3]) const;
