@@ -61,7 +61,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from typing import Dict, Iterator, List, Optional, Tuple
 
-from fdmsubgrid import checkpoint, couettescene, demonly, files, output, results, rheology  # couettescene: a row's time step
+from fdmsubgrid import checkpoint, couettescene, demonly, files, output, results, rheology, suspension  # couettescene: a row's time step
 from fdmsubgrid.shear import steps_planned
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -114,12 +114,12 @@ def makespan(walls: List[float], jobs: int) -> float:
 
 
 def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int, model: str,
-             fluid_every: int = 1, coulomb_solve: str = "frozen") -> Optional[str]:
+             fluid_every: int = 1, coulomb_solve: str = suspension.COULOMB_SOLVE[0]) -> Optional[str]:
     """The run folder couette.py --table8 wrote for this row, sub-grid model, fluid_every and coulomb_solve, if
     any (a folder without the model in its name is from before the name said it: the cut-off model's)."""
     pattern = os.path.join(workdir, "table8_phi%g_*_ad%g_dt%g_seed%d" % (phi, a_over_delta, dt, seed))
     every = "_fluidEvery%d" % fluid_every if fluid_every > 1 else ""
-    every += "" if coulomb_solve == "frozen" else "_coulomb" + coulomb_solve.capitalize()
+    every += suspension.coulomb_tag(coulomb_solve)
     found = sorted(d for d in glob.glob(pattern + "_" + model + every)
                    + (glob.glob(pattern + every) if model == "cutoff" else []) if os.path.isdir(d))
     return found[0] if found else None
@@ -468,7 +468,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                    "couettescene.fluid_dt(phi), %s)" % ", ".join(
                        "%d at %g" % (couettescene.fluid_every(phi), phi) for phi in sorted(couettescene.TABLE8)))
     p.add_argument("--a-over-delta", type=float, default=3.0)
-    p.add_argument("--coulomb-solve", choices=("frozen", "consistent"), default="frozen",
+    p.add_argument("--coulomb-solve", choices=suspension.COULOMB_SOLVE, default=suspension.COULOMB_SOLVE[0],
                    help="how a contact slides within its step (fix fdm/couple coulomb_solve, docs/contact.md 2c)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--model", choices=("calibrated", "cutoff"), default="calibrated",

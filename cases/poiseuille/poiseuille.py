@@ -200,9 +200,7 @@ def main(argv: list[str] | None = None) -> dict:
                                                  "records" if args.from_records else "seed%d" % args.seed,
                                                  "_" + args.model,
                                                  "_fluidEvery%d" % args.fluid_every if args.fluid_every > 1 else "")
-    if args.coulomb_solve != suspension.COULOMB_SOLVE[0]:
-        name += "_coulomb" + args.coulomb_solve.capitalize()
-    name += couettescene.sizes_tag(sizes)
+    name += suspension.coulomb_tag(args.coulomb_solve) + couettescene.sizes_tag(sizes)
     run_dir = os.path.join(args.workdir, name)
     if os.path.exists(run_dir):
         if not args.overwrite:

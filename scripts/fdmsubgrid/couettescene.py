@@ -196,9 +196,7 @@ def run_name(phi: float, size, a_over_delta: float, dt: float, seed: int, accele
                                                   + "_" + model)
     if fluid_every > 1:
         name += "_fluidEvery%d" % fluid_every
-    if coulomb_solve != suspension.COULOMB_SOLVE[0]:
-        name += "_coulomb" + coulomb_solve.capitalize()
-    name += sizes_tag(sizes)
+    name += suspension.coulomb_tag(coulomb_solve) + sizes_tag(sizes)
     if table8:
         name = "table8_" + name
     return name

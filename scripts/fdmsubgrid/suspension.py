@@ -155,6 +155,11 @@ HELD_DRAG = ("extrapolated", "constant")
 COULOMB_SOLVE = ("frozen", "consistent")
 
 
+def coulomb_tag(coulomb_solve: str) -> str:
+    """What a run folder's name adds for its coulomb_solve: nothing for the default, else e.g. _coulombConsistent."""
+    return "" if coulomb_solve == COULOMB_SOLVE[0] else "_coulomb" + coulomb_solve.capitalize()
+
+
 def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_delta: float, dt: float, steps: int,
                dump_every: int, tol_lambda: float, acceleration: str, n_max: int = 50, write_every: int = 100000,
                text_dump: bool = False, model: str = "calibrated", wall_velocities: tuple[float, float] = (0.0, 0.0),
