@@ -704,9 +704,10 @@ def test_resume_with_another_coulomb_solve_is_refused_and_loses_nothing(tmp_path
 SNAPSHOT_STEP = 20
 SCENE = "tests/test_resume.py make_scene(root, fix_extra='%s')" % EXTRAPOLATED
 # the largest position difference from the uninterrupted run over the first 1, 5 and 30 steps after the
-# snapshot (a): measured 0 (step 21 holds the drag: the snapshot's state alone), 4.8e-6 and 4.8e-6 (the
-# inner iteration's tolerance, tolLambda 1e-4, from two starting points); bounds 10 times that
-SNAPSHOT_BOUND = {1: 0.0, 5: 5e-5, 30: 5e-5}
+# snapshot (a): measured 5.3e-9 (step 21 holds the drag: the snapshot's state alone, its velocities and
+# drags rounded to single precision; 0 with the checkpoint's own doubles), 4.8e-6 and 4.8e-6 (the inner
+# iteration's tolerance, tolLambda 1e-4, from two starting points); bounds 10 times that
+SNAPSHOT_BOUND = {1: 5e-8, 5: 5e-5, 30: 5e-5}
 
 
 @pytest.fixture(scope="module")
@@ -729,15 +730,23 @@ def snapshot_case(path):
 
 
 def test_snapshot_is_complete_and_compact(snapshot_dir, env):
-    """The snapshot is the newest checkpoint's DEM file as fdmDEM wrote it (positions, velocities, contact
-    history, the position update's history, the extrapolated held drag's last two fluid steps), the fluid
-    marker, the input, the calibration record, the scene command and a README: 6 plain files, a few kB for
-    3 spheres. A second snapshot replaces the first."""
+    """The snapshot is the newest checkpoint's DEM file compacted (positions, velocities, contact history, the
+    position update's history, the extrapolated held drag's last two fluid steps; the exact arrays as fdmDEM
+    wrote them, the velocity-like ones to single precision, the outputs every step recomputes zero, xz), the
+    fluid marker, the input, the calibration record, the scene command and a README: 6 plain files, a few kB
+    for 3 spheres. A second snapshot replaces the first."""
     root, dest = snapshot_dir
-    assert sorted(os.listdir(dest)) == ["README", "calibration.json", "dem.20", "fluid.20", "in.couette", "scene"]
-    with open(os.path.join(dest, "dem.20"), "rb") as f, open(checkpoint.dem_file(root, 20), "rb") as g:
-        assert f.read() == g.read()
-    header, arrays = checkpoint.read_dem_checkpoint(os.path.join(dest, "dem.20"))
+    assert sorted(os.listdir(dest)) == ["README", "calibration.json", "dem.20.xz", "fluid.20", "in.couette", "scene"]
+    header, arrays = checkpoint.read_dem_checkpoint(os.path.join(dest, "dem.20.xz"))
+    _, written = checkpoint.read_dem_checkpoint(checkpoint.dem_file(root, 20))
+    assert sorted(arrays) == sorted(written)
+    for name, values in written.items():
+        if name in checkpoint.SNAPSHOT_RECOMPUTED:
+            assert arrays[name] == [0.0] * len(values), name
+        elif name in checkpoint.SNAPSHOT_SINGLE:
+            assert np.allclose(arrays[name], values, rtol=1e-7, atol=0), name
+        else:
+            assert arrays[name] == values, name
     assert header["step"] == 20 and header["natoms"] == 3
     assert len(arrays["atoms"]) == 14 * 3
     assert arrays["heldDrag"][0] == 1 and len(arrays["heldDragLast"]) == len(arrays["heldDragBefore"]) == 6 * 3
@@ -760,7 +769,7 @@ def test_snapshot_is_complete_and_compact(snapshot_dir, env):
     with open(checkpoint.dem_file(copy, 20), "r+b") as f:
         f.truncate(100)
     assert checkpoint.snapshot(copy, other, scene=SCENE)["step"] == 15
-    assert sorted(n for n in os.listdir(other) if n[0] in "df") == ["dem.15", "fluid.15"]
+    assert sorted(n for n in os.listdir(other) if n[0] in "df") == ["dem.15.xz", "fluid.15"]
 
 
 def test_snapshot_continues_close_to_the_uninterrupted_run(snapshot_dir, tmp_path, env, reference_extrapolated):
@@ -848,7 +857,7 @@ def test_snapshot_of_another_scene_is_refused(snapshot_dir, tmp_path, env):
             "fdm/subgrid model cutoff contact 400 200 0.5 0.05" % dest)
     # another particle count (the data file)
     root = make_scene(str(tmp_path / "natoms"), fix_extra=EXTRAPOLATED, spheres=[(5.0, 2.55, 3.0, 1.0), (3.0, 3.45, 3.0, 1.0)])
-    refused(root, "spheres.data has 2 particles, the snapshot %s/dem.20 holds 3" % dest)
+    refused(root, "spheres.data has 2 particles, the snapshot %s/dem.20.xz holds 3" % dest)
     # a calibration record of another table
     changed = str(tmp_path / "changed")
     shutil.copytree(dest, changed)

@@ -31,8 +31,8 @@ in a small folder of plain files, to keep (e.g. in git) when the run folder may 
 recomputed from the particles:
 
     python3 -m fdmsubgrid.checkpoint snapshot CASE DEST [--scene COMMAND] [--dem-input NAME]
-                                                 write DEST (replacing the snapshot there): dem.STEP
-                                                 (the DEM checkpoint as fdmDEM wrote it), fluid.STEP (the
+                                                 write DEST (replacing the snapshot there): dem.STEP.xz
+                                                 (the DEM checkpoint, compacted), fluid.STEP (the
                                                  fluid marker), the LIGGGHTS input, calibration.json (the
                                                  run's CASE/.fdmRun-calibration), scene (the command that
                                                  writes the scene: --scene, else CASE/scene) and README
@@ -49,8 +49,10 @@ recomputed from the particles:
                                                  calibration record installed as CASE's checkpoint of STEP
 """
 import array
+import errno
 import hashlib
 import json
+import lzma
 import os
 import re
 import shlex
@@ -87,11 +89,23 @@ def fluid_marker(case_dir, step):
     return os.path.join(case_dir, "fluid", "checkpoint", "fluid.%d" % step)
 
 
+def _dem_bytes(path: str) -> bytes:
+    """The bytes of a particle checkpoint: the file, or a compact snapshot's dem.STEP.xz decompressed."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if path.endswith(SNAPSHOT_DEM_SUFFIX):
+        try:
+            return lzma.decompress(data)
+        except lzma.LZMAError as e:
+            raise OSError(errno.EIO, "not an intact xz file: %s" % e)
+    return data
+
+
 def dem_problem(path):
-    """None if the particle checkpoint at path is complete and intact, else what is wrong."""
+    """None if the particle checkpoint at path (or a snapshot's dem.STEP.xz) is complete and intact, else what is
+    wrong."""
     try:
-        with open(path, "rb") as f:
-            data = f.read()
+        data = _dem_bytes(path)
     except OSError as e:
         return "cannot be read (%s)" % e.strerror
     if not data.startswith(DEM_MAGIC):
@@ -520,9 +534,7 @@ def write_scene_command(case_dir: str, script: str, argv: list[str]) -> str:
 
 def _dem_header(path: str) -> dict:
     """The header entries of a DEM checkpoint (step, lastStep, natoms, dt, boxlo, boxhi)."""
-    with open(path, "rb") as f:
-        f.readline()
-        words = f.readline().decode(errors="replace").split()
+    words = _dem_bytes(path).split(b"\n", 2)[1].decode(errors="replace").split()
     entries = dict(w.split("=", 1) for w in words if "=" in w)
     try:
         return dict(step=int(entries["step"]), lastStep=int(entries["lastStep"]), natoms=int(entries["natoms"]),
@@ -540,8 +552,7 @@ def read_dem_checkpoint(path: str) -> tuple[dict, dict]:
     if problem:
         raise CheckpointError("%s %s" % (path, problem))
     header = _dem_header(path)
-    with open(path, "rb") as f:
-        data = f.read()
+    data = _dem_bytes(path)
     counts, pos = [], len(DEM_MAGIC)
     pos = data.index(b"\n", pos) + 1                       # the header line
     while not data.startswith(b"data ", pos):
@@ -557,6 +568,41 @@ def read_dem_checkpoint(path: str) -> tuple[dict, dict]:
         arrays[name] = values.tolist()
         pos += 8 * count
     return header, arrays
+
+
+# A compact snapshot's particle checkpoint, dem.STEP.xz: fdmDEM's checkpoint with the arrays every step
+# recomputes from the others set to zero (the last step's sub-grid forces and stresslet sums), the velocity-like
+# ones rounded to single precision (their rounding, 6e-8 of themselves, is far below the inner iteration's
+# tolerance, which the snapshot's fluid from rest already costs: docs/coupling.md, "Compact snapshot"), then
+# xz-compressed. Positions, image flags, radii, the contact histories (integers kept in their bits) and the
+# position update's x_n stay exact. It installs as a plain checkpoint (snapshot_install).
+SNAPSHOT_DEM_SUFFIX = ".xz"
+SNAPSHOT_RECOMPUTED = ("stress", "subgrid")
+SNAPSHOT_SINGLE = ("currentVelocity", "previousVelocity", "moveRate", "solution", "hydro", "fluidStress",
+                   "heldDragLast", "heldDragBefore")
+
+
+def encode_dem_checkpoint(header_line: bytes, arrays: dict) -> bytes:
+    """The bytes of a particle checkpoint (dem/particle_checkpoint.h) of the header line (step=... boxhi=...,
+    without its newline) and {name: doubles}, the arrays in name order, with the CRC-32 of their data."""
+    names = sorted(arrays)
+    payload = b"".join(array.array("d", arrays[n]).tobytes() for n in names)
+    lines = b"".join(b"array %s %d\n" % (n.encode(), len(arrays[n])) for n in names)
+    return (DEM_MAGIC + header_line + b"\n" + lines + b"data %d crc32=%d\n" % (len(payload), zlib.crc32(payload)) +
+            payload + DEM_TRAILER)
+
+
+def compact_dem_checkpoint(path: str) -> bytes:
+    """The compact snapshot form (dem.STEP.xz, above) of the particle checkpoint at path."""
+    _, arrays = read_dem_checkpoint(path)
+    for name in SNAPSHOT_RECOMPUTED:
+        if name in arrays:
+            arrays[name] = [0.0] * len(arrays[name])
+    for name in SNAPSHOT_SINGLE:
+        if name in arrays:
+            arrays[name] = array.array("d", array.array("f", arrays[name])).tolist()
+    header_line = _dem_bytes(path).split(b"\n", 2)[1]
+    return lzma.compress(encode_dem_checkpoint(header_line, arrays), preset=9 | lzma.PRESET_EXTREME)
 
 
 def _dem_input_name(case_dir: str, dem_input: str | None) -> str:
@@ -591,7 +637,8 @@ def snapshot(case_dir: str, dest: str, scene: str | None = None, dem_input: str 
     new = dest + ".new"
     shutil.rmtree(new, ignore_errors=True)
     os.makedirs(new)
-    shutil.copyfile(dem_file(case_dir, step), os.path.join(new, "dem.%d" % step))
+    with open(os.path.join(new, "dem.%d%s" % (step, SNAPSHOT_DEM_SUFFIX)), "wb") as f:
+        f.write(compact_dem_checkpoint(dem_file(case_dir, step)))
     shutil.copyfile(fluid_marker(case_dir, step), os.path.join(new, "fluid.%d" % step))
     shutil.copyfile(os.path.join(case_dir, "dem", name), os.path.join(new, name))
     # the table by its hash (what a continued run is checked against) and its path as the project names it:
@@ -618,8 +665,8 @@ def snapshot(case_dir: str, dest: str, scene: str | None = None, dem_input: str 
                 "To continue it: write the scene with the command in %s (in a new folder CASE), then\n"
                 "    fdmRun --from-snapshot THIS_FOLDER CASE\n"
                 "(case scripts: add --from-snapshot THIS_FOLDER to the command). The fluid restarts from rest.\n"
-                "dem.%d: the particles, their contact history and the position update's history (fdmDEM's\n"
-                "checkpoint, dem/particle_checkpoint.h); fluid.%d: the fluid's step, time and step count;\n"
+                "dem.%d.xz: the particles, their contact history and the position update's history (fdmDEM's\n"
+                "checkpoint, dem/particle_checkpoint.h, compacted); fluid.%d: the fluid's step, time and step count;\n"
                 "%s: the LIGGGHTS input; %s: the calibration table the run used.\n"
                 % (step, marker["time"], SCENE_FILE, step, step, name, SNAPSHOT_CALIBRATION))
     check_snapshot(new)
@@ -640,7 +687,9 @@ def check_snapshot(dest: str) -> dict:
         raise CheckpointError("%s is not a folder (a compact snapshot: python3 -m fdmsubgrid.checkpoint snapshot)"
                               % dest)
     names = os.listdir(dest)
-    dem = _steps(dest, "dem.")
+    compact = [int(n[4:-len(SNAPSHOT_DEM_SUFFIX)]) for n in names
+               if re.fullmatch(r"dem\.\d+" + re.escape(SNAPSHOT_DEM_SUFFIX), n)]
+    dem = sorted(_steps(dest, "dem.") + compact)     # a snapshot taken before they were compacted: dem.STEP
     fluid = _steps(dest, "fluid.")
     inputs = [n for n in names if n.startswith("in.")]
     if len(dem) != 1 or fluid != dem:
@@ -654,7 +703,7 @@ def check_snapshot(dest: str) -> dict:
         if n not in names:
             raise CheckpointError("%s is not a complete snapshot: %s is missing" % (dest, n))
     step = dem[0]
-    path = os.path.join(dest, "dem.%d" % step)
+    path = os.path.join(dest, "dem.%d%s" % (step, SNAPSHOT_DEM_SUFFIX if compact else ""))
     problem = dem_problem(path)
     if problem:
         raise CheckpointError("%s %s" % (path, problem))
@@ -824,8 +873,7 @@ def snapshot_install(dest: str, case_dir: str, dem_input: str, np_fluid: int, un
                 shutil.copyfile(os.path.join(source, n), os.path.join(target, n))
     # the DEM checkpoint as if this run had written it: its last step this run's (the header line, outside the
     # CRC of the data), so that a plain --resume from it, before the run's own first checkpoint, ends there too
-    with open(snap["dem"], "rb") as f:
-        data = f.read()
+    data = _dem_bytes(snap["dem"])
     start = len(DEM_MAGIC)
     end = data.index(b"\n", start)
     line = re.sub(rb"\blastStep=\d+", b"lastStep=%d" % last, data[start:end])
