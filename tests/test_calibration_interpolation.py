@@ -223,17 +223,20 @@ def test_scene_table(tmp_path, env):
 
 def test_the_measure_command_meshes_its_boxes_in_whole_cells():
     # a refused pair of a scene at a1/Delta 4 with radius 1.4 is at a/Delta 5.6: the default 8 and 12 a1 boxes
-    # would be 44.8 and 67.2 cells (foamcase refuses them); the command's boxes are the next whole-cell sizes
+    # would be 44.8 and 67.2 cells (foamcase refuses them); the command's boxes are the next sizes of an even
+    # number of cells (the gap's centre, at L/2 plus its offset, at the same place in the mesh in both boxes)
     from fdmsubgrid import foamcase
     for kind, a_over_delta, ratio in (("pair", 5.6, 1.0), ("wall", 5.6, 1.0), ("pair", 4.2, 1.4), ("pair", 3.0, 2.0)):
         words = subgridinterp.measure_command(kind, a_over_delta, ratio).split()
         boxes = [float(w) for w in words[words.index("--boxes") + 1:][:2]] if "--boxes" in words else [8.0, 12.0]
         depth = 1.25 if kind == "wall" else 1.0
         for L, default in zip(boxes, subgridinterp.calibration_boxes(ratio) if kind == "pair" else (8.0, 12.0)):
-            # at most a cell more (a wall's 1.25 L: at most 3 more, its cell count a multiple of 4)
-            assert default <= L < default + (4 if kind == "wall" else 1) / a_over_delta, (kind, a_over_delta, L)
+            # at most two cells more (a wall's 1.25 L: at most 3 more, its cell count a multiple of 4)
+            assert default <= L < default + (4 if kind == "wall" else 2) / a_over_delta, (kind, a_over_delta, L)
+            assert round(L * a_over_delta) % 2 == 0, (kind, a_over_delta, L)
             foamcase.Box((0, 0, 0), (L, depth * L, L), 1.0 / a_over_delta)   # raises if not whole cells
     assert "--boxes 12 16" in subgridinterp.measure_command("pair", 3.0, 2.0)
+    assert "--boxes 8.214285714 12.14285714" in subgridinterp.measure_command("pair", 5.6, 1.0)   # 46, 68 cells
 
 
 def test_held_back_equal_pair_at_a_over_delta_5_6(blocks):

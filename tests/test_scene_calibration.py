@@ -86,7 +86,7 @@ def test_a_pair_beyond_the_interpolation_is_refused_one_line(tmp_path, capsys):
     assert lines[1].startswith("  the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated, "
                                "interpolation error 3.0 % > 2 %; measure it (about ")
     assert lines[1].endswith("core-seconds): python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 "
-                             "--no-wall --boxes 8.035714286 12.14285714 --out my_calibration.dat")  # 45, 68 cells
+                             "--no-wall --boxes 8.214285714 12.14285714 --out my_calibration.dat")  # 46, 68 cells
     assert lines[2] == "  interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.3 %)"
     assert lines[3].startswith("  dem/resistance/data/subgrid_calibration.dat has pairs")
     assert lines[4].startswith("  or --model cutoff")
