@@ -280,7 +280,8 @@ def project_relative(path: str) -> str:
 
 def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str, tangential: bool = False,
                        pair_tangential: bool = False) -> str:
-    """The one command that measures and analyses these calibrations again."""
+    """The one command that measures and analyses these calibrations again (one set of boxes and positions;
+    regenerate_commands splits a table measured in parts)."""
     ads = sorted({c.a_over_delta for c in calibrations})
     ratios = sorted({c.ratio for c in calibrations if c.kind == "pair"})
     c0 = calibrations[0]
@@ -289,12 +290,37 @@ def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str, tan
     words += (["--ratios"] + ["%g" % r for r in ratios]) if ratios else ["--no-pairs"]
     if not any(c.kind == "wall" for c in calibrations):
         words.append("--no-wall")
-    words += ["--boxes"] + ["%g" % L for L in c0.boxes] + ["--offsets", str(n_offsets)]
+    words += ["--boxes"] + ["%.10g" % L for L in c0.boxes] + ["--offsets", str(n_offsets)]
     if tangential:
         words.append("--tangential")
     if pair_tangential:
         words.append("--pair-tangential")
     return " ".join(words + ["--out", out])
+
+
+def regenerate_commands(calibrations: Sequence[SqueezeCalibration], out: str, tangential: Sequence[float] = (),
+                        pair_tangential: Sequence[tuple] = ()) -> List[str]:
+    """The commands that measure these calibrations again, one per a1/Delta whose blocks share their kinds,
+    ratios, boxes and positions, those of equal content merged (a table measured in parts: e.g. a1/Delta 3-5
+    with walls and a later equal pair at 5.6 in boxes of whole cells). tangential: the a/Delta of the wall
+    tangential blocks; pair_tangential: the (a1/Delta, ratio) of the pair tangential ones."""
+    def content(ad):
+        group = [c for c in calibrations if c.a_over_delta == ad]
+        n_offsets = len(next(iter(group[0].velocities.values())))
+        pairs = tuple(sorted({c.ratio for c in group if c.kind == "pair"}))
+        return (pairs, any(c.kind == "wall" for c in group), tuple(group[0].boxes), n_offsets,
+                ad in tangential, all((ad, r) in pair_tangential for r in pairs) and bool(pairs))
+    groups: List[tuple] = []
+    for ad in sorted({c.a_over_delta for c in calibrations}):
+        key = content(ad)
+        for g in groups:
+            if g[0] == key:
+                g[1].append(ad)
+                break
+        else:
+            groups.append((key, [ad]))
+    return [regenerate_command([c for c in calibrations if c.a_over_delta in ads], out, key[4], key[5])
+            for key, ads in groups]
 
 
 def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Sequence[Dict],
@@ -315,9 +341,14 @@ def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Seq
         f.write("# pair_K11, pair_K12, pair_K22, pair_Ktw (scripts/fdmsubgrid/pairtangential.py): K on the pair's\n")
         f.write("# internal modes (sliding q1, rolling q2, twist) in units of eta a1, eta a1^2, eta a1^3, eta a1^3, for\n")
         f.write("# sphere 1 the smaller one; header: kind a1/Delta a2/a1 rows xi_c p fit_rms; rows: xi  xi*K\n")
-        f.write("# Regenerate: %s\n" % regenerate_command(calibrations, project_relative(path), bool(tangential),
-                                                        bool(pair_tangential)))
-        if "from-raw" in command:
+        commands = regenerate_commands(calibrations, project_relative(path), [t["a_over_delta"] for t in tangential],
+                                       [(t["a_over_delta"], t["ratio"]) for t in pair_tangential])
+        for k, line in enumerate(commands):
+            f.write("# Regenerate: %s\n" % line if k == 0 else "#   and: %s\n" % line)
+        if len(commands) > 1:
+            f.write("# (measured in parts: their measurements analysed together with --from-raw, "
+                    "--tangential-from-raw, --pair-tangential-from-raw)\n")
+        elif "from-raw" in command:
             f.write("# (this file was analysed from the measurements kept by earlier calls: --from-raw, "
                     "--tangential-from-raw, --pair-tangential-from-raw)\n")
         for c, fit, rows in zip(calibrations, fits, tables):
