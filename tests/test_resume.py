@@ -869,8 +869,8 @@ def test_snapshot_of_another_scene_is_refused(snapshot_dir, tmp_path, env):
     incomplete = str(tmp_path / "incomplete")
     shutil.copytree(dest, incomplete)
     os.remove(os.path.join(incomplete, "fluid.20"))
-    refused(snapshot_case(tmp_path / "incomplete-case"), "is not a complete snapshot: it needs one dem.STEP and the "
-            "fluid.STEP", incomplete)
+    refused(snapshot_case(tmp_path / "incomplete-case"), "is not a complete snapshot: it needs one dem.STEP.xz (or "
+            "dem.STEP) and the fluid.STEP", incomplete)
     # another mesh (cells of 0.4 instead of 0.5: the same input)
     root = snapshot_case(tmp_path / "mesh")
     path = os.path.join(root, "fluid", "system", "blockMeshDict")

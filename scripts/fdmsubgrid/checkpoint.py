@@ -693,7 +693,7 @@ def check_snapshot(dest: str) -> dict:
     fluid = _steps(dest, "fluid.")
     inputs = [n for n in names if n.startswith("in.")]
     if len(dem) != 1 or fluid != dem:
-        raise CheckpointError("%s is not a complete snapshot: it needs one dem.STEP and the fluid.STEP of the same "
+        raise CheckpointError("%s is not a complete snapshot: it needs one dem.STEP.xz (or dem.STEP) and the fluid.STEP of the same "
                               "step, it has %s" % (dest, ", ".join(sorted(n for n in names if n.startswith(("dem.", "fluid."))))
                                                    or "neither"))
     if len(inputs) != 1:
