@@ -71,11 +71,11 @@ class CheckpointError(Exception):
     pass
 
 
-def _steps(directory, prefix):
+def _steps(directory, prefix, suffix=""):
     out = []
     if os.path.isdir(directory):
         for name in os.listdir(directory):
-            m = re.fullmatch(re.escape(prefix) + r"(\d+)", name)
+            m = re.fullmatch(re.escape(prefix) + r"(\d+)" + re.escape(suffix), name)
             if m:
                 out.append(int(m.group(1)))
     return sorted(out)
@@ -108,6 +108,11 @@ def dem_problem(path):
         data = _dem_bytes(path)
     except OSError as e:
         return "cannot be read (%s)" % e.strerror
+    return _dem_data_problem(data)
+
+
+def _dem_data_problem(data: bytes):
+    """dem_problem of a checkpoint's bytes."""
     if not data.startswith(DEM_MAGIC):
         return "is not a particle checkpoint of fdmDEM"
     lines, pos = [], len(DEM_MAGIC)
@@ -532,9 +537,9 @@ def write_scene_command(case_dir: str, script: str, argv: list[str]) -> str:
     return command
 
 
-def _dem_header(path: str) -> dict:
-    """The header entries of a DEM checkpoint (step, lastStep, natoms, dt, boxlo, boxhi)."""
-    words = _dem_bytes(path).split(b"\n", 2)[1].decode(errors="replace").split()
+def _dem_header(path: str, data: bytes | None = None) -> dict:
+    """The header entries of a DEM checkpoint (step, lastStep, natoms, dt, boxlo, boxhi); data: its bytes, if read."""
+    words = (_dem_bytes(path) if data is None else data).split(b"\n", 2)[1].decode(errors="replace").split()
     entries = dict(w.split("=", 1) for w in words if "=" in w)
     try:
         return dict(step=int(entries["step"]), lastStep=int(entries["lastStep"]), natoms=int(entries["natoms"]),
@@ -548,11 +553,26 @@ def read_dem_checkpoint(path: str) -> tuple[dict, dict]:
     """(header, arrays) of a DEM checkpoint file (dem/particle_checkpoint.h): the header entries as
     _dem_header gives them and {name: list of floats} for each array, e.g. arrays["atoms"] (14 per particle)
     or arrays["heldDragLast"]. CheckpointError if the file is not complete and intact."""
-    problem = dem_problem(path)
+    _, header, arrays = _read_dem(path)
+    return header, arrays
+
+
+def _checked_dem(path: str) -> tuple[bytes, dict]:
+    """The checkpoint's bytes (decompressed), read once, and its header; CheckpointError if it is not complete
+    and intact."""
+    try:
+        data = _dem_bytes(path)
+    except OSError as e:
+        raise CheckpointError("%s cannot be read (%s)" % (path, e.strerror))
+    problem = _dem_data_problem(data)
     if problem:
         raise CheckpointError("%s %s" % (path, problem))
-    header = _dem_header(path)
-    data = _dem_bytes(path)
+    return data, _dem_header(path, data)
+
+
+def _read_dem(path: str) -> tuple[bytes, dict, dict]:
+    """read_dem_checkpoint with the checkpoint's bytes (decompressed), read once."""
+    data, header = _checked_dem(path)
     counts, pos = [], len(DEM_MAGIC)
     pos = data.index(b"\n", pos) + 1                       # the header line
     while not data.startswith(b"data ", pos):
@@ -567,7 +587,7 @@ def read_dem_checkpoint(path: str) -> tuple[dict, dict]:
         values.frombytes(data[pos:pos + 8 * count])
         arrays[name] = values.tolist()
         pos += 8 * count
-    return header, arrays
+    return data, header, arrays
 
 
 # A compact snapshot's particle checkpoint, dem.STEP.xz: fdmDEM's checkpoint with the arrays every step
@@ -594,14 +614,14 @@ def encode_dem_checkpoint(header_line: bytes, arrays: dict) -> bytes:
 
 def compact_dem_checkpoint(path: str) -> bytes:
     """The compact snapshot form (dem.STEP.xz, above) of the particle checkpoint at path."""
-    _, arrays = read_dem_checkpoint(path)
+    data, _, arrays = _read_dem(path)
     for name in SNAPSHOT_RECOMPUTED:
         if name in arrays:
             arrays[name] = [0.0] * len(arrays[name])
     for name in SNAPSHOT_SINGLE:
         if name in arrays:
             arrays[name] = array.array("d", array.array("f", arrays[name])).tolist()
-    header_line = _dem_bytes(path).split(b"\n", 2)[1]
+    header_line = data.split(b"\n", 2)[1]
     return lzma.compress(encode_dem_checkpoint(header_line, arrays), preset=9 | lzma.PRESET_EXTREME)
 
 
@@ -687,8 +707,7 @@ def check_snapshot(dest: str) -> dict:
         raise CheckpointError("%s is not a folder (a compact snapshot: python3 -m fdmsubgrid.checkpoint snapshot)"
                               % dest)
     names = os.listdir(dest)
-    compact = [int(n[4:-len(SNAPSHOT_DEM_SUFFIX)]) for n in names
-               if re.fullmatch(r"dem\.\d+" + re.escape(SNAPSHOT_DEM_SUFFIX), n)]
+    compact = _steps(dest, "dem.", SNAPSHOT_DEM_SUFFIX)
     dem = sorted(_steps(dest, "dem.") + compact)     # a snapshot taken before they were compacted: dem.STEP
     fluid = _steps(dest, "fluid.")
     inputs = [n for n in names if n.startswith("in.")]
@@ -704,10 +723,7 @@ def check_snapshot(dest: str) -> dict:
             raise CheckpointError("%s is not a complete snapshot: %s is missing" % (dest, n))
     step = dem[0]
     path = os.path.join(dest, "dem.%d%s" % (step, SNAPSHOT_DEM_SUFFIX if compact else ""))
-    problem = dem_problem(path)
-    if problem:
-        raise CheckpointError("%s %s" % (path, problem))
-    header = _dem_header(path)
+    _, header = _checked_dem(path)
     marker = read_fluid_marker(os.path.join(dest, "fluid.%d" % step))
     if header["step"] != step or int(marker["step"]) != step:
         raise CheckpointError("%s: dem.%d holds step %d and fluid.%d step %s" % (dest, step, header["step"], step,
