@@ -259,13 +259,7 @@ def test_held_back_equal_pair_at_a_over_delta_5_6(blocks):
 def test_the_table_names_the_commands_that_measure_it_again():
     """The shipped table's header line is the one command of its measurements; a table measured in parts (a block
     at another resolution in other boxes, no walls) gets one command per part, each meshable as written."""
-    def squeeze(path, key=None):
-        with open(path) as f:
-            data = json.load(f)
-        keys = calibration.SqueezeCalibration.__dataclass_fields__.keys()
-        return [calibration.SqueezeCalibration(**{k: v for k, v in d.items() if k in keys})
-                for d in (data if key is None else data[key])]
-    shipped = squeeze(os.path.join(PROJECT, subgridinterp.SHIPPED_JSON))
+    shipped = [b.calibration() for b in subgridinterp.load_blocks()]
     out = "dem/resistance/data/subgrid_calibration.dat"
     tangential = [3.0, 4.0, 5.0]
     pairs = [(a, r) for a in tangential for r in (1.0, 1.4)]
@@ -273,8 +267,8 @@ def test_the_table_names_the_commands_that_measure_it_again():
     with open(os.path.join(PROJECT, out)) as f:
         header = [line for line in f if line.startswith("# Regenerate: ")]
     assert header == ["# Regenerate: %s\n" % command]
-    extra = squeeze(os.path.join(PROJECT, "docs", "data", "validation_calibrationInterpolation_ratio1_ad5.6.json"),
-                    "calibrations")
+    with open(os.path.join(PROJECT, "docs", "data", "validation_calibrationInterpolation_ratio1_ad5.6.json")) as f:
+        extra = [subgridinterp.CollapsedBlock.from_summary(d).calibration() for d in json.load(f)["calibrations"]]
     commands = calibration.regenerate_commands(shipped + extra, out, tangential, pairs + [(5.6, 1.0)])
     assert commands == [command, "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 --no-wall --boxes "
                                  "8.035714286 12.14285714 --offsets 4 --pair-tangential --out " + out]
