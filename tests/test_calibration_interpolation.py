@@ -237,6 +237,14 @@ def test_the_measure_command_meshes_its_boxes_in_whole_cells():
             foamcase.Box((0, 0, 0), (L, depth * L, L), 1.0 / a_over_delta)   # raises if not whole cells
     assert "--boxes 12 16" in subgridinterp.measure_command("pair", 3.0, 2.0)
     assert "--boxes 8.214285714 12.14285714" in subgridinterp.measure_command("pair", 5.6, 1.0)   # 46, 68 cells
+    # the tangential wall calibration's three boxes (L x 1.25 L x L) likewise: the shipped ones unchanged
+    from fdmsubgrid import wallcalibration
+    for a_over_delta in (3.0, 4.0, 5.0):
+        assert wallcalibration.box_sizes(a_over_delta) == list(wallcalibration.BOXES)
+    cells = [L * 5.6 for L in wallcalibration.box_sizes(5.6)]
+    assert cells == pytest.approx([48, 68, 92])
+    for L in wallcalibration.box_sizes(5.6):
+        foamcase.Box((0, 0, 0), (L, wallcalibration.H_OVER_L * L, L), 1.0 / 5.6)
 
 
 def test_held_back_equal_pair_at_a_over_delta_5_6(blocks):

@@ -499,8 +499,8 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
                    "kept (<workdir>/measurements.json, or the .json beside a table) instead of running")
     p.add_argument("--tangential", action="store_true", help="also measure the tangential wall functions "
                    "(wallcalibration.py) at every --a-over-delta")
-    p.add_argument("--tangential-from-raw", metavar="JSON", help="the tangential wall measurements of an earlier "
-                   "run (wall_tangential_calibration.json beside a table, or wallcalibration --out)")
+    p.add_argument("--tangential-from-raw", metavar="JSON", nargs="+", help="the tangential wall measurements of "
+                   "earlier runs (wall_tangential_calibration.json beside a table, or wallcalibration --out)")
     p.add_argument("--pair-tangential", action="store_true", help="also measure the pairs' sliding, rolling and "
                    "twist (pairtangential.py) at every --a-over-delta and --ratios")
     p.add_argument("--pair-tangential-from-raw", metavar="JSON", nargs="+", help="the tangential pair measurements "
@@ -566,8 +566,9 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
               flush=True)
     tangential: List[Dict] = []
     if args.tangential_from_raw:
-        with open(args.tangential_from_raw) as f:
-            tangential = [wallcalibration.summary(wallcalibration.from_summary(d)) for d in json.load(f)]
+        for path in args.tangential_from_raw:
+            with open(path) as f:
+                tangential += [wallcalibration.summary(wallcalibration.from_summary(d)) for d in json.load(f)]
     elif args.tangential:
         for ad in args.a_over_delta:
             tangential.append(wallcalibration.summary(wallcalibration.measure(

@@ -41,7 +41,7 @@ from typing import Dict, List, NamedTuple, Sequence, Tuple
 
 import numpy as np
 
-from . import calibration
+from . import calibration, foamcase
 
 # The shipped measurements the interpolation starts from (beside the shipped table), and the direct
 # calibrations held back from it to measure its error.
@@ -286,21 +286,6 @@ def calibration_boxes(ratio: float) -> Tuple[float, float]:
     return (6.0 * ratio, 8.0 * ratio)
 
 
-def whole_cell_box(L: float, a_over_delta: float, depth: float = 1.0) -> float:
-    """The smallest box size >= L (in a1) whose extents L and depth L are whole, even numbers of cells of
-    a1/a_over_delta (the mesh is cubic cells; at a1/Delta 5.6 the 8 a1 box would be 44.8 cells: 8.2143 a1, 46 cells).
-    Even, because the calibration scenes put the gap's centre at L/2 plus its offset in the cell: the box
-    correction compares the same position in the mesh in both boxes only if L/2 falls on a cell face in both
-    (an odd box puts it on a cell centre; the pair tangential at a1/Delta 5.6 in boxes of 45 and 68 cells had
-    the two boxes 4-9 % apart in sliding, where at a1/Delta 5, 40 and 60 cells, they agree within 0.5 %)."""
-    first = math.ceil(L * a_over_delta - 1e-9)
-    for cells in range(first, first + 400):
-        if cells % 2 == 0 and abs(depth * cells - round(depth * cells)) < 1e-9:
-            return cells / a_over_delta
-    raise ValueError("no box of about %g a1 at a1/Delta %g has whole numbers of cells along L and %g L"
-                     % (L, a_over_delta, depth))
-
-
 def _depth(kind: str) -> float:
     return 1.0 if kind == "pair" else 1.25        # the wall's channel is L x 1.25 L x L
 
@@ -309,7 +294,7 @@ def measure_command(kind: str, a_over_delta: float, ratio: float) -> str:
     """The one command that calibrates (kind, a1/Delta, a2/a1) directly (its boxes in whole cells)."""
     words = ["python3 -m fdmsubgrid.calibration", "--a-over-delta", "%g" % a_over_delta]
     boxes = calibration_boxes(ratio) if kind == "pair" else calibration.BOXES
-    sizes = [whole_cell_box(L, a_over_delta, _depth(kind)) for L in boxes]
+    sizes = [foamcase.whole_cell_box(L, a_over_delta, _depth(kind)) for L in boxes]
     if kind == "wall":
         words += ["--no-pairs"]
     else:
@@ -322,7 +307,8 @@ def measure_command(kind: str, a_over_delta: float, ratio: float) -> str:
 def calibration_cells(kind: str, a_over_delta: float, ratio: float) -> float:
     """Mesh cells of one direct calibration, summed over its two boxes (the wall's channel is L x 1.25 L x L)."""
     boxes = calibration_boxes(ratio) if kind == "pair" else calibration.BOXES
-    return sum(_depth(kind) * (whole_cell_box(L, a_over_delta, _depth(kind)) * a_over_delta) ** 3 for L in boxes)
+    return sum(_depth(kind) * (foamcase.whole_cell_box(L, a_over_delta, _depth(kind)) * a_over_delta) ** 3
+               for L in boxes)
 
 
 def cost_model(summaries: Sequence[Dict]) -> Tuple[float, float]:

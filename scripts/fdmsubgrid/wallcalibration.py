@@ -80,7 +80,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from . import deminput, squeeze, theory
+from . import deminput, foamcase, squeeze, theory
 
 GAPS = [1.0, 0.7, 0.5, 0.3, 0.2, 0.15, 0.1, 0.07, 0.05, 0.03, 0.02, 0.01, 3e-3, 1e-3, 1e-4]
 # (x, z) of the sphere's centre inside its mesh cell, fractions of Delta
@@ -311,10 +311,18 @@ def table_blocks(a_over_delta: float, fits: Dict[str, Dict[str, float]], min_gap
     return rows
 
 
-def measure(a_over_delta: float, workdir: str, gaps: Sequence[float] = GAPS, boxes: Sequence[float] = BOXES,
+def box_sizes(a_over_delta: float) -> List[float]:
+    """BOXES at a/Delta, each the next size whose L and H_OVER_L L are whole, even numbers of cells (BOXES
+    themselves at a/Delta 3, 4, 5; at 5.6: 48, 68 and 92 cells across)."""
+    return [foamcase.whole_cell_box(L, a_over_delta, H_OVER_L) for L in BOXES]
+
+
+def measure(a_over_delta: float, workdir: str, gaps: Sequence[float] = GAPS, boxes: Sequence[float] | None = None,
             offsets: Sequence[Sequence[float]] = OFFSETS, tol_lambda: float = 1e-5,
             np_fluid: int = 1) -> WallTangentialCalibration:
-    """Run the loaded-sphere scenes: every offset in the first box, the first offset in the others."""
+    """Run the loaded-sphere scenes: every offset in the first box, the first offset in the others. boxes:
+    L/a; by default BOXES, each grown to whole, even numbers of cells (box_sizes)."""
+    boxes = box_sizes(a_over_delta) if boxes is None else boxes
     if len(boxes) != 3:
         raise ValueError("wall calibration: three box sizes are needed (M_inf + c2 L^-2 + c3 L^-3), got %s" % boxes)
     cal = WallTangentialCalibration(a_over_delta, list(gaps), list(boxes), [list(o) for o in offsets])
@@ -389,7 +397,8 @@ def plot(path: str, summaries: Sequence[Dict]) -> None:
 def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--a-over-delta", type=float, nargs="+", default=[3.0])
-    p.add_argument("--boxes", type=float, nargs=3, default=list(BOXES), help="the three box sizes L/a")
+    p.add_argument("--boxes", type=float, nargs=3, help="the three box sizes L/a (default %s, in whole, even "
+                   "numbers of cells)" % " ".join("%g" % L for L in BOXES))
     p.add_argument("--offsets", type=int, default=len(OFFSETS), help="positions in the cell averaged (1-4)")
     p.add_argument("--gaps", type=float, nargs="+", default=GAPS, help="eps, largest first")
     p.add_argument("--workdir", default="wall_calibration_runs")
