@@ -2,6 +2,7 @@
 error against direct calibrations held back from it, from the stored measurements (no run), the table it
 writes as the resistance library reads it, and which species pairs of a scene are calibrated, interpolated
 or refused (docs/resistance.md, "Sizes and resolutions outside the table")."""
+import dataclasses
 import json
 import math
 import os
@@ -280,3 +281,11 @@ def test_the_table_names_the_commands_that_measure_it_again():
     commands = calibration.regenerate_commands(shipped + extra, out, tangential, pairs + [(5.6, 1.0)])
     assert commands == [command, "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 --no-wall --boxes "
                                  "8.035714286 12.14285714 --offsets 4 --pair-tangential --out " + out]
+    # a wall at the same a1/Delta in boxes of its own (L x 1.25 L x L in whole cells): a part of its own
+    wall = dataclasses.replace(next(c for c in shipped if c.kind == "wall"), a_over_delta=5.6,
+                               boxes=[8.571428571, 12.14285714])
+    commands = calibration.regenerate_commands(shipped + extra + [wall], out, tangential + [5.6], pairs + [(5.6, 1.0)])
+    assert commands[:2] == [command, "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 --no-wall "
+                                     "--boxes 8.035714286 12.14285714 --offsets 4 --pair-tangential --out " + out]
+    assert commands[2:] == ["python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --no-pairs --boxes 8.571428571 "
+                            "12.14285714 --offsets 4 --tangential --out " + out]

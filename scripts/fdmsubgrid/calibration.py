@@ -300,27 +300,30 @@ def regenerate_command(calibrations: Sequence[SqueezeCalibration], out: str, tan
 
 def regenerate_commands(calibrations: Sequence[SqueezeCalibration], out: str, tangential: Sequence[float] = (),
                         pair_tangential: Sequence[tuple] = ()) -> List[str]:
-    """The commands that measure these calibrations again, one per a1/Delta whose blocks share their kinds,
-    ratios, boxes and positions, those of equal content merged (a table measured in parts: e.g. a1/Delta 3-5
-    with walls and a later equal pair at 5.6 in boxes of whole cells). tangential: the a/Delta of the wall
-    tangential blocks; pair_tangential: the (a1/Delta, ratio) of the pair tangential ones."""
-    def content(ad):
-        group = [c for c in calibrations if c.a_over_delta == ad]
-        n_offsets = len(next(iter(group[0].velocities.values())))
-        pairs = tuple(sorted({c.ratio for c in group if c.kind == "pair"}))
-        return (pairs, any(c.kind == "wall" for c in group), tuple(group[0].boxes), n_offsets,
-                ad in tangential, all((ad, r) in pair_tangential for r in pairs) and bool(pairs))
+    """The commands that measure these calibrations again: one per part measured alike (one a1/Delta, one set of
+    boxes and positions: at a1/Delta 5.6 the pair's boxes of 46 and 68 cells and the wall's of 48 and 68 are two
+    parts), the parts of equal content at several a1/Delta merged (a table measured in parts: e.g. a1/Delta 3-5
+    with walls and a later equal pair and wall at 5.6). tangential: the a/Delta of the wall tangential blocks
+    (measured with the wall's part); pair_tangential: the (a1/Delta, ratio) of the pair tangential ones."""
+    def n_offsets(c):
+        return len(next(iter(c.velocities.values())))
+
+    parts: Dict[tuple, List[SqueezeCalibration]] = {}
+    for c in sorted(calibrations, key=lambda c: (c.a_over_delta, c.kind != "pair", c.ratio)):
+        parts.setdefault((c.a_over_delta, tuple(c.boxes), n_offsets(c)), []).append(c)
     groups: List[tuple] = []
-    for ad in sorted({c.a_over_delta for c in calibrations}):
-        key = content(ad)
+    for (ad, boxes, offsets), part in parts.items():
+        pairs = tuple(sorted({c.ratio for c in part if c.kind == "pair"}))
+        wall = any(c.kind == "wall" for c in part)
+        key = (pairs, wall, boxes, offsets, wall and ad in tangential,
+               bool(pairs) and all((ad, r) in pair_tangential for r in pairs))
         for g in groups:
             if g[0] == key:
-                g[1].append(ad)
+                g[1].extend(part)
                 break
         else:
-            groups.append((key, [ad]))
-    return [regenerate_command([c for c in calibrations if c.a_over_delta in ads], out, key[4], key[5])
-            for key, ads in groups]
+            groups.append((key, list(part)))
+    return [regenerate_command(part, out, key[4], key[5]) for key, part in groups]
 
 
 def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Sequence[Dict],
