@@ -12,6 +12,7 @@ import os
 import subprocess
 import time
 
+import numpy as np
 import pytest
 
 from conftest import PROJECT, assert_refused, load_case_module
@@ -86,7 +87,7 @@ def test_a_pair_beyond_the_interpolation_is_refused_one_line(tmp_path, capsys):
     assert lines[1].startswith("  the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated, "
                                "interpolation error 3.0 % > 2 %; measure it (about ")
     assert lines[1].endswith("core-seconds): python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 "
-                             "--no-wall --boxes 8.214285714 12.14285714 --out my_calibration.dat")  # 46, 68 cells
+                             "--no-wall --boxes 8.214285714 12.14285714 --cache")  # 46, 68 cells
     assert lines[2] == "  interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.3 %)"
     assert lines[3].startswith("  dem/resistance/data/subgrid_calibration.dat has pairs")
     assert lines[4].startswith("  or --model cutoff")
@@ -118,10 +119,89 @@ def test_the_decision_for_walls_alone_and_for_the_shipped_table(tmp_path, capsys
     # without the correction the table does not enter the line
     assert case.subgrid_pair_style(subgrid=False, calibration=finer.table()) == "fdm/subgrid lubrication no"
     with pytest.raises(case.UncalibratedScene, match=r"radius 1 against a wall at a/Delta 7: not calibrated, no "
-                       r"held-back test .* --a-over-delta 7 --no-pairs --out my_calibration.dat"):
+                       r"held-back test .* --a-over-delta 7 --no-pairs --cache"):
         case.scene_calibration("wallShear", [1.0], 1 / 7, walls=True, pairs=False)
     assert case.scene_calibration("wallShear", [1.0], 1 / 7, walls=True, pairs=False, model="cutoff").table() is None
     wall_shear = load_case_module("wallShear")
     assert_refused(wall_shear.main, ["--a-over-delta", "7", "--subgrid-only"],
                    ["wallShear: the sub-grid calibration (model calibrated) lacks 1 of this scene's pairs and walls",
                     "radius 1 against a wall at a/Delta 7"], tmp_path, capsys)
+
+
+def write_measured(folder, summary: dict) -> str:
+    """A table as `calibration --cache` leaves it (FOLDER/<name>/subgrid_calibration.dat), for the held-back
+    direct calibration `summary`: its own header (fit) with the rows the interpolation gives there (the rows of
+    the real command need some 90 s of theory calls; the plumbing is the same)."""
+    block = subgridinterp.CollapsedBlock.from_summary(summary)
+    rows = subgridinterp.interpolated_rows(subgridinterp.load_blocks(), block.kind, block.a_over_delta, block.ratio)
+    name = subgridinterp.measured_name([(block.kind, block.a_over_delta, block.ratio)])
+    os.makedirs(os.path.join(folder, name))
+    path = os.path.join(folder, name, subgridinterp.MEASURED_TABLE)
+    with open(path, "w") as f:
+        f.write("# measured on demand\n")
+        calibration.write_block(f, block.calibration(), summary["fit"], rows)
+    return path
+
+
+def test_a_pair_measured_on_demand_is_found_by_later_scenes(env, tmp_path, monkeypatch, capsys):
+    """Issue 50 item 2, measured on demand: one sphere of radius 2 among spheres of radius 1 at a1/Delta 3
+    between walls is refused for its pair 1-2 (a2/a1 2: 3.0 % > 2 %) with the one command that measures it
+    into the folder later scenes read (`--cache`); with that table there (FDM_CALIBRATIONS), the same scene
+    is written with the shipped table plus the measured block and the interpolated wall of radius 2
+    (a/Delta 6), one line naming both, the resistance library covering the pair with it; the same block
+    measured twice with other values is refused naming both files; --cache does not measure over a kept one."""
+    folder = tmp_path / "calibrations"
+    monkeypatch.setenv(subgridinterp.MEASURED_ENV, str(folder))
+    radii = [1.0] * 6 + [2.0]
+    with pytest.raises(deminput.UncalibratedScene) as refused:
+        deminput.scene_calibration("couette", radii, 1 / 3, walls=True)
+    [line] = [l for l in str(refused.value).splitlines() if "radii 1 and 2" in l]
+    assert "interpolation error 3.0 % > 2 %" in line
+    assert line.endswith("python3 -m fdmsubgrid.calibration --a-over-delta 3 --ratios 2 --no-wall --boxes 12 16 "
+                         "--cache")
+    with open(os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[0])) as f:
+        [summary] = json.load(f)["calibrations"]
+    assert (summary["kind"], summary["a_over_delta"], summary["ratio"]) == ("pair", 3.0, 2.0)
+    path = write_measured(str(folder), summary)
+    assert os.path.dirname(path) == str(folder / "pair_ad3_ratio2")
+    # found: the scene runs with the shipped table, the measured block and the interpolated wall
+    scene = deminput.scene_calibration("couette", radii, 1 / 3, walls=True)
+    assert [(e.kind, e.a_over_delta, e.ratio, e.status) for e in scene.measured] == [("pair", 3.0, 2.0, "measured")]
+    assert [(e.kind, e.a_over_delta, e.status) for e in scene.interpolated] == [("wall", 6.0, "interpolated")]
+    assert scene.tables == [os.path.realpath(path)]
+    assert scene.line() == ("couette: the run reads dem/subgrid_calibration.dat, the shipped table with the calibration "
+                            "measured on demand for radii 1 and 2 (a1/Delta 3, a2/a1 2) (%s) and the squeeze "
+                            "interpolated for radius 2 at a wall (a/Delta 6, error 1.3 %%) (measured on held-back "
+                            "blocks, within 2 %%; the tangential functions there from the cut-off model: "
+                            "docs/resistance.md)" % os.path.realpath(path))
+    table = scene.write(str(tmp_path / "run" / "dem"))
+    assert open(table).read().startswith(open(SHIPPED).read())
+    blocks = calibration.read_table(table)
+    assert set(blocks) - set(calibration.read_table(SHIPPED)) == {("pair", 3.0, 2.0), ("wall", 6.0, 1.0)}
+    assert np.array_equal(blocks[("pair", 3.0, 2.0)][1], calibration.read_table(path)[("pair", 3.0, 2.0)][1])
+    assert blocks[("pair", 3.0, 2.0)][0] != []          # a measured block's header keeps its fit
+    root = tmp_path / "root"
+    (root / "dem" / "resistance" / "data").mkdir(parents=True)
+    (root / "dem" / "resistance" / "data" / "subgrid_calibration.dat").write_text(open(table).read())
+    assert covered(env, root, "--a1", 1, "--a2", 2, "--delta", 1 / 3)["pair"]
+    assert not covered(env, PROJECT, "--a1", 1, "--a2", 2, "--delta", 1 / 3)["pair"]
+    # the couette writer takes it (nothing run)
+    couette = load_case_module("couette")
+    couette.main(["--radii", "1", "2", "--volume-fractions", "0.9", "0.1", "--phi", "0.1", "--size", "12", "12",
+                  "12", "--write-only", "--workdir", str(tmp_path / "couette")])
+    assert "the calibration measured on demand for radii 1 and 2" in capsys.readouterr().out
+    # a second measurement of the same block with other values: refused, both files named
+    other = dict(summary, fit=dict(summary["fit"], r_0=summary["fit"]["r_0"] * 1.01))
+    second = os.path.join(str(folder), "again", subgridinterp.MEASURED_TABLE)
+    os.makedirs(os.path.dirname(second))
+    with open(second, "w") as f:
+        calibration.write_block(f, subgridinterp.CollapsedBlock.from_summary(other).calibration(), other["fit"],
+                                subgridinterp.interpolated_rows(subgridinterp.load_blocks(), "pair", 3.0, 2.0))
+    with pytest.raises(ValueError, match="pair a/Delta 3 ratio 2 is in .* and, with other values, in .*: remove one "
+                                         "of them") as twice:
+        subgridinterp.measured_blocks()
+    assert path in str(twice.value) and second in str(twice.value)
+    # --cache refuses to measure over the kept table
+    with pytest.raises(SystemExit):
+        calibration.main(["--a-over-delta", "3", "--ratios", "2", "--no-wall", "--cache"])
+    assert "holds this measurement already" in capsys.readouterr().err

@@ -172,7 +172,7 @@ def test_an_uncalibrated_scene_is_refused_one_line_per_pair(couette, env, tmp_pa
     assert all("python3 -m fdmsubgrid.calibration --a-over-delta" in line for line in missing)
     assert ("  the pair of radii 1 and 1 at a1/Delta 6 (a2/a1 1): not calibrated, interpolation error 3.0 % > 2 %; "
             "measure it (about 6323 core-seconds): python3 -m fdmsubgrid.calibration --a-over-delta 6 --ratios 1 "
-            "--no-wall --boxes 8 12 --out my_calibration.dat") in missing
+            "--no-wall --boxes 8 12 --cache") in missing
     assert {line.split(":")[0].strip() for line in missing} == {
         "the pair of radii 1 and 1 at a1/Delta 6 (a2/a1 1)", "the pair of radii 1 and 1.4 at a1/Delta 6 (a2/a1 1.4)",
         "the pair of radii 1.4 and 1.4 at a1/Delta 8.4 (a2/a1 1)", "radius 1.4 against a wall at a/Delta 8.4"}

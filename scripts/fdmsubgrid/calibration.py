@@ -494,6 +494,9 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     p.add_argument("--offsets", type=int, default=len(OFFSETS), help="positions in the cell averaged (1-4)")
     p.add_argument("--workdir", default="calibration_runs")
     p.add_argument("--out", help="the table (text); its .json beside it holds every measurement")
+    p.add_argument("--cache", action="store_true", help="instead of --out: the table in a folder of its own under "
+                   "the calibrations measured on demand (FDM_CALIBRATIONS, default calibrations/ in the project), "
+                   "where every later scene finds it (subgridinterp.measured_blocks)")
     p.add_argument("--position-errors", metavar="JSON", help="no run: from the measurements beside a table "
                    "(squeeze_calibration.json), per gap the calibrated model's error averaged over the measured "
                    "positions in the cell and at the worst one, and the floor no correction of the gap alone "
@@ -539,8 +542,21 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     if args.position_errors:
         print_position_errors(args.position_errors)
         return []
+    if args.cache:
+        if args.out or args.from_raw:
+            p.error("--cache measures and keeps its own table: not with --out or --from-raw")
+        from . import subgridinterp
+        jobs = [(kind, ad, ratio) for ad in args.a_over_delta
+                for kind, ratio in (([] if args.no_pairs else [("pair", r) for r in args.ratios])
+                                    + ([] if args.no_wall else [("wall", 1.0)]))]
+        folder = os.path.join(subgridinterp.measured_folder(), subgridinterp.measured_name(jobs))
+        args.out = os.path.join(folder, subgridinterp.MEASURED_TABLE)
+        if os.path.exists(args.out):
+            p.error("--cache: %s holds this measurement already (remove its folder to measure it again)" % args.out)
+        os.makedirs(folder, exist_ok=True)
+        print("calibration: the table goes to %s, where later scenes find it" % args.out, flush=True)
     if not args.out:
-        p.error("--out is required (or --position-errors)")
+        p.error("--out is required (or --position-errors, --cache)")
     if any(r < 1 for r in args.ratios):
         p.error("--ratios: a2/a1 must be >= 1 (a pair 1/1.4 is the pair 1.4 seen from the other sphere)")
     os.makedirs(args.workdir, exist_ok=True)
@@ -552,6 +568,15 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
             with open(path) as f:
                 cals += [SqueezeCalibration(**{k: v for k, v in d.items() if k in keys}) for d in json.load(f)]
     else:
+        from . import subgridinterp
+        model = subgridinterp.cost_model([b.summary for b in subgridinterp.load_blocks()])
+        for ad in args.a_over_delta:
+            for kind, ratio in (([] if args.no_pairs else [("pair", r) for r in args.ratios])
+                                + ([] if args.no_wall else [("wall", 1.0)])):
+                print("calibration: %s a1/Delta %g%s: about %.0f core-seconds (the squeeze; estimated from the shipped "
+                      "calibrations' run times)" % (kind, ad, " a2/a1 %g" % ratio if kind == "pair" else "",
+                                                    subgridinterp.estimated_core_seconds(kind, ad, ratio, model)),
+                      flush=True)
         for ad in args.a_over_delta:
             jobs = (([] if args.no_pairs else [("pair", r) for r in args.ratios])
                     + ([] if args.no_wall else [("wall", 1.0)]))

@@ -142,12 +142,15 @@ SCENE_TABLE = "subgrid_calibration.dat"
 
 class SceneCalibration:
     """The sub-grid calibration table a scene runs with (scene_calibration): the shipped one (`text` None:
-    nothing to write, the pair style reads its default) or the shipped one with the interpolated blocks of
-    the scene's pairs and walls it lacks (`interpolated`: their subgridinterp.PairCoverage, each within
+    nothing to write, the pair style reads its default) or the shipped one with the blocks of the scene's
+    pairs and walls it lacks: measured on demand (`measured`: their subgridinterp.PairCoverage; `tables`, the
+    tables measured on demand they come from) and interpolated (`interpolated`, each within
     subgridinterp.TOLERANCE as measured), written into each run folder's dem/ by `write`."""
 
-    def __init__(self, who: str, text: str | None = None, interpolated: list | None = None) -> None:
+    def __init__(self, who: str, text: str | None = None, interpolated: list | None = None,
+                 measured: list | None = None, tables: list | None = None) -> None:
         self.who, self.text, self.interpolated = who, text, list(interpolated or [])
+        self.measured, self.tables = list(measured or []), list(tables or [])
 
     def table(self) -> str | None:
         """The value of pair_style fdm/subgrid's `calibration` (relative to dem/), None for the shipped table."""
@@ -164,23 +167,28 @@ class SceneCalibration:
         return path
 
     def line(self) -> str | None:
-        """One line saying which pairs and walls are interpolated and their measured error bound, and that
-        only their squeeze is (None for the shipped table)."""
+        """One line saying which pairs and walls are measured on demand (and where) and which are interpolated
+        with their measured error bound, and that only their squeeze is (None for the shipped table)."""
         if self.text is None:
             return None
         from . import subgridinterp
-        return ("%s: the run reads dem/%s, the shipped table with the squeeze interpolated for %s (measured on "
-                "held-back blocks, within %g %%; the tangential functions there from the cut-off model: "
-                "docs/resistance.md)" % (self.who, SCENE_TABLE, "; ".join(_entry_text(e) for e in self.interpolated),
-                                         100 * subgridinterp.TOLERANCE))
+        parts = []
+        if self.measured:
+            parts.append("the calibration measured on demand for %s (%s)" % (
+                "; ".join(_entry_text(e) for e in self.measured), ", ".join(self.tables)))
+        if self.interpolated:
+            parts.append("the squeeze interpolated for %s (measured on held-back blocks, within %g %%; the tangential "
+                         "functions there from the cut-off model: docs/resistance.md)" % (
+                             "; ".join(_entry_text(e) for e in self.interpolated), 100 * subgridinterp.TOLERANCE))
+        return "%s: the run reads dem/%s, the shipped table with %s" % (self.who, SCENE_TABLE, " and ".join(parts))
 
 
 def _entry_text(entry) -> str:
     """An interpolated subgridinterp.PairCoverage in a few words, with its measured error bound."""
+    error = "" if entry.error is None else ", error %.1f %%" % (100 * entry.error)
     if entry.kind == "wall":
-        return "radius %g at a wall (a/Delta %g, error %.1f %%)" % (entry.pair[0], entry.a_over_delta, 100 * entry.error)
-    return "radii %g and %g (a1/Delta %g, a2/a1 %g, error %.1f %%)" % (entry.pair + (entry.a_over_delta, entry.ratio,
-                                                                            100 * entry.error))
+        return "radius %g at a wall (a/Delta %g%s)" % (entry.pair[0], entry.a_over_delta, error)
+    return "radii %g and %g (a1/Delta %g, a2/a1 %g%s)" % (entry.pair + (entry.a_over_delta, entry.ratio, error))
 
 
 def scene_calibration(who: str, radii: Iterable[float], delta: float, walls: bool = False,
@@ -206,6 +214,7 @@ def scene_calibration(who: str, radii: Iterable[float], delta: float, walls: boo
                and (e.kind == "wall" or (pairs and (e.pair[0] != e.pair[1] or counts[e.pair[0]] > 1)))]
     refused = [e for e in entries if e.status == "refused"]
     interpolated = [e for e in entries if e.status == "interpolated"]
+    measured = [e for e in entries if e.status == "measured"]
     if not entries:
         # the resistance library and the interpolation's reading of the table disagree: refuse as the library does
         raise UncalibratedScene(refusal(who, missing))
@@ -218,11 +227,12 @@ def scene_calibration(who: str, radii: Iterable[float], delta: float, walls: boo
                 _entry_text(e) for e in interpolated)))
         lines += ["  " + line for line in missing[-2:]]
         raise UncalibratedScene("\n".join(lines))
-    text, done = subgridinterp.interpolated_table([(e.kind, e.a_over_delta, e.ratio) for e in interpolated])
-    left = [d for d in done if d["status"] != "interpolated"]
+    text, done = subgridinterp.interpolated_table([(e.kind, e.a_over_delta, e.ratio) for e in measured + interpolated])
+    left = [d for d, e in zip(done, measured + interpolated) if d["status"] != e.status]
     if left:
         raise RuntimeError("scene_calibration: coverage() and interpolated_table() disagree on %s" % left)
-    return SceneCalibration(who, text, interpolated)
+    tables = sorted({t for d in done for t in d.get("tables", [])})
+    return SceneCalibration(who, text, interpolated, measured, tables)
 
 
 def write_dem_input(dem_dir, box, spheres, dt=1.0, density=1000.0, fix_options="move no",

@@ -30,6 +30,11 @@ call: the target's correction needs only the blocks' Phi.
 writes the shipped table with the interpolated blocks added whose measured error (`error_bound`) is within
 --max-error (default TOLERANCE), each header marked `interpolated`; the pair style reads it with
 `pair_style fdm/subgrid calibration my_calibration.dat`.
+
+Measured on demand. A pair or wall the interpolation does not reach within TOLERANCE is refused with the one
+command that measures it (`measure_command`, `calibration --cache`): its table goes into a folder of its own
+under `measured_folder()` (FDM_CALIBRATIONS, default calibrations/ in the project), where `coverage` finds it
+for every later scene (status `measured`) and `interpolated_table` adds its blocks to the scene's table.
 """
 from __future__ import annotations
 
@@ -269,8 +274,9 @@ def error_bound(kind: str, distance: Sequence[float], tests: Sequence[HeldBack])
 class PairCoverage(NamedTuple):
     """One species pair of a scene (radii; (a, inf) for a sphere against a wall)."""
     pair: Tuple[float, float]
-    status: str                   # "calibrated", "interpolated" or "refused"
-    error: float | None           # the interpolation's measured error (position-averaged, worst gap); None if calibrated
+    status: str                   # "calibrated", "measured" (on demand), "interpolated" or "refused"
+    error: float | None           # the interpolation's measured error (position-averaged, worst gap); None if
+    #                               calibrated or measured
     kind: str                     # "pair" or "wall"
     a_over_delta: float           # a1/Delta, a1 the smaller sphere (wall: a/Delta)
     ratio: float                  # a2/a1 (wall: 1)
@@ -301,7 +307,7 @@ def measure_command(kind: str, a_over_delta: float, ratio: float) -> str:
         words += ["--ratios", "%g" % ratio, "--no-wall"]
     if kind == "pair" or sizes != list(boxes):
         words += ["--boxes"] + ["%.10g" % L for L in sizes]
-    return " ".join(words + ["--out", "my_calibration.dat"])
+    return " ".join(words + ["--cache"])
 
 
 def calibration_cells(kind: str, a_over_delta: float, ratio: float) -> float:
@@ -326,10 +332,10 @@ def estimated_core_seconds(kind: str, a_over_delta: float, ratio: float, model: 
     return float(math.exp(c + q * math.log(calibration_cells(kind, a_over_delta, ratio))))
 
 
-def _table_grid(table: Dict[tuple, tuple], kind: str, a_over_delta: float, ratio: float) -> bool:
-    """Whether the table covers (kind, a/Delta, ratio) as the resistance library does (subgrid_calibration.cpp,
-    `stencil`): the value itself or the two tabulated values around it, in a/Delta and in ratio, every corner
-    present."""
+def _grid_corners(table, kind: str, a_over_delta: float, ratio: float) -> List[tuple] | None:
+    """The blocks the resistance library reads for (kind, a/Delta, ratio) (subgrid_calibration.cpp, `stencil`):
+    the value itself or the two tabulated values around it, in a/Delta and in ratio; None if a corner is
+    missing or the value lies outside the table. table: any mapping keyed by (kind, a/Delta, ratio)."""
     keys = [k for k in table if k[0] == kind]
 
     def bracket(values, v):
@@ -345,15 +351,82 @@ def _table_grid(table: Dict[tuple, tuple], kind: str, a_over_delta: float, ratio
     a = bracket([k[1] for k in keys], a_over_delta)
     r = bracket([k[2] for k in keys], ratio)
     if a is None or r is None:
-        return False
-    return all((kind, ai, ri) in table for ai in set(a) for ri in set(r))
+        return None
+    corners = sorted({(kind, ai, ri) for ai in a for ri in r})
+    return corners if all(c in table for c in corners) else None
+
+
+def _table_grid(table, kind: str, a_over_delta: float, ratio: float) -> bool:
+    """Whether the table covers (kind, a/Delta, ratio) as the resistance library does (_grid_corners)."""
+    return _grid_corners(table, kind, a_over_delta, ratio) is not None
+
+
+# ---------------------------------------------------------------------------------------------------
+# Calibrations measured on demand
+
+# The folder of the calibrations a user measured (`calibration --cache`): one sub-folder per command, its
+# subgrid_calibration.dat (with the measurements beside it) found by every later scene.
+MEASURED_ENV = "FDM_CALIBRATIONS"
+MEASURED_TABLE = "subgrid_calibration.dat"
+# the blocks that go with a squeeze block of the same (a/Delta, ratio) when it is added to a scene's table
+_COMPANIONS = {"pair": ("pair_K11", "pair_K12", "pair_K22", "pair_Ktw"),
+               "wall": ("wall_YA", "wall_YB", "wall_YC", "wall_XC")}
+
+
+def measured_folder() -> str:
+    """FDM_CALIBRATIONS, or calibrations/ in the project's folder."""
+    folder = os.environ.get(MEASURED_ENV)
+    return folder if folder else _project_file("calibrations")
+
+
+def measured_name(jobs: Sequence[Tuple[str, float, float]]) -> str:
+    """The sub-folder of one `calibration --cache` command: its (kind, a1/Delta, a2/a1) in words."""
+    return "_".join("%s_ad%g%s" % (kind, ad, "_ratio%g" % ratio if kind == "pair" else "") for kind, ad, ratio in jobs)
+
+
+def _block_texts(path: str) -> Dict[tuple, str]:
+    """Every block of a table as its text (header and rows), keyed by (kind, a/Delta, ratio)."""
+    with open(path) as f:
+        lines = [ln for ln in f if ln.strip() and not ln.startswith("#")]
+    out: Dict[tuple, str] = {}
+    k = 0
+    while k < len(lines):
+        head = lines[k].split()
+        try:
+            n = int(head[3])
+            key = (head[0], float(head[1]), float(head[2]))
+        except (IndexError, ValueError):
+            raise ValueError("%s: '%s' is not a block header (kind a/Delta ratio rows ...)" % (path, lines[k].strip()))
+        out[key] = "".join(lines[k:k + 1 + n])
+        k += 1 + n
+    return out
+
+
+def measured_blocks(folder: str | None = None) -> Dict[tuple, Tuple[str, str]]:
+    """The blocks of every table measured on demand (FOLDER/*/subgrid_calibration.dat): {(kind, a/Delta,
+    ratio): (the table's path, the block's text)}. The same block measured twice with different values is
+    refused, naming both files (a scene never runs with one of two measurements silently)."""
+    folder = measured_folder() if folder is None else folder
+    out: Dict[tuple, Tuple[str, str]] = {}
+    if not os.path.isdir(folder):
+        return out
+    for name in sorted(os.listdir(folder)):
+        path = os.path.join(folder, name, MEASURED_TABLE)
+        if not os.path.isfile(path):
+            continue
+        for key, text in _block_texts(path).items():
+            if key in out and out[key][1] != text:
+                raise ValueError("calibrations measured on demand: %s a/Delta %g ratio %g is in %s and, with other "
+                                 "values, in %s: remove one of them" % (key + (out[key][0], path)))
+            out.setdefault(key, (path, text))
+    return out
 
 
 def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, table: str | None = None,
              tests: Sequence[HeldBack] | None = None) -> List[PairCoverage]:
     """For each species pair of a scene (every two distinct radii and each radius with itself; with walls
-    each radius against a wall): whether the calibration table covers it (`calibrated`), the
-    interpolation does within TOLERANCE as measured on held-back blocks in the same situation
+    each radius against a wall): whether the calibration table covers it (`calibrated`), the table with the
+    calibrations measured on demand does (`measured`: measured_blocks), the interpolation does within TOLERANCE as measured on held-back blocks in the same situation
     (`interpolated`), or neither (`refused`), with the command that would measure it directly and that
     command's estimated cost. radii: the species' radii (any order, repeats ignored); a_over_delta: the
     smallest radius over the mesh size; table: default the shipped table."""
@@ -365,6 +438,8 @@ def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, t
     delta = sizes[0] / a_over_delta
     shipped = calibration.read_table(table or _project_file(os.path.join("dem", "resistance", "data",
                                                                          "subgrid_calibration.dat")))
+    with_measured = dict(shipped)
+    with_measured.update({k: None for k in measured_blocks() if k not in shipped})
     blocks = load_blocks()
     tests = list(leave_one_out(blocks)) + held_back_measurements(blocks) if tests is None else tests
     model = cost_model([b.summary for b in blocks])
@@ -380,6 +455,9 @@ def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, t
         cost = estimated_core_seconds(kind, ad, ratio, model)
         if _table_grid(shipped, kind, ad, ratio):
             out.append(PairCoverage((a, b), "calibrated", None, kind, key_ad, key_ratio, command, cost))
+            continue
+        if _table_grid(with_measured, kind, ad, ratio):
+            out.append(PairCoverage((a, b), "measured", None, kind, key_ad, key_ratio, command, cost))
             continue
         same = [x for x in blocks if x.kind == kind]
         distance = outside(reduced_radius(kind, ratio) * ad, ratio, [x.u() for x in same], [x.ratio for x in same])
@@ -418,7 +496,10 @@ def write_interpolated(out: str, targets: Sequence[Tuple[str, float, float]], ta
 
 def interpolated_table(targets: Sequence[Tuple[str, float, float]], table: str | None = None,
                        max_error: float = TOLERANCE) -> Tuple[str, List[Dict]]:
-    """The text `write_interpolated` writes and its per-target record."""
+    """The text `write_interpolated` writes and its per-target record. A target the calibrations measured on
+    demand cover (measured_blocks, with the table's blocks as the resistance library reads them) gets their
+    blocks (squeeze and, where measured, the tangential ones of the same a/Delta and ratio), status
+    "measured"."""
     table = table or _project_file(os.path.join("dem", "resistance", "data", "subgrid_calibration.dat"))
     present = calibration.read_table(table)
     blocks = load_blocks()
@@ -427,10 +508,25 @@ def interpolated_table(targets: Sequence[Tuple[str, float, float]], table: str |
         text = f.read()
     done = []
     added = []
+    measured = measured_blocks()
+    with_measured = dict(present)
+    with_measured.update({k: None for k in measured if k not in present})
     for kind, ad, ratio in targets:
         key = (kind, float("%.6g" % ad), float("%.6g" % ratio))
         if key in present:
             done.append(dict(kind=kind, a_over_delta=ad, ratio=ratio, status="in the table"))
+            continue
+        corners = _grid_corners(with_measured, kind, ad, ratio)
+        if corners is not None:
+            new = [c for c in corners if c not in present and c not in {k for _, k, _ in added}]
+            for c in new:
+                path = calibration.project_relative(measured[c][0])
+                companions = [measured[(name,) + c[1:]][1] for name in _COMPANIONS[kind] if (name,) + c[1:] in measured]
+                added.append(("# measured on demand: %s a1/Delta %g a2/a1 %g from %s\n" % (c + (path,)),
+                              c, measured[c][1] + "".join(companions)))
+            done.append(dict(kind=kind, a_over_delta=ad, ratio=ratio, status="measured",
+                             tables=sorted({calibration.project_relative(measured[c][0]) for c in corners
+                                            if c in measured})))
             continue
         rows = interpolated_rows(blocks, kind, ad, ratio)
         same = [b for b in blocks if b.kind == kind]
@@ -448,9 +544,9 @@ def interpolated_table(targets: Sequence[Tuple[str, float, float]], table: str |
                    "not measured" if bound is None else "%.1f %%" % (100 * bound)))
         block = "%s %.6g %.6g %d %s\n" % (kind, ad, ratio, len(rows), calibration.INTERPOLATED)
         block += "".join("%.8e %.8e\n" % (xi, v) for xi, v in rows)
-        added.append(note + block)
+        added.append((note, key, block))
         done.append(dict(kind=kind, a_over_delta=ad, ratio=ratio, status="interpolated", error=bound, rows=len(rows)))
-    return text + "".join(added), done
+    return text + "".join(note + block for note, _, block in added), done
 
 
 def print_errors(tests: Sequence[HeldBack] | None = None) -> None:

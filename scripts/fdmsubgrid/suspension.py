@@ -231,4 +231,8 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
         scene["calibration_interpolated"] = [dict(kind=e.kind, radii=[e.pair[0]] if e.kind == "wall" else list(e.pair),
                                                   a_over_delta=e.a_over_delta, ratio=e.ratio, error=e.error)
                                              for e in calibration.interpolated]
+        # and those measured on demand, with the tables they come from
+        scene["calibration_measured"] = [dict(kind=e.kind, radii=[e.pair[0]] if e.kind == "wall" else list(e.pair),
+                                              a_over_delta=e.a_over_delta, ratio=e.ratio) for e in calibration.measured]
+        scene["calibration_measured_tables"] = list(calibration.tables)
     return scene
