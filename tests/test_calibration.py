@@ -235,12 +235,12 @@ def test_calibrated_model_refuses_an_uncovered_resolution(tmp_path, env):
 
 def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
     """`fdmResistance coverage` makes the pair style's test; the suspension cases ask it before they
-    write anything: a1/Delta = 4 with a2 = 1.4 a1 between walls has no wall calibration for a/Delta 5.6 (the
-    interpolation gives one within 2 %) and no pair 1.4-1.4 at a1/Delta 5.6 (it does not)."""
+    write anything: radii 1 and 2 at a1/Delta 3 between walls have no wall calibration for a/Delta 6 (the
+    interpolation gives one within 2 %) and no pairs 1-2 and 2-2 (it does not)."""
     from fdmsubgrid import case
     covered = theory.resistance("coverage", "--a1", 1, "--a2", 1.4, "--delta", 1 / 3, "--wall")
     assert covered["pair"] and covered["pair_tangential"] and covered["wall"]
-    assert not theory.resistance("coverage", "--a1", 1.4, "--delta", 0.25, "--wall")["wall"]
+    assert not theory.resistance("coverage", "--a1", 1.4, "--delta", 0.2, "--wall")["wall"]
     assert not theory.resistance("coverage", "--a1", 1, "--a2", 2, "--delta", 0.25)["pair"]
     assert case.uncalibrated([1.0, 1.0, 1.4], 1 / 3, walls=True) == []
     assert case.uncalibrated([1.0, 2.0], 0.25) != []
@@ -249,14 +249,15 @@ def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
     alone = case.uncalibrated([1.0, 1.4], 0.2, walls=True, pairs=False)
     assert alone[0].startswith("radius 1.4 at a wall (a/Delta 7): python3 -m fdmsubgrid.calibration "
                                "--a-over-delta 7 --no-pairs") and len(alone) == 3
-    # one sphere of a radius has no pair with itself: a2/Delta = 5.6 alone is fine without walls, two are not
-    assert case.uncalibrated([1.0, 1.0, 1.4], 0.25) == []
-    assert "pair of radii 1.4 and 1.4" in case.uncalibrated([1.0, 1.4, 1.4], 0.25)[0]
+    # one sphere of a radius has no pair with itself: a2/Delta = 7 alone is fine without walls, two are not
+    assert case.uncalibrated([1.0, 1.0, 1.4], 0.2) == []
+    assert "pair of radii 1.4 and 1.4" in case.uncalibrated([1.0, 1.4, 1.4], 0.2)[0]
     couette = load_case_module("couette")
     with pytest.raises(SystemExit) as refused:
-        couette.main(["--a-over-delta", "4", "--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
-    # the 1.4-1.4 pairs (a1/Delta 5.6) lie beyond the interpolation's 2 %; the wall of 1.4 does not
-    assert "the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated" in str(refused.value)
-    assert "interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.3 %)" in str(refused.value)
+        couette.main(["--radii", "1", "2", "--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
+    # the pairs 1-2 (a2/a1 2) and 2-2 (a1/Delta 6) lie beyond the interpolation's 2 %; the wall of 2 does not
+    assert "the pair of radii 1 and 2 at a1/Delta 3 (a2/a1 2): not calibrated" in str(refused.value)
+    assert "the pair of radii 2 and 2 at a1/Delta 6 (a2/a1 1): not calibrated" in str(refused.value)
+    assert "interpolated within 2 %: radius 2 at a wall (a/Delta 6, error 1.3 %)" in str(refused.value)
     assert "--model cutoff" in str(refused.value)
     assert os.listdir(tmp_path) == []

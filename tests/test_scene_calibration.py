@@ -76,28 +76,32 @@ def test_a_scene_needing_only_an_interpolated_wall_runs_with_its_own_table(env, 
 
 
 def test_a_pair_beyond_the_interpolation_is_refused_one_line(tmp_path, capsys):
-    """The same suspension with more larger spheres (pairs 1.4-1.4 at a1/Delta 5.6, interpolated to 3.0 %
-    > 2 % at worst): refused before anything is written, one line for that pair with the command that
-    measures it, the interpolable wall named as such."""
+    """Spheres of radii 1 and 2 at a1/Delta 3 (pairs 1-2 at a2/a1 2 and 2-2 at a1/Delta 6, interpolated to
+    3.0 % > 2 % at worst): refused before anything is written, one line per pair with the command that
+    measures it into the folder later scenes read, the interpolable wall named as such."""
     with pytest.raises(deminput.UncalibratedScene) as refused:
-        deminput.scene_calibration("couette", [1.0] * 5 + [1.4] * 2, 0.25, walls=True)
+        deminput.scene_calibration("couette", [1.0] * 5 + [2.0] * 2, 1 / 3, walls=True)
     lines = str(refused.value).splitlines()
-    assert lines[0] == ("couette: the sub-grid calibration (model calibrated) lacks 1 of this scene's pairs and walls "
+    assert lines[0] == ("couette: the sub-grid calibration (model calibrated) lacks 2 of this scene's pairs and walls "
                         "beyond what the interpolation reaches within 2 %:")
-    assert lines[1].startswith("  the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated, "
+    assert lines[1].startswith("  the pair of radii 1 and 2 at a1/Delta 3 (a2/a1 2): not calibrated, "
                                "interpolation error 3.0 % > 2 %; measure it (about ")
-    assert lines[1].endswith("core-seconds): python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 "
-                             "--no-wall --boxes 8.214285714 12.14285714 --cache")  # 46, 68 cells
-    assert lines[2] == "  interpolated within 2 %: radius 1.4 at a wall (a/Delta 5.6, error 1.3 %)"
-    assert lines[3].startswith("  dem/resistance/data/subgrid_calibration.dat has pairs")
-    assert lines[4].startswith("  or --model cutoff")
-    assert len(lines) == 5
+    assert lines[1].endswith("core-seconds): python3 -m fdmsubgrid.calibration --a-over-delta 3 --ratios 2 "
+                             "--no-wall --boxes 12 16 --cache")
+    assert lines[2].startswith("  the pair of radii 2 and 2 at a1/Delta 6 (a2/a1 1): not calibrated, "
+                               "interpolation error 3.0 % > 2 %; measure it (about ")
+    assert lines[2].endswith("core-seconds): python3 -m fdmsubgrid.calibration --a-over-delta 6 --ratios 1 "
+                             "--no-wall --boxes 8 12 --cache")
+    assert lines[3] == "  interpolated within 2 %: radius 2 at a wall (a/Delta 6, error 1.3 %)"
+    assert lines[4].startswith("  dem/resistance/data/subgrid_calibration.dat has pairs")
+    assert lines[5].startswith("  or --model cutoff")
+    assert len(lines) == 6
     # the case script: refused with that message, no run folder
     couette = load_case_module("couette")
     with pytest.raises(SystemExit) as stopped:
-        couette.main(["--radii", "1", "1.4", "--volume-fractions", "0.8", "0.2", "--phi", "0.2", "--size", "12", "12",
-                      "12", "--a-over-delta", "4", "--write-only", "--workdir", str(tmp_path)])
-    assert "the pair of radii 1.4 and 1.4 at a1/Delta 5.6 (a2/a1 1): not calibrated" in str(stopped.value)
+        couette.main(["--radii", "1", "2", "--volume-fractions", "0.8", "0.2", "--phi", "0.2", "--size", "12", "12",
+                      "12", "--write-only", "--workdir", str(tmp_path)])
+    assert "the pair of radii 2 and 2 at a1/Delta 6 (a2/a1 1): not calibrated" in str(stopped.value)
     assert os.listdir(tmp_path) == []
 
 
