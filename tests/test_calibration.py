@@ -254,7 +254,8 @@ def test_scenes_outside_the_table_are_refused_before_they_run(tmp_path, env):
     assert "pair of radii 1.4 and 1.4" in case.uncalibrated([1.0, 1.4, 1.4], 0.2)[0]
     couette = load_case_module("couette")
     with pytest.raises(SystemExit) as refused:
-        couette.main(["--radii", "1", "2", "--workdir", str(tmp_path), "--out", str(tmp_path / "r.json")])
+        couette.main(["--radii", "1", "2", "--size", "12", "12", "12", "--workdir", str(tmp_path), "--out",
+                      str(tmp_path / "r.json")])
     # the pairs 1-2 (a2/a1 2) and 2-2 (a1/Delta 6) lie beyond the interpolation's 2 %; the wall of 2 does not
     assert "the pair of radii 1 and 2 at a1/Delta 3 (a2/a1 2): not calibrated" in str(refused.value)
     assert "the pair of radii 2 and 2 at a1/Delta 6 (a2/a1 1): not calibrated" in str(refused.value)
