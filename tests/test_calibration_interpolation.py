@@ -44,7 +44,7 @@ def test_each_shipped_block_from_the_others(loo):
     3.0 %, a1/Delta 3, a2/a1 1.4 at xi 0.3), walls within 1.3 % (measured 1.25 %); against the theory the
     interpolated correction is within 3.8 % (the direct calibrations' own reach 1.8 %) and, near contact
     (xi <= 1e-3), where the correction carries the resistance, within 0.2 %."""
-    assert len(loo) == 9
+    assert len(loo) == 10
     for key, t in loo.items():
         bound = 0.031 if t.kind == "pair" else 0.013
         assert t.worst() < bound, (key, t.added())
@@ -73,14 +73,14 @@ def fixed_xi_leave_one_out(target, blocks):
 
 def test_the_collapse_is_what_makes_it_work(blocks, loo):
     """The same leave-one-out at a fixed reduced gap xi, linear in a1/Delta and a2/a1: worse at the worst
-    pair (measured 4.5 % against 3.0 %) and at the ends of the table (a1/Delta 3: 2.6 % and 4.5 % against
+    pair (measured 4.6 % against 3.0 %) and at the end of the table (a1/Delta 3: 2.4 % and 4.6 % against
     1.5 % and 3.0 %)."""
     pairs = [b for b in blocks if b.kind == "pair"]
     fixed = {(b.a_over_delta, b.ratio): fixed_xi_leave_one_out(b, blocks) for b in pairs}
     collapsed = {(b.a_over_delta, b.ratio): loo[("pair", b.a_over_delta, b.ratio)].worst() for b in pairs}
     assert max(fixed.values()) > max(collapsed.values()) + 0.008
     for key in ((3.0, 1.0), (3.0, 1.4)):
-        assert fixed[key] > 0.025 and collapsed[key] < fixed[key] - 0.008, key
+        assert fixed[key] > 0.024 and collapsed[key] < fixed[key] - 0.008, key
 
 
 def test_held_back_direct_calibration(blocks):
@@ -248,44 +248,43 @@ def test_the_measure_command_meshes_its_boxes_in_whole_cells():
         foamcase.Box((0, 0, 0), (L, wallcalibration.H_OVER_L * L, L), 1.0 / 5.6)
 
 
-def test_held_back_equal_pair_at_a_over_delta_5_6(blocks):
-    """The equal pair at a/Delta 5.6 (the large spheres of a scene at a1/Delta 4), calibrated directly and kept
-    out of the table, against its interpolation from the 6 shipped pair blocks (docs/data): inside their reduced
-    radii (u 2.8), the interpolation within 1 % of the direct calibration at every gap (measured 0.87 %), the
-    direct calibration's own position-averaged error within 2 % at every gap; the bound the scene writers use
-    for such a pair stays the worst held-back one (the leave-one-out's 3.0 %)."""
-    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[1])
-    t = subgridinterp.held_back_measurements(blocks, [path])[0]
-    assert (t.kind, t.a_over_delta, t.ratio) == ("pair", 5.6, 1.0)
+def test_the_equal_pair_at_a_over_delta_5_6(blocks, loo):
+    """The equal pair at a/Delta 5.6 (the spheres of radius 1.4 of a scene at a1/Delta 4), measured in boxes of
+    46 and 68 cells: its own position-averaged error within 2 % at every gap (measured 1.4 %), and from the 6
+    pairs at a1/Delta 3-5 (u 2.8 inside their 1.5 ... 2.92) the interpolation within 1 % of it (measured 0.9 %);
+    the bound the scene writers use for a pair outside the table stays the worst held-back pair inside the
+    table (3.0 %, a1/Delta 3, a2/a1 1.4)."""
+    [block] = [b for b in blocks if (b.kind, b.a_over_delta, b.ratio) == ("pair", 5.6, 1.0)]
+    assert [round(L * 5.6) for L in block.summary["boxes"]] == [46, 68]
+    t = loo[("pair", 5.6, 1.0)]
     assert not any(t.distance()) and t.u == pytest.approx(2.8)
     assert t.worst() < 0.01, t.added()
     assert np.max(np.abs(t.direct)) < 0.02
-    tests = list(subgridinterp.leave_one_out(blocks)) + subgridinterp.held_back_measurements(blocks)
-    assert subgridinterp.error_bound("pair", (0.0, 0.0, 0.0), tests) == pytest.approx(
-        max(x.worst() for x in subgridinterp.leave_one_out(blocks) if x.kind == "pair"))
+    tests = list(loo.values()) + subgridinterp.held_back_measurements(blocks)
+    assert subgridinterp.error_bound("pair", (0.0, 0.0, 0.0), tests) == pytest.approx(loo[("pair", 3.0, 1.4)].worst())
 
 
 def test_the_table_names_the_commands_that_measure_it_again():
-    """The shipped table's header line is the one command of its measurements; a table measured in parts (a block
-    at another resolution in other boxes, no walls) gets one command per part, each meshable as written."""
+    """The shipped table's header names one command per part it was measured in (a1/Delta 3-5 with walls and
+    the tangential functions; the equal pair at 5.6 in boxes of 46 and 68 cells), each meshable as written; a
+    wall at 5.6 in boxes of its own would be a third."""
     shipped = [b.calibration() for b in subgridinterp.load_blocks()]
     out = "dem/resistance/data/subgrid_calibration.dat"
-    tangential = [3.0, 4.0, 5.0]
-    pairs = [(a, r) for a in tangential for r in (1.0, 1.4)]
-    [command] = calibration.regenerate_commands(shipped, out, tangential, pairs)
+    keys = calibration.read_table(os.path.join(PROJECT, out))
+    tangential = sorted({k[1] for k in keys if k[0] == "wall_YA"})
+    pairs = sorted({k[1:] for k in keys if k[0] == "pair_K11"})
+    commands = calibration.regenerate_commands(shipped, out, tangential, pairs)
+    assert commands == [
+        "python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --ratios 1 1.4 --boxes 8 12 --offsets 4 --tangential "
+        "--pair-tangential --out " + out,
+        "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 --no-wall --boxes 8.214285714 12.14285714 "
+        "--offsets 4 --pair-tangential --out " + out]
     with open(os.path.join(PROJECT, out)) as f:
-        header = [line for line in f if line.startswith("# Regenerate: ")]
-    assert header == ["# Regenerate: %s\n" % command]
-    with open(os.path.join(PROJECT, "docs", "data", "validation_calibrationInterpolation_ratio1_ad5.6.json")) as f:
-        extra = [subgridinterp.CollapsedBlock.from_summary(d).calibration() for d in json.load(f)["calibrations"]]
-    commands = calibration.regenerate_commands(shipped + extra, out, tangential, pairs + [(5.6, 1.0)])
-    assert commands == [command, "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 --no-wall --boxes "
-                                 "8.035714286 12.14285714 --offsets 4 --pair-tangential --out " + out]
+        header = [line for line in f if line.startswith("# Regenerate: ") or line.startswith("#   and: ")]
+    assert header == ["# Regenerate: %s\n" % commands[0], "#   and: %s\n" % commands[1]]
     # a wall at the same a1/Delta in boxes of its own (L x 1.25 L x L in whole cells): a part of its own
     wall = dataclasses.replace(next(c for c in shipped if c.kind == "wall"), a_over_delta=5.6,
                                boxes=[8.571428571, 12.14285714])
-    commands = calibration.regenerate_commands(shipped + extra + [wall], out, tangential + [5.6], pairs + [(5.6, 1.0)])
-    assert commands[:2] == [command, "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 --no-wall "
-                                     "--boxes 8.035714286 12.14285714 --offsets 4 --pair-tangential --out " + out]
-    assert commands[2:] == ["python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --no-pairs --boxes 8.571428571 "
-                            "12.14285714 --offsets 4 --tangential --out " + out]
+    assert calibration.regenerate_commands(shipped + [wall], out, tangential + [5.6], pairs) == commands + [
+        "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --no-pairs --boxes 8.571428571 12.14285714 --offsets 4 "
+        "--tangential --out " + out]

@@ -423,6 +423,10 @@ def plot(path: str, summaries: Sequence[Dict]) -> None:
     rows = sorted({s["a_over_delta"] for s in summaries})
     cols = sorted({(s["kind"], s["ratio"]) for s in summaries}, key=lambda kr: (kr[0] == "wall", kr[1]))
     fig, axes = plt.subplots(len(rows), len(cols), figsize=(4.2 * len(cols), 3.6 * len(rows)), squeeze=False)
+    used = {(rows.index(s["a_over_delta"]), cols.index((s["kind"], s["ratio"]))) for s in summaries}
+    for i, j in np.ndindex(axes.shape):
+        if (i, j) not in used:
+            axes[i][j].axis("off")      # a table measured in parts: no block of this kind at this a1/Delta
     for s in summaries:
         ax = axes[rows.index(s["a_over_delta"])][cols.index((s["kind"], s["ratio"]))]
         gaps = np.array(s["gaps"])

@@ -75,8 +75,19 @@ def _coverage_summary(coverage: str) -> str:
     walls = re.findall(r"\(([\d.eE+-]+)\)", parts.get("walls", ""))
     def listed(values):
         return ", ".join(sorted(set(values), key=float)) or "none"
-    return ("pairs a1/Delta %s x a2/a1 %s and walls a/Delta %s (interpolated between)"
-            % (listed(a for a, _ in pairs), listed(r for _, r in pairs), listed(walls)))
+    # the a1/Delta of the same size ratios together: "3, 4, 5 x a2/a1 1, 1.4; 5.6 x 1"
+    ratios = {}
+    for a, r in pairs:
+        ratios.setdefault(a, set()).add(r)
+    groups = []
+    for a in sorted(ratios, key=float):
+        if groups and groups[-1][1] == ratios[a]:
+            groups[-1][0].append(a)
+        else:
+            groups.append(([a], ratios[a]))
+    grid = "; ".join("%s x %s" % (", ".join(ads), listed(rs)) for ads, rs in groups) or "none x none"
+    return "pairs a1/Delta %s; walls a/Delta %s (interpolated between)" % (grid.replace(" x ", " x a2/a1 ", 1),
+                                                                          listed(walls))
 
 
 def uncalibrated(radii: Iterable[float], delta: float, walls: bool = False, model: str = "calibrated",
