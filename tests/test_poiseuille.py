@@ -221,6 +221,31 @@ def test_a_channel_continues_from_a_compact_snapshot_and_is_analysed(case_module
     assert "==== fdmRun --from-snapshot %s: step 40 to 60" % dest in open(os.path.join(r["run_dir"], "log.fluid")).read()
 
 
+def test_required_duration_scales_the_ladders_migration_time(case_module, capsys):
+    """--required-duration: tau = c L_y^2 through the ladder's analysed rungs (docs/data), weighted by their
+    errors (the 12 a1 rung's 73 +- 116 hardly counts, the 20 a1 rung's 206 +- 27 sets c), so the 20 a1 channel
+    gets its own tau back and the paper's 40 a1 four times it; the duration is the analysis's 3 tau before its
+    window plus 3 tau in it. No rung with a migration time: refused."""
+    data = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs", "data")
+    rungs = [json.load(open(os.path.join(data, "validation_poiseuille_ladder%d.json" % n)))["data"] for n in (12, 20)]
+    twenty = poiseuille.required_duration(rungs, 20.0)
+    assert twenty["migration_time"] == pytest.approx(rungs[1]["migration_time"], rel=0.01)
+    paper = poiseuille.required_duration(rungs, 40.0)
+    assert paper["migration_time"] == pytest.approx(4 * twenty["migration_time"])
+    assert paper["migration_time_err"] / paper["migration_time"] == pytest.approx(
+        rungs[1]["migration_time_err"] / rungs[1]["migration_time"], rel=0.02)
+    assert paper["steady_from"] == pytest.approx(3 * paper["migration_time"])
+    assert paper["duration"] == pytest.approx(6 * paper["migration_time"])
+    assert poiseuille.required_duration(rungs, 40.0, window_taus=1.0)["duration"] == pytest.approx(
+        4 * paper["migration_time"])
+    with pytest.raises(ValueError, match="no rung with a measured migration time"):
+        poiseuille.required_duration([dict(L=[12, 12, 8], migration_time=None)], 40.0)
+    out = case_module.main(["--paper", "--required-duration"] + [
+        os.path.join(data, "validation_poiseuille_ladder%d.json" % n) for n in (12, 20)])
+    assert out["duration"] == pytest.approx(paper["duration"])
+    assert "a channel of L_y = 40 a1 needs about" in capsys.readouterr().out
+
+
 def test_budget_predicts_the_run_it_was_measured_on(case_module, small_run):
     """--budget: the fluid steps a duration needs at the run's own fluid step, and its wall time from the
     median step after the cold first one; predicted for the small run's own duration, it is that run's

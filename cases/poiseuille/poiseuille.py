@@ -38,7 +38,7 @@ from typing import Any, List, Optional, Sequence
 import numpy as np
 
 from fdmsubgrid import case, checkpoint, couettescene, packing, poiseuille, sbm, suspension
-from fdmsubgrid.results import Row, write_results
+from fdmsubgrid.results import Row, read_data, write_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PROJECT = os.path.dirname(os.path.dirname(HERE))
@@ -105,6 +105,11 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--budget", metavar="RUN_DIR", default=None,
                    help="predict the wall time of --duration from a short run of the same scene (RUN_DIR: at least "
                         "two fluid steps, e.g. --paper --run --duration 1) and exit")
+    p.add_argument("--required-duration", metavar="RESULTS", nargs="+", default=None,
+                   help="the duration this channel (--size or --paper) needs from a uniform start to its steady state "
+                        "and a window as long again, from the migration times of analysed ladder runs (their "
+                        "results.json; tau grows as L_y^2: poiseuille.required_duration), and exit; with --budget "
+                        "RUN_DIR also its wall time")
     p.add_argument("--from-records", metavar="RECORDS", default=None,
                    help="start from the particles of the last block of this particle records file (dem/"
                         "particles.records of a run of the same channel, e.g. its dense core) instead of a "
@@ -120,6 +125,23 @@ def main(argv: list[str] | None = None) -> dict:
     material = sbm.from_couette_results(args.couette) if args.couette else None
     table8 = table8_material(args.table8)
 
+    if args.required_duration:
+        if args.paper:
+            args.size = list(PAPER_SIZE)
+        try:
+            rungs = [read_data(path) for path in args.required_duration]
+            need = poiseuille.required_duration(rungs, float(args.size[1]))
+        except (OSError, KeyError, ValueError) as e:
+            p.error("--required-duration: %s" % e)
+        print("a channel of L_y = %g a1 needs about %.0f +- %.0f time units (L_y/(2 U_c)) from a uniform start: migration "
+              "time %.0f +- %.0f (tau = %.3g L_y^2 through %s), the steady window from %.0f, then %g tau of it"
+              % (need["width"], need["duration"], need["duration_err"], need["migration_time"],
+                 need["migration_time_err"], need["c"], ", ".join("L_y %g: %.0f +- %.0f" % (
+                     r["width"], r["migration_time"], r["migration_time_err"]) for r in need["rungs"]),
+                 need["steady_from"], need["window_taus"]))
+        args.duration = need["duration"]
+        if not args.budget:
+            return need
     if args.budget:
         try:
             b = poiseuille.budget(args.budget, args.duration)

@@ -38,11 +38,12 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import output, packing, profiles, rheology, sbm, shear, suspension, timeseries
+from . import output, packing, profiles, rheology, sbm, shear, steadystate, suspension, timeseries
 # the steady window (re-exported: the channel's analysis is where users meet them)
 from .steadystate import (MIN_SNAPSHOTS, STEADY_AFTER_TAUS, SLOPE_SIGMAS, Approach, SteadyWindow, Trend, fit_approach,  # noqa: F401
                           profile_change, steady_window, trend)
@@ -197,6 +198,31 @@ def budget(run_dir: str, duration: float) -> dict:
                 first_step_seconds=first, seconds_per_fluid_step=each, parts_per_fluid_step=per_step,
                 inner_iterations_per_fluid_step=float(np.median(np.asarray(steps["innerIterations"])[1:])),
                 predicted_seconds=seconds, predicted_hours=seconds / 3600)
+
+
+def required_duration(rungs: Sequence[dict], width: float, window_taus: float = steadystate.STEADY_AFTER_TAUS) -> dict:
+    """How long a channel of wall distance `width` (a1) must run from a uniform start to its steady state and an
+    averaging window, from the migration times the ladder measured (`rungs`: the `data` of analysed runs, each
+    with `L` and `migration_time` ± `migration_time_err`). In units of L_y/(2 U_c) the shear-induced migration
+    time grows as (L_y/a)^2 (its diffusivity scales with a^2 times the shear rate, about U_c/L_y), so
+    tau = c L_y^2 is fitted through the rungs (least squares weighted by 1/err^2), and the duration is the
+    analysis's STEADY_AFTER_TAUS time constants before its window plus `window_taus` of them in it.
+    Returns the fit (c, its error and chi^2 per rung), tau at `width` and the duration, each with its error."""
+    rows = [(float(r["L"][1]), float(r["migration_time"]), float(r["migration_time_err"])) for r in rungs
+            if r.get("migration_time") is not None and r.get("migration_time_err")]
+    if not rows:
+        raise ValueError("required_duration: no rung with a measured migration time (analyse a ladder run first)")
+    L, tau, err = (np.array(v) for v in zip(*rows))
+    w = 1.0 / err ** 2
+    c = float(np.sum(w * tau * L ** 2) / np.sum(w * L ** 4))
+    c_err = float(1.0 / math.sqrt(np.sum(w * L ** 4)))
+    taus = steadystate.STEADY_AFTER_TAUS + window_taus
+    return dict(c=c, c_err=c_err, chi2_per_rung=float(np.sum(w * (tau - c * L ** 2) ** 2) / len(L)),
+                rungs=[dict(width=float(l), migration_time=float(t), migration_time_err=float(e),
+                            fitted=c * float(l) ** 2) for l, t, e in rows],
+                width=width, migration_time=c * width ** 2, migration_time_err=c_err * width ** 2,
+                window_taus=window_taus, steady_from=steadystate.STEADY_AFTER_TAUS * c * width ** 2,
+                duration=taus * c * width ** 2, duration_err=taus * c_err * width ** 2)
 
 
 def flow_rate(run_dir: str) -> tuple[NDArray, NDArray]:
