@@ -173,9 +173,9 @@ def test_a_pair_measured_on_demand_is_found_by_later_scenes(env, tmp_path, monke
     assert [(e.kind, e.a_over_delta, e.ratio, e.status) for e in scene.measured] == [("pair", 3.0, 2.0, "measured")]
     assert [(e.kind, e.a_over_delta, e.status) for e in scene.interpolated] == [("wall", 6.0, "interpolated")]
     assert scene.tables == [os.path.realpath(path)]
-    assert scene.line() == ("couette: the run reads dem/subgrid_calibration.dat, the shipped table with the calibration "
-                            "measured on demand for radii 1 and 2 (a1/Delta 3, a2/a1 2) (%s) and the squeeze "
-                            "interpolated for radius 2 at a wall (a/Delta 6, error 1.3 %%) (measured on held-back "
+    assert scene.line() == ("couette: the run reads dem/subgrid_calibration.dat, the shipped table with the "
+                            "calibration measured on demand for radii 1 and 2 (a1/Delta 3, a2/a1 2) (%s) and the "
+                            "squeeze interpolated for radius 2 at a wall (a/Delta 6, error 1.3 %%) (measured on held-back "
                             "blocks, within 2 %%; the tangential functions there from the cut-off model: "
                             "docs/resistance.md)" % os.path.realpath(path))
     table = scene.write(str(tmp_path / "run" / "dem"))

@@ -133,8 +133,9 @@ def main(argv: list[str] | None = None) -> dict:
             need = poiseuille.required_duration(rungs, float(args.size[1]))
         except (OSError, KeyError, ValueError) as e:
             p.error("--required-duration: %s" % e)
-        print("a channel of L_y = %g a1 needs about %.0f +- %.0f time units (L_y/(2 U_c)) from a uniform start: migration "
-              "time %.0f +- %.0f (tau = %.3g L_y^2 through %s), the steady window from %.0f, then %g tau of it"
+        print("a channel of L_y = %g a1 needs about %.0f +- %.0f time units (L_y/(2 U_c)) from a uniform start: "
+              "migration time %.0f +- %.0f (tau = %.3g L_y^2 through %s), the steady window from %.0f, then %g tau "
+              "of it"
               % (need["width"], need["duration"], need["duration_err"], need["migration_time"],
                  need["migration_time_err"], need["c"], ", ".join("L_y %g: %.0f +- %.0f" % (
                      r["width"], r["migration_time"], r["migration_time_err"]) for r in need["rungs"]),

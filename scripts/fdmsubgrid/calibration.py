@@ -546,13 +546,14 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     if args.position_errors:
         print_position_errors(args.position_errors)
         return []
+    # what a measuring call measures, in order: (kind, a1/Delta, a2/a1)
+    jobs = [(kind, ad, ratio) for ad in args.a_over_delta
+            for kind, ratio in (([] if args.no_pairs else [("pair", r) for r in args.ratios])
+                                + ([] if args.no_wall else [("wall", 1.0)]))]
     if args.cache:
         if args.out or args.from_raw:
             p.error("--cache measures and keeps its own table: not with --out or --from-raw")
         from . import subgridinterp
-        jobs = [(kind, ad, ratio) for ad in args.a_over_delta
-                for kind, ratio in (([] if args.no_pairs else [("pair", r) for r in args.ratios])
-                                    + ([] if args.no_wall else [("wall", 1.0)]))]
         folder = os.path.join(subgridinterp.measured_folder(), subgridinterp.measured_name(jobs))
         args.out = os.path.join(folder, subgridinterp.MEASURED_TABLE)
         if os.path.exists(args.out):
@@ -574,19 +575,14 @@ def main(argv: Sequence[str] | None = None) -> List[Dict]:
     else:
         from . import subgridinterp
         model = subgridinterp.cost_model([b.summary for b in subgridinterp.load_blocks()])
-        for ad in args.a_over_delta:
-            for kind, ratio in (([] if args.no_pairs else [("pair", r) for r in args.ratios])
-                                + ([] if args.no_wall else [("wall", 1.0)])):
-                print("calibration: %s a1/Delta %g%s: about %.0f core-seconds (the squeeze; estimated from the shipped "
-                      "calibrations' run times)" % (kind, ad, " a2/a1 %g" % ratio if kind == "pair" else "",
-                                                    subgridinterp.estimated_core_seconds(kind, ad, ratio, model)),
-                      flush=True)
-        for ad in args.a_over_delta:
-            jobs = (([] if args.no_pairs else [("pair", r) for r in args.ratios])
-                    + ([] if args.no_wall else [("wall", 1.0)]))
-            for kind, ratio in jobs:
-                cals.append(measure(kind, ad, ratio, args.workdir, boxes=args.boxes, offsets=OFFSETS[:args.offsets]))
-                files.write_json(raw_path, [c.__dict__ for c in cals], indent=None)   # kept before any analysis
+        for kind, ad, ratio in jobs:
+            print("calibration: %s a1/Delta %g%s: about %.0f core-seconds (the squeeze; estimated from the shipped "
+                  "calibrations' run times)" % (kind, ad, " a2/a1 %g" % ratio if kind == "pair" else "",
+                                                subgridinterp.estimated_core_seconds(kind, ad, ratio, model)),
+                  flush=True)
+        for kind, ad, ratio in jobs:
+            cals.append(measure(kind, ad, ratio, args.workdir, boxes=args.boxes, offsets=OFFSETS[:args.offsets]))
+            files.write_json(raw_path, [c.__dict__ for c in cals], indent=None)   # kept before any analysis
     fits = [c.fit() for c in cals]
     tables = [c.table(fit) for c, fit in zip(cals, fits)]
     summaries = [summary(c, fit, table) for c, fit, table in zip(cals, fits, tables)]

@@ -55,8 +55,8 @@ class Box:
 
 
 def whole_cell_box(L: float, a_over_delta: float, depth: float = 1.0) -> float:
-    """The smallest box size >= L (in the mesh's unit, a1) whose extents L and depth L are whole, even numbers of cells of
-    a1/a_over_delta (the mesh is cubic cells; at a1/Delta 5.6 the 8 a1 box would be 44.8 cells: 8.2143 a1, 46 cells).
+    """The smallest box size >= L (in the mesh's unit, a1) whose extents L and depth L are whole, even numbers of
+    cells of a1/a_over_delta (cubic cells; at a1/Delta 5.6 the 8 a1 box would be 44.8 cells: 8.2143 a1, 46 cells).
     Even, because the calibration scenes put the gap's centre at L/2 plus its offset in the cell: the box
     correction compares the same position in the mesh in both boxes only if L/2 falls on a cell face in both
     (an odd box puts it on a cell centre; the pair tangential at a1/Delta 5.6 in boxes of 45 and 68 cells had

@@ -425,9 +425,9 @@ def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, t
              tests: Sequence[HeldBack] | None = None) -> List[PairCoverage]:
     """For each species pair of a scene (every two distinct radii and each radius with itself; with walls
     each radius against a wall): whether the calibration table covers it (`calibrated`), the table with the
-    calibrations measured on demand does (`measured`: measured_blocks), the interpolation does within TOLERANCE as measured on held-back blocks in the same situation
-    (`interpolated`), or neither (`refused`), with the command that would measure it directly and that
-    command's estimated cost. radii: the species' radii (any order, repeats ignored); a_over_delta: the
+    calibrations measured on demand does (`measured`: measured_blocks), the interpolation does within TOLERANCE
+    as measured on held-back blocks in the same situation (`interpolated`), or neither (`refused`), with the
+    command that would measure it directly and that command's estimated cost. radii: the species' radii (any order, repeats ignored); a_over_delta: the
     smallest radius over the mesh size; table: default the shipped table."""
     sizes = sorted({float(r) for r in radii})
     if not sizes or sizes[0] <= 0:
@@ -520,7 +520,8 @@ def interpolated_table(targets: Sequence[Tuple[str, float, float]], table: str |
             new = [c for c in corners if c not in present and c not in {k for _, k, _ in added}]
             for c in new:
                 path = calibration.project_relative(measured[c][0])
-                companions = [measured[(name,) + c[1:]][1] for name in _COMPANIONS[kind] if (name,) + c[1:] in measured]
+                companions = [measured[(name,) + c[1:]][1] for name in _COMPANIONS[kind]
+                              if (name,) + c[1:] in measured]
                 added.append(("# measured on demand: %s a1/Delta %g a2/a1 %g from %s\n" % (c + (path,)),
                               c, measured[c][1] + "".join(companions)))
             done.append(dict(kind=kind, a_over_delta=ad, ratio=ratio, status="measured",
