@@ -427,8 +427,9 @@ def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, t
     each radius against a wall): whether the calibration table covers it (`calibrated`), the table with the
     calibrations measured on demand does (`measured`: measured_blocks), the interpolation does within TOLERANCE
     as measured on held-back blocks in the same situation (`interpolated`), or neither (`refused`), with the
-    command that would measure it directly and that command's estimated cost. radii: the species' radii (any order, repeats ignored); a_over_delta: the
-    smallest radius over the mesh size; table: default the shipped table."""
+    command that would measure it directly and that command's estimated cost. radii: the species' radii (any
+    order, repeats ignored); a_over_delta: the smallest radius over the mesh size; table: default the shipped
+    table."""
     sizes = sorted({float(r) for r in radii})
     if not sizes or sizes[0] <= 0:
         raise ValueError("coverage: radii must be positive, got %s" % list(radii))
