@@ -121,13 +121,13 @@ def main(argv: list[str] | None = None) -> dict:
                         "(fdmRun --from-snapshot; docs/coupling.md \"Compact snapshot\")")
     case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
     args = p.parse_args(argv)
+    if args.paper:
+        args.size = list(PAPER_SIZE)
     started = time.time()
     material = sbm.from_couette_results(args.couette) if args.couette else None
     table8 = table8_material(args.table8)
 
     if args.required_duration:
-        if args.paper:
-            args.size = list(PAPER_SIZE)
         try:
             rungs = [read_data(path) for path in args.required_duration]
             need = poiseuille.required_duration(rungs, float(args.size[1]))
@@ -162,8 +162,6 @@ def main(argv: list[str] | None = None) -> dict:
         return report(args.analyse, args.out, material, args.from_time, argv, args, started, table8,
                       args.plateau_threshold)
 
-    if args.paper:
-        args.size = list(PAPER_SIZE)
     pack = None
     if args.from_records:
         if args.radii is not None or args.volume_fractions is not None or args.distribution is not None:

@@ -373,21 +373,34 @@ def write_table(path: str, calibrations: Sequence[SqueezeCalibration], fits: Seq
                     f.write("%.8e %.8e\n" % (xi, v))
 
 
+def table_blocks(path: str) -> Dict[tuple, List[str]]:
+    """The blocks of a calibration table (write_table's format) as their lines, header first, keyed by (kind,
+    a/Delta, ratio); comments and blank lines left out."""
+    with open(path) as f:
+        lines = [ln for ln in f if ln.strip() and not ln.startswith("#")]
+    blocks: Dict[tuple, List[str]] = {}
+    k = 0
+    while k < len(lines):
+        head = lines[k].split()
+        try:
+            n = int(head[3])
+            key = (head[0], float(head[1]), float(head[2]))
+        except (IndexError, ValueError):
+            raise ValueError("%s: '%s' is not a block header (kind a/Delta ratio rows ...)" % (path, lines[k].strip()))
+        blocks[key] = lines[k:k + 1 + n]
+        k += 1 + n
+    return blocks
+
+
 def read_table(path: str) -> Dict[tuple, tuple]:
     """The blocks of a calibration table (write_table's format): {(kind, a/Delta, ratio): (header floats
     after the row count, rows as an (n, 2) array of xi and xi * s_hat)}. An interpolated block's header
     (subgridinterp.py) has the word `interpolated` instead of the fit's numbers: its header floats are []."""
     blocks = {}
-    with open(path) as f:
-        lines = [ln.split() for ln in f if ln.strip() and not ln.startswith("#")]
-    k = 0
-    while k < len(lines):
-        head = lines[k]
-        n = int(head[3])
-        rows = np.array([[float(x) for x in ln] for ln in lines[k + 1:k + 1 + n]])
-        blocks[(head[0], float(head[1]), float(head[2]))] = ([] if INTERPOLATED in head[4:]
-                                                             else [float(x) for x in head[4:]], rows)
-        k += 1 + n
+    for key, lines in table_blocks(path).items():
+        head = lines[0].split()
+        rows = np.array([[float(x) for x in ln.split()] for ln in lines[1:]])
+        blocks[key] = ([] if INTERPOLATED in head[4:] else [float(x) for x in head[4:]], rows)
     return blocks
 
 

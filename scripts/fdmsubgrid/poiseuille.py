@@ -43,7 +43,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import output, packing, profiles, rheology, sbm, shear, steadystate, suspension, timeseries
+from . import output, packing, profiles, rheology, sbm, shear, suspension, timeseries
 # the steady window (re-exported: the channel's analysis is where users meet them)
 from .steadystate import (MIN_SNAPSHOTS, STEADY_AFTER_TAUS, SLOPE_SIGMAS, Approach, SteadyWindow, Trend, fit_approach,  # noqa: F401
                           profile_change, steady_window, trend)
@@ -200,7 +200,7 @@ def budget(run_dir: str, duration: float) -> dict:
                 predicted_seconds=seconds, predicted_hours=seconds / 3600)
 
 
-def required_duration(rungs: Sequence[dict], width: float, window_taus: float = steadystate.STEADY_AFTER_TAUS) -> dict:
+def required_duration(rungs: Sequence[dict], width: float, window_taus: float = STEADY_AFTER_TAUS) -> dict:
     """How long a channel of wall distance `width` (a1) must run from a uniform start to its steady state and an
     averaging window, from the migration times the ladder measured (`rungs`: the `data` of analysed runs, each
     with `L` and `migration_time` ± `migration_time_err`). In units of L_y/(2 U_c) the shear-induced migration
@@ -216,12 +216,12 @@ def required_duration(rungs: Sequence[dict], width: float, window_taus: float = 
     w = 1.0 / err ** 2
     c = float(np.sum(w * tau * L ** 2) / np.sum(w * L ** 4))
     c_err = float(1.0 / math.sqrt(np.sum(w * L ** 4)))
-    taus = steadystate.STEADY_AFTER_TAUS + window_taus
+    taus = STEADY_AFTER_TAUS + window_taus
     return dict(c=c, c_err=c_err, chi2_per_rung=float(np.sum(w * (tau - c * L ** 2) ** 2) / len(L)),
                 rungs=[dict(width=float(l), migration_time=float(t), migration_time_err=float(e),
                             fitted=c * float(l) ** 2) for l, t, e in rows],
                 width=width, migration_time=c * width ** 2, migration_time_err=c_err * width ** 2,
-                window_taus=window_taus, steady_from=steadystate.STEADY_AFTER_TAUS * c * width ** 2,
+                window_taus=window_taus, steady_from=STEADY_AFTER_TAUS * c * width ** 2,
                 duration=taus * c * width ** 2, duration_err=taus * c_err * width ** 2)
 
 

@@ -383,24 +383,6 @@ def measured_name(jobs: Sequence[Tuple[str, float, float]]) -> str:
     return "_".join("%s_ad%g%s" % (kind, ad, "_ratio%g" % ratio if kind == "pair" else "") for kind, ad, ratio in jobs)
 
 
-def _block_texts(path: str) -> Dict[tuple, str]:
-    """Every block of a table as its text (header and rows), keyed by (kind, a/Delta, ratio)."""
-    with open(path) as f:
-        lines = [ln for ln in f if ln.strip() and not ln.startswith("#")]
-    out: Dict[tuple, str] = {}
-    k = 0
-    while k < len(lines):
-        head = lines[k].split()
-        try:
-            n = int(head[3])
-            key = (head[0], float(head[1]), float(head[2]))
-        except (IndexError, ValueError):
-            raise ValueError("%s: '%s' is not a block header (kind a/Delta ratio rows ...)" % (path, lines[k].strip()))
-        out[key] = "".join(lines[k:k + 1 + n])
-        k += 1 + n
-    return out
-
-
 def measured_blocks(folder: str | None = None) -> Dict[tuple, Tuple[str, str]]:
     """The blocks of every table measured on demand (FOLDER/*/subgrid_calibration.dat): {(kind, a/Delta,
     ratio): (the table's path, the block's text)}. The same block measured twice with different values is
@@ -413,12 +395,18 @@ def measured_blocks(folder: str | None = None) -> Dict[tuple, Tuple[str, str]]:
         path = os.path.join(folder, name, MEASURED_TABLE)
         if not os.path.isfile(path):
             continue
-        for key, text in _block_texts(path).items():
+        for key, lines in calibration.table_blocks(path).items():
+            text = "".join(lines)
             if key in out and out[key][1] != text:
                 raise ValueError("calibrations measured on demand: %s a/Delta %g ratio %g is in %s and, with other "
                                  "values, in %s: remove one of them" % (key + (out[key][0], path)))
             out.setdefault(key, (path, text))
     return out
+
+
+def _with_measured(table: Dict[tuple, tuple], measured: Dict[tuple, tuple]) -> Dict[tuple, tuple | None]:
+    """The keys of a table's blocks and of those measured on demand it lacks (for _grid_corners)."""
+    return {**table, **{k: None for k in measured if k not in table}}
 
 
 def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, table: str | None = None,
@@ -438,8 +426,7 @@ def coverage(radii: Sequence[float], a_over_delta: float, walls: bool = False, t
     delta = sizes[0] / a_over_delta
     shipped = calibration.read_table(table or _project_file(os.path.join("dem", "resistance", "data",
                                                                          "subgrid_calibration.dat")))
-    with_measured = dict(shipped)
-    with_measured.update({k: None for k in measured_blocks() if k not in shipped})
+    with_measured = _with_measured(shipped, measured_blocks())
     blocks = load_blocks()
     tests = list(leave_one_out(blocks)) + held_back_measurements(blocks) if tests is None else tests
     model = cost_model([b.summary for b in blocks])
@@ -509,8 +496,7 @@ def interpolated_table(targets: Sequence[Tuple[str, float, float]], table: str |
     done = []
     added = []
     measured = measured_blocks()
-    with_measured = dict(present)
-    with_measured.update({k: None for k in measured if k not in present})
+    with_measured = _with_measured(present, measured)
     for kind, ad, ratio in targets:
         key = (kind, float("%.6g" % ad), float("%.6g" % ratio))
         if key in present:

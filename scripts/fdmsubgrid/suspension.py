@@ -228,11 +228,11 @@ def write_case(run_dir: str, pack: packing.Packing, springs: Springs, a_over_del
                  held_drag=held_drag if fluid_every > 1 else None, coulomb_solve=coulomb_solve)
     if table is not None:
         # the interpolated blocks the run reads (dem/<table>), each with its measured error bound
-        scene["calibration_interpolated"] = [dict(kind=e.kind, radii=[e.pair[0]] if e.kind == "wall" else list(e.pair),
-                                                  a_over_delta=e.a_over_delta, ratio=e.ratio, error=e.error)
-                                             for e in calibration.interpolated]
+        def entry(e) -> dict:
+            return dict(kind=e.kind, radii=[e.pair[0]] if e.kind == "wall" else list(e.pair),
+                        a_over_delta=e.a_over_delta, ratio=e.ratio)
+        scene["calibration_interpolated"] = [dict(entry(e), error=e.error) for e in calibration.interpolated]
         # and those measured on demand, with the tables they come from
-        scene["calibration_measured"] = [dict(kind=e.kind, radii=[e.pair[0]] if e.kind == "wall" else list(e.pair),
-                                              a_over_delta=e.a_over_delta, ratio=e.ratio) for e in calibration.measured]
+        scene["calibration_measured"] = [entry(e) for e in calibration.measured]
         scene["calibration_measured_tables"] = list(calibration.tables)
     return scene
