@@ -41,19 +41,20 @@ def test_each_shipped_block_from_the_others(loo):
     """Leave one out: each shipped block interpolated from the other blocks of its kind, judged at its own
     4 measured positions in the cell. The interpolation's error (position-averaged closing velocity with the
     interpolated correction minus with the block's own) at every gap 1e-4 ... 1: pairs within 3.1 % (measured
-    3.0 %, a1/Delta 3, a2/a1 1.4 at xi 0.3), walls within 1.3 % (measured 1.25 %); against the theory the
+    3.0 %, a1/Delta 3, a2/a1 1.4 at xi 0.3), walls within 0.9 % (measured 0.8 %, a/Delta 3, extrapolated
+    below its sources; with a/Delta 5.6 in the table a/Delta 5 is inside, 0.4 %); against the theory the
     interpolated correction is within 3.8 % (the direct calibrations' own reach 1.8 %) and, near contact
     (xi <= 1e-3), where the correction carries the resistance, within 0.2 %."""
-    assert len(loo) == 10
+    assert len(loo) == 11
     for key, t in loo.items():
-        bound = 0.031 if t.kind == "pair" else 0.013
+        bound = 0.031 if t.kind == "pair" else 0.009
         assert t.worst() < bound, (key, t.added())
         assert np.max(np.abs(t.interpolated)) < 0.038, key
         for g, e in zip(t.gaps, t.interpolated):
             if g <= 1e-3:
                 assert abs(e) < 2e-3, (key, g, e)
     # the end blocks of the table were extrapolated (below and above their sources)
-    assert loo[("pair", 3.0, 1.0)].distance()[0] > 0 and loo[("wall", 5.0, 1.0)].distance()[1] > 0
+    assert loo[("pair", 3.0, 1.0)].distance()[0] > 0 and loo[("wall", 5.6, 1.0)].distance()[1] > 0
 
 
 def fixed_xi_leave_one_out(target, blocks):
@@ -206,7 +207,7 @@ def test_cost_model_against_the_measured_calibrations(blocks):
 
 def test_scene_table(tmp_path, env):
     """write_scene_table: radii 1 and 2 at a1/Delta 3 between walls: the wall of the larger sphere (a/Delta 6,
-    measured 1.3 %) is added and read by the resistance library; the pairs 1-2 and 2-2 (3.0 %) are not."""
+    measured 0.6 %) is added and read by the resistance library; the pairs 1-2 and 2-2 (3.0 %) are not."""
     data = tmp_path / "dem" / "resistance" / "data"
     data.mkdir(parents=True)
     out = data / "subgrid_calibration.dat"
@@ -266,8 +267,9 @@ def test_the_equal_pair_at_a_over_delta_5_6(blocks, loo):
 
 def test_the_table_names_the_commands_that_measure_it_again():
     """The shipped table's header names one command per part it was measured in (a1/Delta 3-5 with walls and
-    the tangential functions; the equal pair at 5.6 in boxes of 46 and 68 cells), each meshable as written; a
-    wall at 5.6 in boxes of its own would be a third."""
+    the tangential functions; the equal pair at 5.6 in boxes of 46 and 68 cells; the wall at 5.6 with its
+    tangential functions in boxes of 48 and 68), each meshable as written; a wall at a further a/Delta in the
+    pair's boxes would join the first part."""
     shipped = [b.calibration() for b in subgridinterp.load_blocks()]
     out = "dem/resistance/data/subgrid_calibration.dat"
     keys = calibration.read_table(os.path.join(PROJECT, out))
@@ -278,13 +280,12 @@ def test_the_table_names_the_commands_that_measure_it_again():
         "python3 -m fdmsubgrid.calibration --a-over-delta 3 4 5 --ratios 1 1.4 --boxes 8 12 --offsets 4 --tangential "
         "--pair-tangential --out " + out,
         "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --ratios 1 --no-wall --boxes 8.214285714 12.14285714 "
-        "--offsets 4 --pair-tangential --out " + out]
-    with open(os.path.join(PROJECT, out)) as f:
-        header = [line for line in f if line.startswith("# Regenerate: ") or line.startswith("#   and: ")]
-    assert header == ["# Regenerate: %s\n" % commands[0], "#   and: %s\n" % commands[1]]
-    # a wall at the same a1/Delta in boxes of its own (L x 1.25 L x L in whole cells): a part of its own
-    wall = dataclasses.replace(next(c for c in shipped if c.kind == "wall"), a_over_delta=5.6,
-                               boxes=[8.571428571, 12.14285714])
-    assert calibration.regenerate_commands(shipped + [wall], out, tangential + [5.6], pairs) == commands + [
+        "--offsets 4 --pair-tangential --out " + out,
         "python3 -m fdmsubgrid.calibration --a-over-delta 5.6 --no-pairs --boxes 8.571428571 12.14285714 --offsets 4 "
         "--tangential --out " + out]
+    with open(os.path.join(PROJECT, out)) as f:
+        header = [line for line in f if line.startswith("# Regenerate: ") or line.startswith("#   and: ")]
+    assert header == ["# Regenerate: %s\n" % commands[0]] + ["#   and: %s\n" % c for c in commands[1:]]
+    # without the wall at 5.6 the table was measured in two parts
+    assert calibration.regenerate_commands([c for c in shipped if (c.kind, c.a_over_delta) != ("wall", 5.6)], out,
+                                           [t for t in tangential if t != 5.6], pairs) == commands[:2]

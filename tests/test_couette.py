@@ -515,6 +515,39 @@ def test_table8_names_a_run_that_stopped(tmp_path, env):
     assert "fluid/system not found" in (tmp_path / "table8_phi0.47_broken.log").read_text()
 
 
+def test_table8_continues_a_new_run_folder_from_its_kept_snapshot(tmp_path, env, capsys):
+    """--snapshots DIR: a row whose run folder is new (nothing run, no checkpoint) is continued from the compact
+    snapshot kept under the run folder's name in DIR (fdmRun --from-snapshot, on to the step asked), one that is
+    not kept starts afresh; fdmRun itself checks the snapshot (here it stops on the folder without a case, and
+    table8.py names the run and its log). --save without --snapshots is refused."""
+    import argparse
+    table8 = load_case_module("couette", "table8")
+    run_dir = tmp_path / "runs" / "table8_phi0.47_25x25x20_ad4_dt0.01_seed1_calibrated_fluidEvery2"
+    run_dir.mkdir(parents=True)
+    kept = tmp_path / "snapshots" / run_dir.name
+    kept.mkdir(parents=True)
+    (kept / "README").write_text("Compact snapshot\n")
+    args = argparse.Namespace(np_fluid=1, snapshots=str(tmp_path / "snapshots"))
+    assert table8.snapshot_folder(str(run_dir), args) == str(kept)
+    with pytest.raises(SystemExit) as stopped:
+        table8._fdmrun(str(run_dir), args, until=2500)
+    line = [l for l in capsys.readouterr().out.splitlines() if l.startswith("table8: ")][-1]
+    assert "fdmRun -f 1 --from-snapshot %s --until 2500 %s " % (kept, run_dir) in line
+    assert str(run_dir) + ".log" in str(stopped.value)
+    # another row's folder: no snapshot of its name, a fresh start
+    other = tmp_path / "runs" / "table8_phi0.52_broken"
+    other.mkdir()
+    assert table8.snapshot_folder(str(other), args) is None
+    with pytest.raises(SystemExit):
+        table8._fdmrun(str(other), args)
+    line = [l for l in capsys.readouterr().out.splitlines() if l.startswith("table8: ")][-1]
+    assert "--from-snapshot" not in line and line.endswith("fdmRun -f 1 %s (log %s.log)" % (other, other))
+    with pytest.raises(SystemExit) as refused:
+        table8.main(["--phis", "0.47", "--save", "--workdir", str(tmp_path / "runs"), "--out", str(tmp_path / "t.json")])
+    assert refused.value.code == 2
+    assert "--save writes into the --snapshots folder" in capsys.readouterr().err
+
+
 def test_table8_extends_a_run_whose_averaging_window_is_short():
     """table8.py's rule: a finished run averaged over fewer than --min-average strain units after its
     transient is continued by the shortfall, at least a tenth of --min-average (in whole steps), never

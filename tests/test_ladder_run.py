@@ -65,6 +65,11 @@ def test_bad_rung_and_options_are_refused(tmp_path, env):
     assert refused.returncode == 2 and "not 'L7'" in refused.stderr and "L12, L20 or paper" in refused.stderr
     refused = run([LADDER, "L20", "--save", "--workdir", str(tmp_path)], env)
     assert refused.returncode == 2 and "no run in %s" % tmp_path in refused.stderr
+    refused = run([LADDER, "L12", "--until", "100", "--workdir", str(tmp_path)], env)
+    assert refused.returncode == 2 and "--until continues a run folder's own checkpoint or the committed " \
+        "snapshot" in refused.stderr
+    # the committed snapshot of L20 is continued by --until, but only past its own step
     refused = run([LADDER, "L20", "--until", "100", "--workdir", str(tmp_path)], env)
-    assert refused.returncode == 2 and "--until continues a run folder's own checkpoint" in refused.stderr
+    assert refused.returncode == 2 and "--until 100: the committed snapshot" in refused.stderr
+    assert "already" in refused.stderr
     assert not os.listdir(tmp_path)

@@ -110,6 +110,10 @@ def test_bad_options_are_refused(case_module, tmp_path):
         case_module.main(["--size", "8", "12.1", "8", "--workdir", str(tmp_path)])
     with pytest.raises(SystemExit):
         case_module.main(["--phi", "0.7", "--workdir", str(tmp_path)])
+    # --until continues a snapshot past the scene's end; a new run ends at its --duration
+    with pytest.raises(SystemExit) as refused:
+        case_module.main(["--until", "100", "--workdir", str(tmp_path)])
+    assert refused.value.code == 2 and not os.listdir(tmp_path)
 
 
 def test_steady_state_keys_of_a_short_run(small_run):

@@ -161,7 +161,7 @@ def test_an_uncalibrated_scene_is_refused_one_line_per_pair(couette, env, tmp_pa
     """issue 50's example: phi 0.4 in 12^3 a1 at a1/Delta 6. Each (a1/Delta, a2/a1) pair or wall a/Delta that
     neither the table nor the interpolation within 2 % covers gets one line naming the command that measures it
     (deminput.scene_calibration, subgridinterp.refusal); the wall of radius 1 at a/Delta 6, interpolated within
-    1.3 %, is named as such; then the table's line and the cut-off alternative. Nothing is written."""
+    0.6 %, is named as such; then the table's line and the cut-off alternative. Nothing is written."""
     with pytest.raises(SystemExit) as refused:
         couette.main(["--phi", "0.4", "--size", "12", "12", "12", "--a-over-delta", "6", "--write-only",
                       "--workdir", str(tmp_path)])
@@ -178,9 +178,9 @@ def test_an_uncalibrated_scene_is_refused_one_line_per_pair(couette, env, tmp_pa
     assert {line.split(":")[0].strip() for line in missing} == {
         "the pair of radii 1 and 1 at a1/Delta 6 (a2/a1 1)", "the pair of radii 1 and 1.4 at a1/Delta 6 (a2/a1 1.4)",
         "the pair of radii 1.4 and 1.4 at a1/Delta 8.4 (a2/a1 1)", "radius 1.4 against a wall at a/Delta 8.4"}
-    assert lines[5] == "  interpolated within 2 %: radius 1 at a wall (a/Delta 6, error 1.3 %)"
+    assert lines[5] == "  interpolated within 2 %: radius 1 at a wall (a/Delta 6, error 0.6 %)"
     assert lines[-2] == ("  dem/resistance/data/subgrid_calibration.dat has pairs a1/Delta 3, 4, 5 x a2/a1 1, 1.4; "
-                         "5.6 x 1; walls a/Delta 3, 4, 5 (interpolated between)")
+                         "5.6 x 1; walls a/Delta 3, 4, 5, 5.6 (interpolated between)")
     assert lines[-1].startswith("  or --model cutoff (squeeze up to 16 % off")
     assert len(lines) == 8
     assert os.listdir(tmp_path) == []

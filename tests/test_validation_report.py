@@ -48,10 +48,11 @@ def test_report_carries_the_case_physics(sheared_report):
     assert "## 5.2.2" in text and "cases/shearedSphere" in text and "| S* (unbounded: 1) |" in text
     assert (work / "shearedSphere" / "results.json").exists() and (work / "shearedSphere" / "log").exists()
     # the squeeze calibration at every position, read from the shipped measurements (no run): two rows per
-    # calibration (3 resolutions x pair 1, pair 1.4, wall), the mean's error within the spread's reach
+    # calibration (3 resolutions x pair 1, pair 1.4, wall; the pair 1 and the wall at 5.6), the mean's error
+    # within the spread's reach
     assert "## Appendix B: the squeeze calibration at every position in the cell" in text
     calibration_rows = summary["squeeze_calibration_rows"]
-    assert len(calibration_rows) == 18
+    assert len(calibration_rows) == 22
     for row in calibration_rows:
         assert row["error"] == pytest.approx((row["value"] - row["reference"]) / row["reference"], rel=1e-9)
         assert abs(row["error"]) < (0.035 if "mean" in row["quantity"] else 0.1)

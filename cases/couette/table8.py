@@ -17,6 +17,9 @@ run or resumed, analysed, then the viscosity curve with the Maron-Pierce fit (Eq
                                             checkpointed every strain unit; the next call resumes it)
   table8.py --jobs 2                        rows run at once (default: one per --np-fluid cores this
                                             process may use; a row's particle rank mostly waits)
+  table8.py --snapshots DIR [--save]        keep each row's compact snapshot in DIR (--save writes them and
+                                            stops); a row whose run folder is new continues from its
+                                            snapshot there: a run of several sessions outlives its machine
   table8.py --min-average 20                each finished run whose averaging window (after the transient
                                             its MSER rule finds) is shorter is extended (fdmRun --resume
                                             --until) until it holds 20 strain units, up to --max-strain
@@ -213,13 +216,18 @@ def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None,
     """Start the run in run_dir, or resume it from its checkpoint (to step `until` if given); phi names the
     row in the line that says so (one print: with --jobs 2 the rows' lines must not interleave)."""
     fdmrun = [os.path.join(PROJECT, "scripts", "fdmRun"), "-f", str(args.np_fluid)]
+    kept = snapshot_folder(run_dir, args)
     try:
         checkpoint.select(run_dir)
         cmd = fdmrun + ["--resume"] + (["--until", str(until)] if until else []) + [run_dir]
     except checkpoint.CheckpointError:
-        if until and steps_done(run_dir) >= steps_planned(run_dir):
+        if kept and not steps_done(run_dir):
+            # the run folder is new (a new machine): the particles from the kept snapshot, the fluid from rest
+            cmd = fdmrun + ["--from-snapshot", kept] + (["--until", str(until)] if until else []) + [run_dir]
+        elif until and steps_done(run_dir) >= steps_planned(run_dir):
             raise   # a finished run without a checkpoint cannot be extended
-        cmd = fdmrun + (["--overwrite"] if steps_done(run_dir) else []) + [run_dir]
+        else:
+            cmd = fdmrun + (["--overwrite"] if steps_done(run_dir) else []) + [run_dir]
     log = run_dir + ".log"
     print("table8: %s%s (log %s)" % ("" if phi is None else "phi_bulk %g: " % phi, " ".join(cmd), log), flush=True)
     with open(log, "a") as f:
@@ -228,6 +236,32 @@ def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None,
         # fdmRun has said why at the end of the log; the checkpoints are kept
         raise SystemExit("table8: fdmRun stopped with exit code %d on %s: the end of %s says why; the same "
                          "table8.py command resumes the run from its last checkpoint" % (done.returncode, run_dir, log))
+
+
+def snapshot_folder(run_dir: str, args: argparse.Namespace) -> Optional[str]:
+    """The compact snapshot of this run kept under --snapshots (its folder named as the run folder), if any."""
+    if not getattr(args, "snapshots", None):
+        return None
+    folder = os.path.join(args.snapshots, os.path.basename(os.path.normpath(run_dir)))
+    return folder if os.path.exists(os.path.join(folder, "README")) else None
+
+
+def save_snapshots(args: argparse.Namespace) -> None:
+    """--save: each row's newest checkpoint as a compact snapshot in --snapshots (replacing the one there),
+    the rows without a run folder or checkpoint named."""
+    for phi in args.phis:
+        run_dir = find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args), args.seed, args.model,
+                           row_fluid_every(phi, args), args.coulomb_solve)
+        if run_dir is None:
+            print("table8 --save: phi_bulk %g: no run folder in %s" % (phi, args.workdir))
+            continue
+        dest = os.path.join(args.snapshots, os.path.basename(os.path.normpath(run_dir)))
+        try:
+            snap = checkpoint.snapshot(run_dir, dest)
+        except checkpoint.CheckpointError as e:
+            print("table8 --save: phi_bulk %g: %s" % (phi, e))
+            continue
+        print("table8 --save: phi_bulk %g: step %d kept in %s (%.0f kB)" % (phi, snap["step"], dest, snap["bytes"] / 1e3))
 
 
 def extension(row: Dict, args: argparse.Namespace, dt: float) -> Optional[int]:
@@ -488,6 +522,12 @@ def main(argv: Optional[List[str]] = None) -> Dict:
     p.add_argument("--workdir", default=os.path.join(HERE, "runs"))
     p.add_argument("--out", default=os.path.join(PROJECT, "docs", "data", "table8.json"))
     p.add_argument("--analyse-only", action="store_true", help="report the runs as they stand; run nothing")
+    p.add_argument("--snapshots", metavar="DIR", default=None,
+                   help="a folder keeping each row's compact snapshot (DIR/<run folder name>/; docs/coupling.md "
+                        "\"Compact snapshot\"), to commit: a row whose run folder is new continues from it (the "
+                        "particles from its step, the fluid from rest), so that a run outlives its machine")
+    p.add_argument("--save", action="store_true", help="with --snapshots: write each row's newest checkpoint "
+                   "into its snapshot folder (replacing the one there) and stop")
     p.add_argument("--rows-from", nargs="+", default=[], metavar="JSON",
                    help="add the rows of earlier table8.py summaries (runs made elsewhere, or whose folders are "
                    "gone) for the phi_bulk not in --phis, e.g. docs/data/validation_table8_calibrated.json; fitted by the "
@@ -504,6 +544,11 @@ def main(argv: Optional[List[str]] = None) -> Dict:
         p.error("--paper runs all seven rows: give it or --phis, not both")
     args.phis = sorted(couettescene.TABLE8) if args.paper else (args.phis or DEFAULT_PHIS)
     args.jobs = args.jobs or default_jobs(args.np_fluid)   # the pool's size and the budget's
+    if args.save:
+        if not args.snapshots:
+            p.error("--save writes into the --snapshots folder: give it")
+        save_snapshots(args)
+        return {}
     os.makedirs(args.workdir, exist_ok=True)
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)   # the figures are written first
     start = time.time()

@@ -119,10 +119,15 @@ def main(argv: list[str] | None = None) -> dict:
                    help="continue the compact snapshot in this folder (python3 -m fdmsubgrid.checkpoint snapshot RUN "
                         "DIR) in the scene these options write: the particles from its step on, the fluid from rest "
                         "(fdmRun --from-snapshot; docs/coupling.md \"Compact snapshot\")")
+    p.add_argument("--until", metavar="STEP", type=int, default=None,
+                   help="with --from-snapshot: run on to this particle step instead of the scene's end (a run "
+                        "continued past its --duration, as the ladder's rungs are)")
     case.add_run_options(p, HERE, tol_lambda=1e-2, model=True)
     args = p.parse_args(argv)
     if args.paper:
         args.size = list(PAPER_SIZE)
+    if args.until is not None and not args.from_snapshot:
+        p.error("--until %d goes with --from-snapshot (a new run ends at its --duration)" % args.until)
     started = time.time()
     material = sbm.from_couette_results(args.couette) if args.couette else None
     table8 = table8_material(args.table8)
@@ -249,7 +254,8 @@ def main(argv: list[str] | None = None) -> dict:
         return dict(run_dir=run_dir, **scene)
 
     case.run(run_dir, np_fluid=args.np_fluid, np_dem=args.np_dem,
-             extra=("--from-snapshot", args.from_snapshot) if args.from_snapshot else ())
+             extra=(("--from-snapshot", args.from_snapshot) if args.from_snapshot else ())
+             + (("--until", str(args.until)) if args.until is not None else ()))
     results = report(run_dir, args.out, material, args.from_time, argv, args, started, table8,
                      args.plateau_threshold)
     if not args.keep:

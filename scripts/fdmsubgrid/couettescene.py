@@ -134,12 +134,13 @@ def time_step_warning(phi: float, dt: float, sizes: packing.SizeDistribution | N
 
 
 def choose_springs(phi: float, dt: float, delta: float, kn: float | None = None, kt: float | None = None,
-                   sizes: packing.SizeDistribution | None = None, model: str = "calibrated") -> suspension.Springs:
+                   sizes: packing.SizeDistribution | None = None, model: str = "calibrated",
+                   pair: bool = True) -> suspension.Springs:
     """The springs by the rule of the module docstring (docs/contact.md) for the shear stress
-    eta gamma_dot_0 eta_MP(phi) and the sizes (default the paper's), unless given; model: the scene's
-    sub-grid model (suspension.choose_springs)."""
+    eta gamma_dot_0 eta_MP(phi) and the sizes (default the paper's), unless given; model, pair: the scene's
+    sub-grid model and whether it holds two of the smallest spheres (suspension.choose_springs)."""
     return suspension.choose_springs(ETA * SHEAR_RATE * suspension.maron_pierce_viscosity(phi), dt, delta, kn, kt,
-                                     sizes, model=model)
+                                     sizes, model=model, pair=pair)
 
 
 def write_case(run_dir: str, pack: packing.Packing, springs: suspension.Springs, a_over_delta: float, dt: float,
@@ -228,13 +229,14 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
     calibration = deminput.scene_calibration("couette", pack.radii, delta, walls=True, model=model)
     if calibration.line():
         print(calibration.line(), flush=True)
-    springs = choose_springs(pack.phi, dt, delta, kn, kt, sizes, model=model)
+    springs = choose_springs(pack.phi, dt, delta, kn, kt, sizes, model=model,
+                             pair=int(np.sum(np.isclose(pack.radii, min(pack.radii)))) >= 2)
     print(springs.describe(dt))
     warning = time_step_warning(pack.phi, dt, sizes)
     if warning:
         print(warning, flush=True)
 
-    name = run_name(pack.phi if n_particles is None else phi, size, a_over_delta, dt, seed, acceleration, model,
+    name = run_name(pack.phi if n_particles is None or phi is None else phi, size, a_over_delta, dt, seed, acceleration, model,
                     fluid_every, table8, sizes, coulomb_solve)
     run_dir = os.path.join(workdir, name)
     if os.path.exists(run_dir):

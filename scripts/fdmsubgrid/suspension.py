@@ -127,18 +127,19 @@ def scaled_time_step(dt: float, sizes: packing.SizeDistribution) -> float:
 
 def choose_springs(stress: float, dt: float, delta: float, kn: float | None = None,
                    kt: float | None = None, sizes: packing.SizeDistribution | None = None,
-                   model: str = "calibrated") -> Springs:
+                   model: str = "calibrated", pair: bool = True) -> Springs:
     """The springs by the rule of the module docstring for the shear stress `stress` [Pa] and the size distribution
     `sizes` (default the paper's), unless given (fdmsubgrid.contactstability: the design load, the recipe's k_n,
     the explicit springs' limits): the design load of the largest sphere, the resistances of a pair of the
     smallest. model: the scene's sub-grid model (pair_style fdm/subgrid model, write_case's), which sets zeta_n
-    and zeta_t (not the springs)."""
+    and zeta_t (not the springs); pair False: the scene holds no two of the smallest spheres (a lone sphere),
+    so no calibration of their pair exists to be asked for, and zeta_n, zeta_t are the cut-off model's."""
     sizes = PAPER_SIZES if sizes is None else sizes
     design_load = contactstability.design_load(sizes.largest * A1, stress)
     a_min = sizes.smallest * A1
     # the contact points in the middle of the gap (docs/contact.md 2): lever arms a + h_r/4
-    zeta_n, zeta_t = theory.pair_mode_resistances(a_min, a_min, 0.5 * ROUGHNESS, delta, ETA, model=model,
-                                                  contact_in_mid_gap=True)
+    zeta_n, zeta_t = theory.pair_mode_resistances(a_min, a_min, 0.5 * ROUGHNESS, delta, ETA,
+                                                  model=model if pair else "cutoff", contact_in_mid_gap=True)
     kn = contactstability.normal_stiffness(design_load, ROUGHNESS) if kn is None else kn
     # k_t independent of dt: until the return mapping of docs/contact.md 2c the rule was
     # min(k_n, 0.5 zeta_t/dt), which softened friction as dt grew (eta_s at phi 0.47 fell with dt)
