@@ -207,22 +207,41 @@ def test_a_channel_starts_from_the_last_record_of_another(case_module, small_run
 
 def test_a_channel_continues_from_a_compact_snapshot_and_is_analysed(case_module, small_run, tmp_path):
     """The small run's compact snapshot (its last checkpoint, step 40: the case script recorded the scene's
-    command, without where it was written) continued to time 3 by `--from-snapshot` in a new folder: the run
-    starts at step 41, its records after step 40, and the analysis of a run that starts at t = 2 works."""
+    command, without where it was written) continued past the scene's end to step 60 (t = 3) by
+    `--from-snapshot --until` in a new folder: the run starts at step 41, its records after step 40, and the
+    analysis of a run that starts at t = 2 works. With the small run's kept segment (`--segments`, as
+    ladderRun keeps them) the analysis covers the whole migration: the segment's 20 records before the new
+    folder's 10, the series and phi_center's start the small run's own."""
     dest = str(tmp_path / "snapshot")
     assert checkpoint.snapshot(small_run["run_dir"], dest)["step"] == 40
     scene = open(os.path.join(dest, "scene")).read()
     assert scene == "python3 cases/poiseuille/poiseuille.py %s\n" % " ".join(SMALL), scene
-    args = SMALL[:SMALL.index("--duration")] + ["--duration", "3"] + SMALL[SMALL.index("--duration") + 2:]
-    r = case_module.main(args + ["--from-snapshot", dest, "--workdir", str(tmp_path / "work"),
-                                 "--out", str(tmp_path / "r.json")])
+    r = case_module.main(SMALL + ["--from-snapshot", dest, "--until", "60", "--workdir", str(tmp_path / "work"),
+                                  "--out", str(tmp_path / "r.json")])
     steps = output.steps(os.path.join(r["run_dir"], "fluid"))["step"].astype(int)
     assert list(steps) == list(range(41, 61))
     records = output.read_particle_records(os.path.join(r["run_dir"], "dem", "particles.records"), mmap=False)
     assert list(records.steps) == list(range(42, 61, 2))
     assert r["time"] == pytest.approx(3.0) and r["steps"] == 20 and r["unconverged_steps"] == 0
     assert r["wall_force_balance_rel_error"] < 0.01
+    assert r["records_from_segments"] == 0 and len(r["series"]["time"]) == 10
+    # the continued run's scene is the snapshot's: how far it went is not part of it
+    assert open(os.path.join(r["run_dir"], "scene")).read() == scene
     assert "==== fdmRun --from-snapshot %s: step 40 to 60" % dest in open(os.path.join(r["run_dir"], "log.fluid")).read()
+    # the whole history: the small run's segment before the new folder's records
+    poiseuille.write_segment(small_run["run_dir"], str(tmp_path / "segments"))
+    whole = case_module.main(["--analyse", r["run_dir"], "--segments", str(tmp_path / "segments"),
+                              "--out", str(tmp_path / "whole.json")])
+    assert whole["records_from_segments"] == 20 and whole["snapshots_averaged"] <= 10
+    assert whole["series"]["time"] == pytest.approx(small_run["series"]["time"] + r["series"]["time"])
+    assert whole["series"]["phi_center"][:20] == pytest.approx(small_run["series"]["phi_center"], abs=1e-5)
+    assert whole["series"]["phi_center"][20:] == pytest.approx(r["series"]["phi_center"], abs=1e-12)
+    assert whole["phi_center_initial"] == pytest.approx(small_run["phi_center_initial"], abs=1e-5)
+    assert whole["profiles_from"] >= 2.0
+    # a segment of another channel (profiles in other bins) is refused by name
+    other = dict(json.load(open(next((tmp_path / "segments").iterdir()))), y=[0.5] * 7)
+    with pytest.raises(poiseuille.PoiseuilleRunError, match="bins"):
+        poiseuille.analyse(r["run_dir"], segments=[dict(other, time=[t - 5 for t in other["time"]])])
 
 
 def test_required_duration_scales_the_ladders_migration_time(case_module, capsys):

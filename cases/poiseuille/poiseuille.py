@@ -18,7 +18,8 @@ a LIGGGHTS atom type, the smallest setting the mesh and the time step (fdmsubgri
   poiseuille.py --duration 2    a few steps (the CI test)
   poiseuille.py --paper         writes the paper's (40, 40, 20) a1 channel (not run; --run runs it)
   poiseuille.py --write-only    writes the scene and stops (fdmRun runs it)
-  poiseuille.py --analyse RUN   the analysis of a run folder as it stands
+  poiseuille.py --analyse RUN   the analysis of a run folder as it stands (--segments FOLDER: with the run's
+                                kept history before the folder, for a run continued from a compact snapshot)
   poiseuille.py ... --from-snapshot DIR   writes the scene of these options and continues the compact
                                 snapshot DIR in it (its file `scene` holds the options; docs/coupling.md)
   poiseuille.py --help          every option
@@ -89,6 +90,10 @@ def main(argv: list[str] | None = None) -> dict:
                    help="the central plateau is where phi (bins of a1) is at least this (the paper's is about 0.63)")
     p.add_argument("--from-time", type=float, default=None, help="average from this time on (default: the steady "
                    "window found from the data, 3 migration times on, fdmsubgrid.poiseuille.steady_window)")
+    p.add_argument("--segments", metavar="FOLDER", default=None,
+                   help="the run's kept history before its folder's first record (segment_<t0>_<t1>.json files, as "
+                        "ladderRun --save keeps them): a run continued from a compact snapshot is analysed over its "
+                        "whole migration, not from the snapshot on")
     p.add_argument("--overwrite", action="store_true", help="replace a run folder that already exists")
     p.add_argument("--analyse", metavar="RUN_DIR", default=None, help="analyse this run folder as it stands")
     p.add_argument("--compare", metavar="RUN_DIR", default=None, help="with --analyse: the rms and largest "
@@ -163,9 +168,13 @@ def main(argv: list[str] | None = None) -> dict:
         return b
     if args.analyse and args.compare:
         return compare(args.analyse, args.compare, material, args.from_time, table8)
+    try:
+        segments = poiseuille.read_segments(args.segments) if args.segments else []
+    except (OSError, ValueError, poiseuille.PoiseuilleRunError) as e:
+        p.error("--segments: %s" % e)
     if args.analyse:
         return report(args.analyse, args.out, material, args.from_time, argv, args, started, table8,
-                      args.plateau_threshold)
+                      args.plateau_threshold, segments)
 
     pack = None
     if args.from_records:
@@ -257,7 +266,7 @@ def main(argv: list[str] | None = None) -> dict:
              extra=(("--from-snapshot", args.from_snapshot) if args.from_snapshot else ())
              + (("--until", str(args.until)) if args.until is not None else ()))
     results = report(run_dir, args.out, material, args.from_time, argv, args, started, table8,
-                     args.plateau_threshold)
+                     args.plateau_threshold, segments)
     if not args.keep:
         case.delete_fields(run_dir)
     return results
@@ -345,11 +354,11 @@ def validation_rows(results: dict) -> List[Row]:
 
 def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional[Sequence[str]] = None,
            options: Any = None, started: Optional[float] = None, table8=None,
-           plateau_threshold: float = poiseuille.PLATEAU_THRESHOLD) -> dict:
-    """Analyse a run folder (fdmsubgrid.poiseuille.analyse), write `out` (fdmsubgrid.results: argv and
-    options are the command's) and the figure beside it."""
+           plateau_threshold: float = poiseuille.PLATEAU_THRESHOLD, segments: Sequence[dict] = ()) -> dict:
+    """Analyse a run folder (fdmsubgrid.poiseuille.analyse; segments: the run's kept history before it), write
+    `out` (fdmsubgrid.results: argv and options are the command's) and the figure beside it."""
     started = time.time() if started is None else started
-    results, fig = poiseuille.analyse(run_dir, material, from_time, table8, plateau_threshold)
+    results, fig = poiseuille.analyse(run_dir, material, from_time, table8, plateau_threshold, segments)
     results.update(case="poiseuille", run=os.path.basename(os.path.normpath(run_dir)), run_dir=os.path.abspath(run_dir))
     figure = os.path.join(os.path.dirname(os.path.abspath(out)), "results_poiseuille.png")
     poiseuille.plot(figure, fig)

@@ -504,15 +504,17 @@ def check_stamp(case_dir: str, dem_input: str, accept_new: bool = False) -> str:
 
 SCENE_FILE = "scene"                 # in a case folder and in a snapshot: the command that writes the scene
 SNAPSHOT_CALIBRATION = "calibration.json"
-# the options of a case script that say where, not what: left out of the scene command it records
-_WHERE_OPTIONS = ("--workdir", "--out", "--from-snapshot")
+# the options of a case script that say where (or how far, or with which history), not what: left out of the
+# scene command it records
+_WHERE_OPTIONS = ("--workdir", "--out", "--from-snapshot", "--until", "--segments")
 _WHERE_FLAGS = ("--overwrite", "--keep")
 
 
 def scene_command(script: str, argv: list[str]) -> str:
     """The command line that writes a case script's scene again: the script (relative to the repository,
-    run from its root) and its options, without those that say where it is written or what happens to an
-    older folder (--workdir, --out, --from-snapshot, --overwrite, --keep)."""
+    run from its root) and its options, without those that say where it is written, how far a continued run
+    goes or what happens to an older folder (--workdir, --out, --from-snapshot, --until, --segments,
+    --overwrite, --keep)."""
     root = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
     path = os.path.relpath(os.path.abspath(script), root)
     kept, skip = [], False

@@ -323,15 +323,53 @@ def sbm_comparison(material: sbm.MaterialFunctions, snapshots: list, channel: pr
     return model, float(np.sqrt(np.mean(dphi ** 2))), float(np.sqrt(np.mean(du ** 2))), phi_region
 
 
+def earlier_series(segments: Sequence[dict], before: float) -> dict:
+    """The migration series of kept segments (migration_series, write_segment) joined in time and cut before
+    `before` (the first record of the run folder that continues them): a run continued from a compact snapshot
+    on a new machine has only its own records, its history lives in the segments. A record present in two
+    segments is taken once."""
+    time, centre, walls, profile = [], [], [], []
+    y = None
+    for seg in sorted(segments, key=lambda d: d["time"][0]):
+        if y is not None and len(seg["y"]) != len(y):
+            raise PoiseuilleRunError("the kept segments have profiles in %d and %d bins: not of one channel"
+                                     % (len(y), len(seg["y"])))
+        y = seg["y"]
+        for k, t in enumerate(seg["time"]):
+            if t < before - 1e-6 and (not time or t > time[-1] + 1e-6):
+                time.append(t)
+                centre.append(seg["phi_center"][k])
+                walls.append(seg["phi_wall_layer"][k])
+                profile.append(seg["phi_profile"][k])
+    return dict(time=np.array(time), phi_center=np.array(centre), phi_wall_layer=np.array(walls),
+                phi_profile=profile, y=y)
+
+
+def read_segments(folder: str) -> list[dict]:
+    """The segment files (segment_<t0>_<t1>.json) of a folder, e.g. cases/poiseuille/ladder20/segments."""
+    import json
+    names = sorted(n for n in os.listdir(folder) if n.startswith("segment_") and n.endswith(".json"))
+    if not names:
+        raise PoiseuilleRunError("%s holds no segment_<t0>_<t1>.json" % folder)
+    out = []
+    for name in names:
+        with open(os.path.join(folder, name)) as f:
+            out.append(json.load(f))
+    return out
+
+
 def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_time: float | None = None,
-            table8: sbm.MaterialFunctions | None = None, plateau_threshold: float | None = None
-            ) -> tuple[dict, dict]:
+            table8: sbm.MaterialFunctions | None = None, plateau_threshold: float | None = None,
+            segments: Sequence[dict] = ()) -> tuple[dict, dict]:
     """The results of a run (a flat dict, the keys of cases/poiseuille/results.json; `species` one dict per
     species, profiles.species_summary with its phi_center in the central band |y - mid| < a1 in place of
     phi_core) and what the figure needs. material: the SBM's material functions (default the paper's,
     sbm.MaterialFunctions); table8: a second set drawn beside them, fitted to this project's Table 8 rows
     (sbm.from_couette_results), or None; plateau_threshold: the phi above which the central plateau is
-    measured (central_plateau; default PLATEAU_THRESHOLD, 0.6)."""
+    measured (central_plateau; default PLATEAU_THRESHOLD, 0.6); segments: the kept migration series of the run
+    before this folder's first record (read_segments), for a run continued from a compact snapshot: the steady
+    window, the migration's fit, phi_center and the series run over them and this folder's records; the
+    profiles are averaged over this folder's records in the window."""
     material = material or sbm.MaterialFunctions.maron_pierce_power_law()
     run = shear.read_run(run_dir)
     sc = scales(run)
@@ -343,22 +381,33 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
     if len(snapshots) < MIN_SNAPSHOTS:
         raise PoiseuilleRunError("%s: %d particle snapshots are too few for time averages (%d at least): run longer"
                          % (run_dir, len(snapshots), MIN_SNAPSHOTS))
-    times = np.array([s.time for s in snapshots])
+    own_times = np.array([s.time for s in snapshots])
     mid = channel.y_mid
-    phi_center, phi_walls = centre_and_wall_series(snapshots, channel)
+    own_centre, own_walls = centre_and_wall_series(snapshots, channel)
     phi_integral = np.array([profiles.volume_fraction(s, channel) for s in snapshots])
+    own_profiles = [profiles.profiles_in_bins(s, channel).phi for s in snapshots]
+    # the run's history before this folder (a compact snapshot's continuation): the kept segments
+    before = earlier_series(segments, float(own_times[0])) if segments else None
+    if before is not None and before["y"] is not None and len(before["y"]) != len(own_profiles[0]):
+        raise PoiseuilleRunError("the kept segments have profiles in %d bins, %s in %d: not this channel"
+                                 % (len(before["y"]), run_dir, len(own_profiles[0])))
+    n_before = 0 if before is None else len(before["time"])
+    times = own_times if not n_before else np.concatenate([before["time"], own_times])
+    phi_center = own_centre if not n_before else np.concatenate([before["phi_center"], own_centre])
+    phi_walls = own_walls if not n_before else np.concatenate([before["phi_wall_layer"], own_walls])
     # the steady window from the data (steady_window: the migration's approach fitted, phi_center's trend
     # over the window checked), unless a start is given
-    rms_change, _ = profile_change([profiles.profiles_in_bins(s, channel).phi for s in snapshots])
+    rms_change, _ = profile_change((before["phi_profile"] if n_before else []) + own_profiles)
     window = steady_window(times, phi_center, rms_change)
     if from_time is not None:
         start = int(np.searchsorted(times, from_time - 1e-9))
         steady_detected = True
     else:
         start, steady_detected = window.start, window.steady
-    start = min(start, len(snapshots) - MIN_SNAPSHOTS)
+    # the profiles are this folder's records: the window holds MIN_SNAPSHOTS of them at least
+    start = min(start, len(times) - MIN_SNAPSHOTS)
     t0 = float(times[start])
-    kept = snapshots[start:]
+    kept = snapshots[max(0, start - n_before):]
     window_trend = trend(times[start:], phi_center[start:])
 
     coarse = profiles.average_profiles(kept, channel)
@@ -380,9 +429,10 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
     results = dict(
         phi_bulk=pack.phi, phi_bulk_integral_max_error=float(np.max(np.abs(phi_integral - pack.phi))),
         L=list(run.box), time=float(times[-1]), steady_from=t0, steady_detected=bool(steady_detected),
-        snapshots_averaged=len(kept),
+        snapshots_averaged=len(kept), profiles_from=float(kept[0].time), records_from_segments=n_before,
         phi_center=float(np.mean(phi_center[start:])),
-        phi_center_err=float(timeseries.block_average(phi_center[start:]).error) if len(kept) >= 2 * timeseries.MIN_BLOCKS else math.nan,
+        phi_center_err=(float(timeseries.block_average(phi_center[start:]).error)
+                        if len(times) - start >= 2 * timeseries.MIN_BLOCKS else math.nan),
         phi_center_initial=float(phi_center[0]),
         phi_wall_layer=float(np.mean(phi_walls[start:])),
         phi_sbm_region=phi_region,
