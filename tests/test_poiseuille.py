@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import load_case_module
-from fdmsubgrid import checkpoint, contacts, output, poiseuille, shear
+from fdmsubgrid import checkpoint, contacts, output, packing, poiseuille, sbm, shear
 
 SMALL = ["--size", "8", "12", "8", "--duration", "2", "--dump-every", "0.1", "--seed", "2", "--fluid-every", "1"]
 
@@ -371,3 +371,37 @@ def test_time_step_warning_cites_the_measured_steps_and_the_stability_map():
     assert "0.05 the springs" not in springs and "above 0.05" not in springs
     # the paper's radii: the limits as measured; a wider distribution scales both particle limits
     assert poiseuille.time_step_warning(0.05, 4, packing.PAPER_SUSPENSION) is None
+
+
+def band_phi(pack, lo, hi):
+    """The packing's volume fraction between the planes y = lo and hi (each sphere's exact slab volume)."""
+    r = pack.radii
+    a, b = np.clip(lo - pack.positions[:, 1], -r, r), np.clip(hi - pack.positions[:, 1], -r, r)
+    volume = np.pi * (r ** 2 * (b - a) - (b ** 3 - a ** 3) / 3)
+    return float(volume.sum() / (pack.box[0] * pack.box[2] * (hi - lo)))
+
+
+def test_a_channel_starts_near_the_sbm_profile(case_module, tmp_path):
+    """--start sbm spreads the same spheres (same seed, count and sizes) with the SBM's steady phi(y) at phi_bulk
+    (sbm.solve, the paper's material functions): denser at the centre and thinner at the walls than the uniform
+    start, no overlap, its own run folder; --start with --from-records, or sbm-table8 without Table 8 rows,
+    is refused."""
+    common = ["--size", "12", "16", "8", "--duration", "1", "--write-only", "--workdir", str(tmp_path)]
+    packs = {}
+    for start in ("uniform", "sbm"):
+        out = case_module.main(common + ["--start", start])
+        assert out["run_dir"].endswith("_seed1_calibrated_fluidEvery4" if start == "uniform"
+                                       else "_seed1_startSbm_calibrated_fluidEvery4"), out["run_dir"]
+        packs[start] = packing.read_data(os.path.join(out["run_dir"], "dem", "packing.data"), walls=(1,))
+    uniform, near = packs["uniform"], packs["sbm"]
+    assert near.n == uniform.n and sorted(near.radii) == sorted(uniform.radii)
+    assert near.min_gap >= 0.01 - 1e-12 and near.min_wall_gap >= 0.01 - 1e-12
+    model = sbm.solve(sbm.MaterialFunctions.maron_pierce_power_law(), near.phi, y_edge=0.5)
+    centre, walls = (6.0, 10.0), [(0.0, 2.0), (14.0, 16.0)]
+    assert model.at([0.0])[0][0] > 0.55                       # what the start aims at: the centre jammed
+    assert band_phi(near, *centre) > band_phi(uniform, *centre) + 0.03
+    assert np.mean([band_phi(near, *w) for w in walls]) < np.mean([band_phi(uniform, *w) for w in walls])
+    with pytest.raises(SystemExit):
+        case_module.main(common + ["--start", "sbm-table8", "--table8", "none"])
+    with pytest.raises(SystemExit):
+        case_module.main(common + ["--start", "sbm", "--from-records", "x.records", "--overwrite"])

@@ -115,6 +115,12 @@ def main(argv: list[str] | None = None) -> dict:
                         "and a window as long again, from the migration times of analysed ladder runs (their "
                         "results.json; tau grows as L_y^2: poiseuille.required_duration), and exit; with --budget "
                         "RUN_DIR also its wall time")
+    p.add_argument("--start", choices=START_PROFILES, default=START_PROFILES[0],
+                   help="how the spheres are spread across the channel at the start: uniform (the paper's), or "
+                        "near a steady state to shorten the migration: sbm, the Suspension Balance Model's steady "
+                        "phi(y) at phi_bulk (the paper's material functions, or --couette's), sbm-table8, the same with "
+                        "this project's Table 8 rows (--table8); docs/cases/poiseuille.md, \"Starting near the "
+                        "steady state\"")
     p.add_argument("--from-records", metavar="RECORDS", default=None,
                    help="start from the particles of the last block of this particle records file (dem/"
                         "particles.records of a run of the same channel, e.g. its dense core) instead of a "
@@ -178,6 +184,8 @@ def main(argv: list[str] | None = None) -> dict:
 
     pack = None
     if args.from_records:
+        if args.start != START_PROFILES[0]:
+            p.error("--from-records starts from the records' own positions: --start goes with a random packing")
         if args.radii is not None or args.volume_fractions is not None or args.distribution is not None:
             p.error("--from-records takes its spheres' sizes from the records: --radii, --volume-fractions and "
                     "--distribution go with a random packing")
@@ -213,8 +221,12 @@ def main(argv: list[str] | None = None) -> dict:
     time_unit = width / (2 * u_c)
     dt = args.dt * time_unit
     if pack is None:
+        try:
+            profile = start_profile(args.start, args.phi, width, material, table8)
+        except sbm.SBMError as e:
+            p.error("--start %s: %s" % (args.start, e))
         pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
-                                       wall_gap=2 * suspension.ROUGHNESS, sizes=sizes)
+                                       wall_gap=2 * suspension.ROUGHNESS, sizes=sizes, profile=profile)
     print("packing:", pack.summary())
     try:
         calibration = case.scene_calibration("poiseuille", pack.radii, delta, walls=True, model=args.model)
@@ -232,7 +244,8 @@ def main(argv: list[str] | None = None) -> dict:
         print(warning, file=sys.stderr)
 
     name = "phi%g_%gx%gx%g_ad%g_dt%g_%s%s%s" % (args.phi, *args.size, args.a_over_delta, args.dt,
-                                                 "records" if args.from_records else "seed%d" % args.seed,
+                                                 "records" if args.from_records else "seed%d" % args.seed
+                                                 + START_TAGS[args.start],
                                                  "_" + args.model,
                                                  "_fluidEvery%d" % args.fluid_every if args.fluid_every > 1 else "")
     name += suspension.coulomb_tag(args.coulomb_solve) + couettescene.sizes_tag(sizes)
@@ -270,6 +283,24 @@ def main(argv: list[str] | None = None) -> dict:
     if not args.keep:
         case.delete_fields(run_dir)
     return results
+
+
+# --start: how the spheres are spread at the start (the first the default), and what a run folder's name adds
+START_PROFILES = ("uniform", "sbm", "sbm-table8")
+START_TAGS = {"uniform": "", "sbm": "_startSbm", "sbm-table8": "_startSbmTable8"}
+
+
+def start_profile(start: str, phi_bulk: float, width: float, material=None, table8=None):
+    """The relative density of the centres across the channel (y from 0 to width) for --start, or None for a
+    uniform start: the SBM's steady phi(y) over the whole width at phi_bulk (sbm.solve), with the paper's
+    material functions (or `material`) or the Table 8 rows' (`table8`)."""
+    if start == "uniform":
+        return None
+    chosen = material if start == "sbm" else table8
+    if start == "sbm-table8" and chosen is None:
+        raise sbm.SBMError("the Table 8 rows are 'none' (--table8): no material functions to start from")
+    model = sbm.solve(chosen or sbm.MaterialFunctions.maron_pierce_power_law(), phi_bulk, y_edge=0.5)
+    return lambda y: np.nan_to_num(model.at((np.asarray(y, dtype=float) - 0.5 * width) / width)[0])
 
 
 def table8_material(paths: Sequence[str]):

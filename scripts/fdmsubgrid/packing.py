@@ -516,8 +516,22 @@ def bidisperse_counts_for_volume(volume, phi, a1=1.0):
     return n1, n2
 
 
+def centres_along(profile, length, low, high, rng):
+    """Centres along an axis of the given length drawn with a density proportional to profile(y) >= 0 (a
+    callable on [0, length]), each inside its own [low, high] (arrays: where the sphere fits)."""
+    grid = np.linspace(0.0, length, 4001)
+    weight = np.asarray(profile(grid), dtype=float)
+    if weight.shape != grid.shape or not np.all(np.isfinite(weight)) or np.any(weight < 0) or weight.max() <= 0:
+        raise ValueError("packing: the profile must be finite and >= 0 across the channel, and positive somewhere")
+    weight = weight + 1e-9 * weight.max()          # a strictly rising cumulative, to invert
+    cdf = np.concatenate([[0.0], np.cumsum(0.5 * (weight[1:] + weight[:-1]) * np.diff(grid))])
+    cdf /= cdf[-1]
+    c_lo, c_hi = np.interp(low, grid, cdf), np.interp(high, grid, cdf)
+    return np.interp(c_lo + rng.uniform(0.0, 1.0, len(low)) * (c_hi - c_lo), cdf, grid)
+
+
 def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, wall_axis=1, a1=1.0,
-                    attempts=3, max_sweeps=3000, margin=0.5, sizes=None):
+                    attempts=3, max_sweeps=3000, margin=0.5, sizes=None, profile=None):
     """A random packing of the size distribution `sizes` (a SizeDistribution; default PAPER_SUSPENSION, the
     paper's a2 = 1.4 a1 in equal volumes) in the box [0, L_x] x [0, L_y] x [0, L_z] of any shape, periodic
     except along wall_axis (planar walls at 0 and L there), for Couette and Poiseuille cells. Species k (radius
@@ -527,7 +541,9 @@ def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, 
     species' volume within half of one of its spheres of its share; the actual phi is Packing.phi) or n: the
     total count (split by sizes.counts_for_number, e.g. the N_P of Table 8). min_gap: smallest surface gap
     between spheres, wall_gap: between a sphere and a wall (default min_gap). Tries `attempts` seeds (seed,
-    seed + 1, ...) of at most max_sweeps relaxation sweeps each.
+    seed + 1, ...) of at most max_sweeps relaxation sweeps each. profile: None (uniform), or a callable giving the
+    relative density of the centres across the walls (y from 0 to L along wall_axis), e.g. a steady profile to
+    start a channel near its steady state (the relaxation of the overlaps then smooths it a little).
 
     Raises ValueError for a box side smaller than a particle (the largest diameter plus the wall gaps
     across the walls) or too small for the minimum image (a periodic side below 2 (2 a_max + gaps)),
@@ -579,7 +595,9 @@ def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, 
         r, t = radii[perm], types[perm]
         x = rng.uniform(0.0, 1.0, (total, 3)) * box
         # centres where the sphere fits between the walls
-        x[:, wall_axis] = r + 2 * wall_gap + rng.uniform(0.0, 1.0, total) * (box[wall_axis] - 2 * r - 4 * wall_gap)
+        low, high = r + 2 * wall_gap, box[wall_axis] - r - 2 * wall_gap
+        x[:, wall_axis] = (low + rng.uniform(0.0, 1.0, total) * (high - low) if profile is None
+                           else centres_along(profile, box[wall_axis], low, high, rng))
         try:
             sweeps = relax_overlaps(x, r, box, min_gap, margin=margin, max_iterations=max_sweeps,
                                     walls=(wall_axis,), wall_gap=wall_gap)
