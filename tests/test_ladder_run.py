@@ -45,6 +45,20 @@ def test_each_rung_continues_the_run_folder_its_scene_writes(rung, size, spheres
         assert "\n%d atoms\n" % spheres in f.read()
 
 
+def test_the_paper_rung_started_near_its_steady_state_is_a_scene_of_its_own(tmp_path, env):
+    """ladderRun paper-sbm: the paper's channel with --start sbm, in a run folder (and kept folder) of its own,
+    the same spheres as the paper rung spread with the SBM's profile."""
+    options, folder = scene(LADDER, "paper-sbm", tmp_path, env)
+    paper, paper_folder = scene(LADDER, "paper", tmp_path, env)
+    assert options[options.index("--start") + 1] == "sbm" and folder != paper_folder
+    assert [o for o in options if o not in ("--start", "sbm")] == paper
+    written = load_case_module("poiseuille").main(options + ["--write-only", "--workdir", str(tmp_path),
+                                                             "--out", str(tmp_path / "r.json")])
+    assert written["run_dir"] == folder and folder.endswith("_seed1_startSbm_calibrated_fluidEvery8")
+    with open(os.path.join(folder, "dem", "packing.data")) as f:
+        assert "\n2345 atoms\n" in f.read()
+
+
 def test_paper_run_is_the_ladders_paper_rung(tmp_path, env):
     """paperRun keeps its command line: the same scene and run folder as `ladderRun paper`, the options of
     the committed paper snapshot's scene command, its own help and its own name in a refusal."""
@@ -62,7 +76,7 @@ def test_paper_run_is_the_ladders_paper_rung(tmp_path, env):
 
 def test_bad_rung_and_options_are_refused(tmp_path, env):
     refused = run([LADDER, "L7"], env)
-    assert refused.returncode == 2 and "not 'L7'" in refused.stderr and "L12, L20 or paper" in refused.stderr
+    assert refused.returncode == 2 and "not 'L7'" in refused.stderr and "L12, L20, paper or paper-sbm" in refused.stderr
     refused = run([LADDER, "L20", "--save", "--workdir", str(tmp_path)], env)
     assert refused.returncode == 2 and "no run in %s" % tmp_path in refused.stderr
     refused = run([LADDER, "L12", "--until", "100", "--workdir", str(tmp_path)], env)

@@ -405,3 +405,23 @@ def test_a_channel_starts_near_the_sbm_profile(case_module, tmp_path):
         case_module.main(common + ["--start", "sbm-table8", "--table8", "none"])
     with pytest.raises(SystemExit):
         case_module.main(common + ["--start", "sbm", "--from-records", "x.records", "--overwrite"])
+
+
+def test_a_profiled_packing_follows_its_target_at_the_papers_size():
+    """packing.profiled_channel_packing in the paper's channel (2345 spheres, 40 x 40 x 20 a1) with the SBM's
+    profile: the corrections bring the packed phi in slabs of a1 (those 2 a1 or more from the walls) nearer the
+    target than the first draw (rms 0.026 against 0.034), the central 2 a1 within 0.02 of the model's 0.592
+    (0.591; the first draw 0.587), and the packing keeps its gaps and its phi_bulk."""
+    model = sbm.solve(sbm.MaterialFunctions.maron_pierce_power_law(), 0.45, y_edge=0.5)
+    target = lambda y: np.nan_to_num(model.at((np.asarray(y) - 20.0) / 40.0)[0])
+    options = dict(seed=1, min_gap=0.01, wall_gap=0.01)
+    first = packing.profiled_channel_packing((40, 40, 20), target, 0.45, iterations=0, **options)
+    corrected = packing.profiled_channel_packing((40, 40, 20), target, 0.45, **options)
+    assert corrected.info["profile_rms"] < first.info["profile_rms"]
+    centre = [packing.slab_volume_fractions(p, [19.0, 21.0])[0] for p in (first, corrected)]
+    assert abs(centre[1] - target(20.0)) < 0.02 and centre[0] < centre[1]
+    assert corrected.n == 2345 and corrected.phi == pytest.approx(first.phi)
+    assert corrected.min_gap >= 0.01 - 1e-12 and corrected.min_wall_gap >= 0.01 - 1e-12
+    # the slabs add up to the whole channel's phi (each sphere's volume counted once)
+    edges = np.linspace(0.0, 40.0, 41)
+    assert packing.slab_volume_fractions(corrected, edges).mean() == pytest.approx(corrected.phi, rel=1e-12)

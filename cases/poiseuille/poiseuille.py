@@ -225,8 +225,10 @@ def main(argv: list[str] | None = None) -> dict:
             profile = start_profile(args.start, args.phi, width, material, table8)
         except sbm.SBMError as e:
             p.error("--start %s: %s" % (args.start, e))
-        pack = packing.channel_packing(args.size, phi=args.phi, seed=args.seed, min_gap=2 * suspension.ROUGHNESS,
-                                       wall_gap=2 * suspension.ROUGHNESS, sizes=sizes, profile=profile)
+        options = dict(seed=args.seed, min_gap=2 * suspension.ROUGHNESS, wall_gap=2 * suspension.ROUGHNESS,
+                       sizes=sizes)
+        pack = (packing.channel_packing(args.size, phi=args.phi, **options) if profile is None
+                else packing.profiled_channel_packing(args.size, profile, args.phi, **options))
     print("packing:", pack.summary())
     try:
         calibration = case.scene_calibration("poiseuille", pack.radii, delta, walls=True, model=args.model)
@@ -291,9 +293,10 @@ START_TAGS = {"uniform": "", "sbm": "_startSbm", "sbm-table8": "_startSbmTable8"
 
 
 def start_profile(start: str, phi_bulk: float, width: float, material=None, table8=None):
-    """The relative density of the centres across the channel (y from 0 to width) for --start, or None for a
-    uniform start: the SBM's steady phi(y) over the whole width at phi_bulk (sbm.solve), with the paper's
-    material functions (or `material`) or the Table 8 rows' (`table8`)."""
+    """The volume fraction the packing follows across the channel (y from 0 to width) for --start
+    (packing.profiled_channel_packing), or None for a uniform start: the SBM's steady phi(y) over the whole width
+    at phi_bulk (sbm.solve), with the paper's material functions (or `material`) or the Table 8 rows'
+    (`table8`)."""
     if start == "uniform":
         return None
     chosen = material if start == "sbm" else table8

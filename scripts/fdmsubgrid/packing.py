@@ -615,6 +615,50 @@ def channel_packing(box, phi=None, n=None, seed=0, min_gap=0.01, wall_gap=None, 
                           max_sweeps, "; ".join(failures)))
 
 
+def slab_volume_fractions(p, edges, axis=1):
+    """The packing's volume fraction in the slabs between consecutive planes `edges` across `axis` (each
+    sphere's exact volume in each slab)."""
+    edges = np.asarray(edges, dtype=float)
+    r = p.radii[:, None]
+    c = p.positions[:, axis][:, None]
+    a = np.clip(edges[None, :-1] - c, -r, r)
+    b = np.clip(edges[None, 1:] - c, -r, r)
+    volume = np.pi * (r ** 2 * (b - a) - (b ** 3 - a ** 3) / 3)
+    area = float(np.prod(np.delete(p.box, axis)))
+    return volume.sum(axis=0) / (area * np.diff(edges))
+
+
+def profiled_channel_packing(box, target, phi, iterations=3, wall_axis=1, **options):
+    """channel_packing whose volume fraction across the walls follows target(y) (a callable, y from 0 to L along
+    wall_axis; its level is set by phi, only its shape matters), not only its centres: the centres are drawn
+    with a density corrected `iterations` times by the ratio of the target to the packed phi in slabs of a1
+    (the spheres' width and the relaxation of overlaps smooth the drawn density; the slabs within 2 a1 of a
+    wall left as drawn), the packing nearest the target kept. Its info gains profile_rms (the rms difference in the slabs) and profile_iterations."""
+    length = float(box[wall_axis])
+    edges = np.linspace(0.0, length, max(2, int(round(length))) + 1)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    wanted = np.asarray(target(centres), dtype=float)
+    correction = np.ones_like(centres)
+    # the slabs within 2 a1 of a wall are left as drawn: no sphere's centre comes nearer the wall than its
+    # radius, so no density of centres makes them follow a continuum profile
+    inner = (centres > 2.0) & (centres < length - 2.0)
+    best = None
+    for k in range(iterations + 1):
+        factor = correction.copy()
+        p = channel_packing(box, phi=phi, wall_axis=wall_axis,
+                            profile=lambda y, f=factor: np.asarray(target(y), dtype=float)
+                            * np.interp(y, centres, f), **options)
+        packed = slab_volume_fractions(p, edges, wall_axis)
+        aim = wanted * packed.mean() / wanted.mean()
+        rms = float(np.sqrt(np.mean((packed - aim)[inner] ** 2)))
+        if best is None or rms < best[1]:
+            best = (p, rms, k)
+        correction[inner] *= np.clip(aim / np.maximum(packed, 1e-3), 0.5, 2.0)[inner]
+    p, rms, k = best
+    p.info.update(profile_rms=rms, profile_iterations=k)
+    return p
+
+
 def write_data(path, p, density=1000.0, scale=1.0, title=None):
     """LIGGGHTS data file (read_data; atom_style sphere: id type diameter density x y z), box
     [0, L)^3, one atom type per radius (1: a1, 2: a2; species k + 1 of a SizeDistribution). scale
