@@ -128,6 +128,12 @@ def find_run(workdir: str, phi: float, a_over_delta: float, dt: float, seed: int
     return found[0] if found else None
 
 
+def row_run(phi: float, args: argparse.Namespace) -> Optional[str]:
+    """The run folder of this row under the command's options (find_run), if any."""
+    return find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args), args.seed, args.model,
+                    row_fluid_every(phi, args), args.coulomb_solve)
+
+
 def steps_done(run_dir: str) -> int:
     path = os.path.join(run_dir, "fluid", "postProcessing", "fdm", "steps.dat")
     if not os.path.exists(path):
@@ -250,8 +256,7 @@ def save_snapshots(args: argparse.Namespace) -> None:
     """--save: each row's newest checkpoint as a compact snapshot in --snapshots (replacing the one there),
     the rows without a run folder or checkpoint named."""
     for phi in args.phis:
-        run_dir = find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args), args.seed, args.model,
-                           row_fluid_every(phi, args), args.coulomb_solve)
+        run_dir = row_run(phi, args)
         if run_dir is None:
             print("table8 --save: phi_bulk %g: no run folder in %s" % (phi, args.workdir))
             continue
@@ -289,7 +294,7 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
     never started a second time."""
     dt = row_dt(phi, args)
     every = row_fluid_every(phi, args)
-    run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every, args.coulomb_solve)
+    run_dir = row_run(phi, args)
     if run_dir is not None and running_elsewhere(run_dir):
         print("table8: phi_bulk %g: %s is running in another process; waiting for it" % (phi, run_dir), flush=True)
         while running_elsewhere(run_dir):
@@ -300,7 +305,7 @@ def run_row(phi: float, args: argparse.Namespace) -> Optional[Dict]:
                         "--seed", str(args.seed), "--n-max", str(args.n_max), "--tol-lambda", str(args.tol_lambda),
                         "--model", args.model, "--fluid-every", str(every), "--coulomb-solve", args.coulomb_solve,
                         "--workdir", args.workdir], check=True)
-        run_dir = find_run(args.workdir, phi, args.a_over_delta, dt, args.seed, args.model, every, args.coulomb_solve)
+        run_dir = row_run(phi, args)
     if steps_done(run_dir) < steps_planned(run_dir):
         # to the input's last step: an extension killed before its first checkpoint resumes from one
         # written for the shorter run, which fdmDEM accepts only with -until
@@ -586,10 +591,7 @@ def main(argv: Optional[List[str]] = None) -> Dict:
                 if row is not None:
                     analysed[phi] = row
         stop_progress.set()
-    rows = [analysed.get(phi) or analyse_row(phi, find_run(args.workdir, phi, args.a_over_delta, row_dt(phi, args),
-                                                            args.seed, args.model, row_fluid_every(phi, args),
-                                                            args.coulomb_solve), args)
-            for phi in args.phis]
+    rows = [analysed.get(phi) or analyse_row(phi, row_run(phi, args), args) for phi in args.phis]
     rows = sorted(rows + earlier_rows(args.rows_from, args.phis), key=lambda r: r["phi_bulk_table8"])
     summary = summarise(rows, args)
     summary["command"] = "cases/couette/table8.py " + " ".join(argv if argv is not None else sys.argv[1:])
