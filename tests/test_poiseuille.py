@@ -4,6 +4,8 @@ steps (about 30 s); the exact checks of the analysis (the phi integral, the wall
 linear shear stress in the core) and the case's bad input. The SBM's own tests: test_sbm.py."""
 import json
 import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -425,3 +427,30 @@ def test_a_profiled_packing_follows_its_target_at_the_papers_size():
     # the slabs add up to the whole channel's phi (each sphere's volume counted once)
     edges = np.linspace(0.0, 40.0, 41)
     assert packing.slab_volume_fractions(corrected, edges).mean() == pytest.approx(corrected.phi, rel=1e-12)
+
+
+def test_arrival_of_the_centre_from_two_starts(tmp_path, env):
+    """poiseuille.arrival on exponential approaches phi(t) = 0.62 - d exp(-t/150) sampled every time unit: the
+    +-25 average reaches a level at the time the exponential does (to the window's curvature, a unit or two),
+    the nearer start (d 0.07) sooner than the farther (d 0.14) by tau ln 2; a level never reached is None. The
+    command reads a segments folder as it reads an analysed run."""
+    t = np.arange(0.0, 1000.0)
+    first = {}
+    for d in (0.14, 0.07):
+        found = poiseuille.arrival(t, 0.62 - d * np.exp(-t / 150.0), levels=[0.6, 0.63], at=[500.0])
+        exact = 150.0 * np.log(d / 0.02)
+        assert found["first"][0.6] == pytest.approx(exact, abs=3.0)
+        assert found["first"][0.63] is None
+        assert found["at"][500.0] == pytest.approx(0.62 - d * np.exp(-500 / 150.0), abs=1e-4)
+        first[d] = found["first"][0.6]
+    assert first[0.14] - first[0.07] == pytest.approx(150.0 * np.log(2.0), abs=3.0)
+    folder = tmp_path / "segments"
+    folder.mkdir()
+    phi = 0.62 - 0.14 * np.exp(-t / 150.0)
+    (folder / "segment_0_999.json").write_text(json.dumps(dict(
+        time=t.tolist(), phi_center=phi.tolist(), phi_wall_layer=[0.3] * len(t), y=[0.5],
+        phi_profile=[[0.45]] * len(t))))
+    done = subprocess.run([sys.executable, "-m", "fdmsubgrid.poiseuille", "arrival", "0.6", "500", str(folder)],
+                          capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert "first reaching 0.6 at t %g" % first[0.14] in done.stdout

@@ -828,9 +828,55 @@ def write_segment(run_dir: str, folder: str) -> str:
     return path
 
 
+def arrival(time: ArrayLike, phi_center: ArrayLike, levels: Sequence[float], at: Sequence[float] = (),
+            half_window: float = 25.0) -> dict:
+    """How fast a channel's centre arrives (runs of two starts side by side): phi_center averaged over
+    +-half_window time units, read at the times `at`, and the first time that average reaches each of `levels`
+    (None if it never does)."""
+    t = np.asarray(time, dtype=float)
+    phi = np.asarray(phi_center, dtype=float)
+    mean = np.array([phi[np.abs(t - x) <= half_window].mean() for x in t])
+    first = {}
+    for level in levels:
+        reached = np.nonzero(mean >= level)[0]
+        first[level] = float(t[reached[0]]) if reached.size else None
+    return dict(at={x: float(np.interp(x, t, mean)) for x in at}, first=first, half_window=half_window)
+
+
+def _series_of(path: str) -> dict:
+    """The migration series of an analysed run (its results.json: data.series) or of a folder of segments."""
+    import json
+    if os.path.isdir(path):
+        joined = earlier_series(read_segments(path), math.inf)
+        return dict(time=joined["time"], phi_center=joined["phi_center"])
+    with open(path) as f:
+        data = json.load(f)
+    series = data.get("data", data)["series"]
+    return dict(time=series["time"], phi_center=series["phi_center"])
+
+
+USAGE = """usage: python3 -m fdmsubgrid.poiseuille series RUN_DIR FOLDER
+  the migration series of the run's records into FOLDER/segment_<t0>_<t1>.json
+       python3 -m fdmsubgrid.poiseuille arrival LEVELS TIMES SOURCE...
+  per SOURCE (an analysed run's results.json, or a folder of segments) phi_center averaged over +-25 time units
+  at the comma-separated TIMES and the first time it reaches each of the comma-separated LEVELS"""
+
+
 if __name__ == "__main__":
     import sys
-    if len(sys.argv) != 4 or sys.argv[1] != "series":
-        raise SystemExit("usage: python3 -m fdmsubgrid.poiseuille series RUN_DIR FOLDER\n"
-                         "  the migration series of the run's records into FOLDER/segment_<t0>_<t1>.json")
-    print(write_segment(sys.argv[2], sys.argv[3]))
+    if len(sys.argv) == 4 and sys.argv[1] == "series":
+        print(write_segment(sys.argv[2], sys.argv[3]))
+    elif len(sys.argv) >= 5 and sys.argv[1] == "arrival":
+        try:
+            levels = [float(v) for v in sys.argv[2].split(",")]
+            times = [float(v) for v in sys.argv[3].split(",")]
+        except ValueError:
+            raise SystemExit(USAGE)
+        for source in sys.argv[4:]:
+            found = arrival(**_series_of(source), levels=levels, at=times)
+            print("%s: phi_center %s; first reaching %s" % (
+                source, ", ".join("%.3f at t %g" % (v, x) for x, v in found["at"].items()),
+                ", ".join("%g at t %s" % (lv, "never" if tt is None else "%g" % tt)
+                          for lv, tt in found["first"].items())))
+    else:
+        raise SystemExit(USAGE)
