@@ -376,11 +376,8 @@ def test_time_step_warning_cites_the_measured_steps_and_the_stability_map():
 
 
 def band_phi(pack, lo, hi):
-    """The packing's volume fraction between the planes y = lo and hi (each sphere's exact slab volume)."""
-    r = pack.radii
-    a, b = np.clip(lo - pack.positions[:, 1], -r, r), np.clip(hi - pack.positions[:, 1], -r, r)
-    volume = np.pi * (r ** 2 * (b - a) - (b ** 3 - a ** 3) / 3)
-    return float(volume.sum() / (pack.box[0] * pack.box[2] * (hi - lo)))
+    """The packing's volume fraction between the planes y = lo and hi."""
+    return float(packing.slab_volume_fractions(pack, [lo, hi])[0])
 
 
 def test_a_channel_starts_near_the_sbm_profile(case_module, tmp_path):

@@ -118,9 +118,9 @@ def main(argv: list[str] | None = None) -> dict:
     p.add_argument("--start", choices=START_PROFILES, default=START_PROFILES[0],
                    help="how the spheres are spread across the channel at the start: uniform (the paper's), or "
                         "near a steady state to shorten the migration: sbm, the Suspension Balance Model's steady "
-                        "phi(y) at phi_bulk (the paper's material functions, or --couette's), sbm-table8, the same with "
-                        "this project's Table 8 rows (--table8); docs/cases/poiseuille.md, \"Starting near the "
-                        "steady state\"")
+                        "phi(y) at phi_bulk (the paper's material functions, or --couette's), sbm-table8, the same "
+                        "with this project's Table 8 rows (--table8); docs/cases/poiseuille.md, \"Starting near "
+                        "the steady state\"")
     p.add_argument("--from-records", metavar="RECORDS", default=None,
                    help="start from the particles of the last block of this particle records file (dem/"
                         "particles.records of a run of the same channel, e.g. its dense core) instead of a "

@@ -633,7 +633,8 @@ def profiled_channel_packing(box, target, phi, iterations=3, wall_axis=1, **opti
     wall_axis; its level is set by phi, only its shape matters), not only its centres: the centres are drawn
     with a density corrected `iterations` times by the ratio of the target to the packed phi in slabs of a1
     (the spheres' width and the relaxation of overlaps smooth the drawn density; the slabs within 2 a1 of a
-    wall left as drawn), the packing nearest the target kept. Its info gains profile_rms (the rms difference in the slabs) and profile_iterations."""
+    wall left as drawn), the packing nearest the target kept. Its info gains profile_rms (the rms difference
+    in the slabs) and profile_iterations."""
     length = float(box[wall_axis])
     edges = np.linspace(0.0, length, max(2, int(round(length))) + 1)
     centres = 0.5 * (edges[1:] + edges[:-1])
