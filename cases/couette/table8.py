@@ -244,11 +244,16 @@ def _fdmrun(run_dir: str, args: argparse.Namespace, until: Optional[int] = None,
                          "table8.py command resumes the run from its last checkpoint" % (done.returncode, run_dir, log))
 
 
+def kept_snapshot_path(run_dir: str, snapshots: str) -> str:
+    """Where --snapshots keeps the compact snapshot of this run: a folder named as the run folder."""
+    return os.path.join(snapshots, os.path.basename(os.path.normpath(run_dir)))
+
+
 def snapshot_folder(run_dir: str, args: argparse.Namespace) -> Optional[str]:
-    """The compact snapshot of this run kept under --snapshots (its folder named as the run folder), if any."""
+    """The compact snapshot of this run kept under --snapshots, if any."""
     if not getattr(args, "snapshots", None):
         return None
-    folder = os.path.join(args.snapshots, os.path.basename(os.path.normpath(run_dir)))
+    folder = kept_snapshot_path(run_dir, args.snapshots)
     return folder if os.path.exists(os.path.join(folder, "README")) else None
 
 
@@ -260,7 +265,7 @@ def save_snapshots(args: argparse.Namespace) -> None:
         if run_dir is None:
             print("table8 --save: phi_bulk %g: no run folder in %s" % (phi, args.workdir))
             continue
-        dest = os.path.join(args.snapshots, os.path.basename(os.path.normpath(run_dir)))
+        dest = kept_snapshot_path(run_dir, args.snapshots)
         try:
             snap = checkpoint.snapshot(run_dir, dest)
         except checkpoint.CheckpointError as e:

@@ -237,9 +237,10 @@ def main(argv: list[str] | None = None) -> dict:
     if calibration.line():
         print(calibration.line(), flush=True)
     tau_w = abs(grad) * width / 2
-    springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt, sizes, model=args.model)
+    pair = suspension.holds_smallest_pair(pack.radii)
+    springs = suspension.choose_springs(tau_w, dt, delta, args.kn, args.kt, sizes, model=args.model, pair=pair)
     print(springs.describe(dt))
-    recipe = suspension.choose_springs(tau_w, dt, delta, None, None, sizes, model=args.model)
+    recipe = suspension.choose_springs(tau_w, dt, delta, None, None, sizes, model=args.model, pair=pair)
     warning = poiseuille.time_step_warning(args.dt, args.fluid_every, sizes,
                                            (springs.kn / recipe.kn, springs.kt / recipe.kt))
     if warning:

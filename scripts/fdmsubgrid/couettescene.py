@@ -230,7 +230,7 @@ def write_run(workdir: str, size, dt: float, strain: float, phi: float | None = 
     if calibration.line():
         print(calibration.line(), flush=True)
     springs = choose_springs(pack.phi, dt, delta, kn, kt, sizes, model=model,
-                             pair=int(np.sum(np.isclose(pack.radii, min(pack.radii)))) >= 2)
+                             pair=suspension.holds_smallest_pair(pack.radii))
     print(springs.describe(dt))
     warning = time_step_warning(pack.phi, dt, sizes)
     if warning:

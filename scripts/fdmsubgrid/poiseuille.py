@@ -327,7 +327,7 @@ def earlier_series(segments: Sequence[dict], before: float) -> dict:
     """The migration series of kept segments (migration_series, write_segment) joined in time and cut before
     `before` (the first record of the run folder that continues them): a run continued from a compact snapshot
     on a new machine has only its own records, its history lives in the segments. A record present in two
-    segments is taken once."""
+    segments is taken once; no segments give empty series."""
     time, centre, walls, profile = [], [], [], []
     y = None
     for seg in sorted(segments, key=lambda d: d["time"][0]):
@@ -341,7 +341,8 @@ def earlier_series(segments: Sequence[dict], before: float) -> dict:
                 centre.append(seg["phi_center"][k])
                 walls.append(seg["phi_wall_layer"][k])
                 profile.append(seg["phi_profile"][k])
-    return dict(time=np.array(time), phi_center=np.array(centre), phi_wall_layer=np.array(walls),
+    return dict(time=np.array(time, dtype=float), phi_center=np.array(centre, dtype=float),
+                phi_wall_layer=np.array(walls, dtype=float),
                 phi_profile=profile, y=y)
 
 
@@ -386,18 +387,18 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
     own_centre, own_walls = centre_and_wall_series(snapshots, channel)
     phi_integral = np.array([profiles.volume_fraction(s, channel) for s in snapshots])
     own_profiles = [profiles.profiles_in_bins(s, channel).phi for s in snapshots]
-    # the run's history before this folder (a compact snapshot's continuation): the kept segments
-    before = earlier_series(segments, float(own_times[0])) if segments else None
-    if before is not None and before["y"] is not None and len(before["y"]) != len(own_profiles[0]):
+    # the run's history before this folder (a compact snapshot's continuation): the kept segments, if any
+    before = earlier_series(segments, float(own_times[0]))
+    if before["y"] is not None and len(before["y"]) != len(own_profiles[0]):
         raise PoiseuilleRunError("the kept segments have profiles in %d bins, %s in %d: not this channel"
                                  % (len(before["y"]), run_dir, len(own_profiles[0])))
-    n_before = 0 if before is None else len(before["time"])
-    times = own_times if not n_before else np.concatenate([before["time"], own_times])
-    phi_center = own_centre if not n_before else np.concatenate([before["phi_center"], own_centre])
-    phi_walls = own_walls if not n_before else np.concatenate([before["phi_wall_layer"], own_walls])
+    n_before = len(before["time"])
+    times = np.concatenate([before["time"], own_times])
+    phi_center = np.concatenate([before["phi_center"], own_centre])
+    phi_walls = np.concatenate([before["phi_wall_layer"], own_walls])
     # the steady window from the data (steady_window: the migration's approach fitted, phi_center's trend
     # over the window checked), unless a start is given
-    rms_change, _ = profile_change((before["phi_profile"] if n_before else []) + own_profiles)
+    rms_change, _ = profile_change(before["phi_profile"] + own_profiles)
     window = steady_window(times, phi_center, rms_change)
     if from_time is not None:
         start = int(np.searchsorted(times, from_time - 1e-9))

@@ -36,6 +36,8 @@ import math
 import os
 from dataclasses import dataclass
 
+import numpy as np
+
 from . import contactstability, deminput, foamcase, output, packing, rheology, theory
 
 A1 = 1.0
@@ -123,6 +125,13 @@ def scaled_time_step(dt: float, sizes: packing.SizeDistribution) -> float:
     scaled = dt * factor
     unit = 10.0 ** (math.floor(math.log10(scaled)) - 1)
     return round(math.floor(scaled / unit * (1 + 1e-12)) * unit, 12)
+
+
+def holds_smallest_pair(radii) -> bool:
+    """Whether a packing's radii hold two spheres of the smallest radius: the pair whose resistances
+    choose_springs quotes (pair=), which a lone smallest sphere does not make."""
+    radii = np.asarray(radii, dtype=float)
+    return int(np.sum(np.isclose(radii, radii.min()))) >= 2
 
 
 def choose_springs(stress: float, dt: float, delta: float, kn: float | None = None,
