@@ -129,7 +129,7 @@ def test_held_back_equal_pair_at_a1_over_delta_6(blocks):
         if g <= 1e-3:
             assert abs(e) < 2e-3, (g, e)
     # every held-back measurement is what the scene writers' bounds see
-    assert len(subgridinterp.held_back_measurements(blocks)) == 3
+    assert len(subgridinterp.held_back_measurements(blocks)) == 4
 
 
 def test_held_back_ratio_2_at_a1_over_delta_4(blocks):
@@ -155,6 +155,30 @@ def test_held_back_ratio_2_at_a1_over_delta_4(blocks):
     tests = subgridinterp.leave_one_out(blocks) + subgridinterp.held_back_measurements(blocks)
     inside = max(h.worst() for h in tests if h.kind == "pair" and not any(h.distance()))
     assert subgridinterp.error_bound("pair", t.distance(), tests) == pytest.approx(inside)
+
+
+def test_held_back_ratio_3_at_a1_over_delta_3(blocks):
+    """a2/a1 3 at a1/Delta 3 (boxes 18 and 24 a1, 54 and 72 cells, 4 positions), calibrated directly and kept out
+    of the table: a*/Delta 2.25 inside the shipped pairs, a2/a1 0.76 beyond their 1.4 in ln ratio. Its own
+    correction is within 2.1 % of the theory averaged over the positions (measured 2.03 %: the logistic form fits
+    this ratio less well); interpolated from the table it is 6.9 % off (5.6 % added, at xi 0.05). It bounds the
+    pairs between a2/a1 2 and 3, not those up to 2, for which the nearer ratio-2 tests hold."""
+    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[3])
+    with open(path) as f:
+        data = json.load(f)
+    [s] = data["calibrations"]
+    assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 3.0, 3.0) and s["boxes"] == [18.0, 24.0]
+    [t] = subgridinterp.held_back_measurements(blocks, [path])
+    assert t.u == pytest.approx(2.25) and t.distance() == pytest.approx((0, 0, math.log(3 / 1.4)))
+    assert np.max(np.abs(t.direct)) < 0.021
+    assert 0.05 < t.worst() < 0.06 and 0.06 < np.max(np.abs(t.interpolated)) < 0.075
+    tests = subgridinterp.leave_one_out(blocks) + subgridinterp.held_back_measurements(blocks)
+    inside = max(h.worst() for h in tests if h.kind == "pair" and not any(h.distance()))
+    ratio2 = [h.worst() for h in tests if h.kind == "pair" and h.ratio == 2.0]
+    assert subgridinterp.error_bound("pair", (0, 0, math.log(2 / 1.4)), tests) == pytest.approx(
+        max([inside] + ratio2))
+    assert subgridinterp.error_bound("pair", (0, 0, math.log(2.5 / 1.4)), tests) == pytest.approx(t.worst())
+    assert subgridinterp.error_bound("pair", (0, 0, math.log(3.5 / 1.4)), tests) is None
 
 
 def test_interpolated_table_is_read_by_the_resistance_library(tmp_path, env):
@@ -219,9 +243,12 @@ def test_coverage_of_scenes(blocks, loo):
     inside = max(t.worst() for t in loo.values() if t.kind == "pair" and not any(t.distance()))
     assert one_two.error == pytest.approx(max(inside, ratio2.worst()))
     assert one_two.status == ("interpolated" if one_two.error <= subgridinterp.TOLERANCE else "refused")
-    # a2/a1 3 lies farther beyond the ratios than any test: refused whatever the errors measured
-    assert calibration.coverage([1.0, 3.0], 3.0)[1].status == "refused"
-    assert calibration.coverage([1.0, 3.0], 3.0)[1].error is None
+    # a2/a1 3 and 2.5 are bounded by the held-back ratio-3 pair (5.6 %), a2/a1 4 lies farther beyond the
+    # ratios than any test: refused whatever the errors measured
+    ratio3 = calibration.coverage([1.0, 3.0], 3.0)[1]
+    assert ratio3.status == "refused" and 0.05 < ratio3.error < 0.06
+    assert calibration.coverage([1.0, 2.5], 3.0)[1].error == pytest.approx(ratio3.error)
+    assert calibration.coverage([1.0, 4.0], 3.0)[1].error is None
     # the wall at a/Delta 6 (radius 2) lies 0.18 above the walls' 3 ... 5 in ln u: the wall a/Delta 5 from
     # 3 and 4 lay 0.22 above its sources and was within 1.3 %; a/Delta 6.7 lies farther above than any test
     wall = scene[((2.0, math.inf), "wall")]

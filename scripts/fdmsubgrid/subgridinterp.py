@@ -53,7 +53,8 @@ from . import calibration, foamcase
 SHIPPED_JSON = os.path.join("dem", "resistance", "data", "squeeze_calibration.json")
 HELD_BACK_JSON = (os.path.join("docs", "data", "validation_calibrationInterpolation_ratio2_ad3.json"),
                   os.path.join("docs", "data", "validation_calibrationInterpolation_ratio1_ad6.json"),
-                  os.path.join("docs", "data", "validation_calibrationInterpolation_ratio2_ad4.json"))
+                  os.path.join("docs", "data", "validation_calibrationInterpolation_ratio2_ad4.json"),
+                  os.path.join("docs", "data", "validation_calibrationInterpolation_ratio3_ad3.json"))
 # A species pair is used without refusal when the interpolation's error, measured on held-back blocks in
 # the same situation (`error_bound`), is within this (position-averaged, every gap 1e-4 ... 1).
 TOLERANCE = 0.02
@@ -256,16 +257,23 @@ def outside(u: float, ratio: float, sources_u: Sequence[float],
 def error_bound(kind: str, distance: Sequence[float], tests: Sequence[HeldBack]) -> float | None:
     """The interpolation's error to expect for a block of `kind` lying `distance` (`outside`) outside the
     measured blocks: the worst of the held-back tests of that kind inside their sources and, for a block
-    outside, of those at least as far outside in each direction (an extrapolation is never trusted more than
-    an interpolation); None when no test lies that far outside (an extrapolation farther than any measured)."""
+    outside, of the nearest tests at least as far outside in each direction (an extrapolation is never trusted
+    more than an interpolation; a test farther out than another such test does not bound it, as the ratio-3 pair
+    does not bound a ratio-2 one); None when no test lies that far outside (an extrapolation farther than any
+    measured)."""
     same = [t for t in tests if t.kind == kind]
     inside = [t.worst() for t in same if not any(t.distance())]
     if not any(d > 0 for d in distance):
         return max(inside, default=None)
-    farther = [t.worst() for t in same if all(td >= d - 1e-9 for td, d in zip(t.distance(), distance))]
-    if not farther:
+
+    def at_least(a: Sequence[float], b: Sequence[float]) -> bool:
+        return all(x >= y - 1e-9 for x, y in zip(a, b))
+    farther = [t.distance() for t in same if at_least(t.distance(), distance)]
+    nearest = [t.worst() for t in same if at_least(t.distance(), distance)
+               and not any(at_least(t.distance(), f) and not at_least(f, t.distance()) for f in farther)]
+    if not nearest:
         return None
-    return max(inside + farther)
+    return max(inside + nearest)
 
 
 # ---------------------------------------------------------------------------------------------------
