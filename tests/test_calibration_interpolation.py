@@ -129,7 +129,7 @@ def test_held_back_equal_pair_at_a1_over_delta_6(blocks):
         if g <= 1e-3:
             assert abs(e) < 2e-3, (g, e)
     # every held-back measurement is what the scene writers' bounds see
-    assert len(subgridinterp.held_back_measurements(blocks)) == 4
+    assert len(subgridinterp.held_back_measurements(blocks)) == 5
 
 
 def test_held_back_ratio_2_at_a1_over_delta_4(blocks):
@@ -179,6 +179,29 @@ def test_held_back_ratio_3_at_a1_over_delta_3(blocks):
         max([inside] + ratio2))
     assert subgridinterp.error_bound("pair", (0, 0, math.log(2.5 / 1.4)), tests) == pytest.approx(t.worst())
     assert subgridinterp.error_bound("pair", (0, 0, math.log(3.5 / 1.4)), tests) is None
+
+
+def test_held_back_ratio_3_at_a1_over_delta_4(blocks):
+    """a2/a1 3 at a1/Delta 4 (boxes 18 and 24 a1, 72 and 96 cells, 4 positions; 6243 core-seconds), calibrated
+    directly and kept out of the table: a*/Delta 3, 0.03 above the shipped pairs, a2/a1 0.76 beyond their 1.4. Its
+    own correction is within 2 % of the theory averaged over the positions (measured 1.8 %), as the table's blocks
+    are; interpolated it is 3.0 % off (1.2 % added, at xi 0.07): measured on demand, not interpolated. Farther out
+    than the ratio-3 pair at a1/Delta 3 (above the table's a*/Delta too), it does not bound the pairs that one does."""
+    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[4])
+    with open(path) as f:
+        data = json.load(f)
+    [s] = data["calibrations"]
+    assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 4.0, 3.0) and s["boxes"] == [18.0, 24.0]
+    [t] = subgridinterp.held_back_measurements(blocks, [path])
+    assert t.u == pytest.approx(3.0) and t.distance()[2] == pytest.approx(math.log(3 / 1.4))
+    assert t.distance()[1] == pytest.approx(math.log(3.0 / 2.92), abs=0.01)
+    assert np.max(np.abs(t.direct)) < 0.0185
+    assert 0.01 < t.worst() < 0.014 and 0.025 < np.max(np.abs(t.interpolated)) < 0.032
+    tests = subgridinterp.leave_one_out(blocks) + subgridinterp.held_back_measurements(blocks)
+    inside = max(h.worst() for h in tests if h.kind == "pair" and not any(h.distance()))
+    assert subgridinterp.error_bound("pair", t.distance(), tests) == pytest.approx(max(inside, t.worst()))
+    ratio3 = [h for h in tests if h.kind == "pair" and h.ratio == 3.0 and h.a_over_delta == 3.0]
+    assert subgridinterp.error_bound("pair", (0, 0, math.log(2.5 / 1.4)), tests) == pytest.approx(ratio3[0].worst())
 
 
 def test_interpolated_table_is_read_by_the_resistance_library(tmp_path, env):

@@ -54,7 +54,8 @@ SHIPPED_JSON = os.path.join("dem", "resistance", "data", "squeeze_calibration.js
 HELD_BACK_JSON = (os.path.join("docs", "data", "validation_calibrationInterpolation_ratio2_ad3.json"),
                   os.path.join("docs", "data", "validation_calibrationInterpolation_ratio1_ad6.json"),
                   os.path.join("docs", "data", "validation_calibrationInterpolation_ratio2_ad4.json"),
-                  os.path.join("docs", "data", "validation_calibrationInterpolation_ratio3_ad3.json"))
+                  os.path.join("docs", "data", "validation_calibrationInterpolation_ratio3_ad3.json"),
+                  os.path.join("docs", "data", "validation_calibrationInterpolation_ratio3_ad4.json"))
 # A species pair is used without refusal when the interpolation's error, measured on held-back blocks in
 # the same situation (`error_bound`), is within this (position-averaged, every gap 1e-4 ... 1).
 TOLERANCE = 0.02
