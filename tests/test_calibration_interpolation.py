@@ -106,6 +106,15 @@ def test_held_back_direct_calibration(blocks):
     assert 1 / 1.6 < estimate / data["core_seconds"] < 1.6
 
 
+def held_back(blocks, index):
+    """The summary of the held-back calibration HELD_BACK_JSON[index] (one block) and its interpolation."""
+    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[index])
+    with open(path) as f:
+        [summary] = json.load(f)["calibrations"]
+    [test] = subgridinterp.held_back_measurements(blocks, [path])
+    return summary, test
+
+
 # measured 1.5 % (at xi 0.07; docs/resistance.md, "Sizes and resolutions outside the table")
 HELD_BACK_BOUND = 0.016
 
@@ -115,13 +124,9 @@ def test_held_back_equal_pair_at_a1_over_delta_6(blocks):
     kept out of the table: a*/Delta 3, just above the shipped pairs (0.03 in ln u), interpolated from them within
     0.8 % of its own correction at every gap (measured 0.7 %, at xi 0.02), within 2 % of the theory averaged
     over the positions (measured 1.8 %, as its direct calibration), near contact within 0.2 %."""
-    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[1])
-    with open(path) as f:
-        data = json.load(f)
-    [s] = data["calibrations"]
+    s, t = held_back(blocks, 1)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 6.0, 1.0) and s["boxes"] == [8.0, 12.0]
     assert all(len(v) == 4 for v in s["velocities"].values()) and len(s["gaps"]) == 15
-    [t] = subgridinterp.held_back_measurements(blocks, [path])
     assert t.u == pytest.approx(3.0) and t.distance()[1] == pytest.approx(math.log(3.0 / 2.92), abs=0.01)
     assert t.worst() < 0.008, t.added()
     assert np.max(np.abs(t.interpolated)) < 0.02 and np.max(np.abs(t.direct)) < 0.02
@@ -138,12 +143,8 @@ def test_held_back_ratio_2_at_a1_over_delta_4(blocks):
     3. The interpolation adds at most 1.3 % to its own calibration (measured 1.2 %, at xi 0.5), which is within
     2 % of the theory (1.8 %); interpolated it is within 2.6 % (measured 2.55 %, at xi 0.1: above the 2 %, as the
     scene writers' 3.0 % bound for pairs outside the table says), near contact within 0.2 %."""
-    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[2])
-    with open(path) as f:
-        data = json.load(f)
-    [s] = data["calibrations"]
+    s, t = held_back(blocks, 2)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 4.0, 2.0) and s["boxes"] == [12.0, 16.0]
-    [t] = subgridinterp.held_back_measurements(blocks, [path])
     assert t.u == pytest.approx(8.0 / 3.0) and t.distance() == pytest.approx((0, 0, math.log(2 / 1.4)))
     assert t.worst() < 0.013, t.added()
     assert np.max(np.abs(t.direct)) < 0.02 and np.max(np.abs(t.interpolated)) < 0.026
@@ -163,12 +164,8 @@ def test_held_back_ratio_3_at_a1_over_delta_3(blocks):
     correction is within 2.1 % of the theory averaged over the positions (measured 2.03 %: the logistic form fits
     this ratio less well); interpolated from the table it is 6.9 % off (5.6 % added, at xi 0.05). It bounds the
     pairs between a2/a1 2 and 3, not those up to 2, for which the nearer ratio-2 tests hold."""
-    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[3])
-    with open(path) as f:
-        data = json.load(f)
-    [s] = data["calibrations"]
+    s, t = held_back(blocks, 3)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 3.0, 3.0) and s["boxes"] == [18.0, 24.0]
-    [t] = subgridinterp.held_back_measurements(blocks, [path])
     assert t.u == pytest.approx(2.25) and t.distance() == pytest.approx((0, 0, math.log(3 / 1.4)))
     assert np.max(np.abs(t.direct)) < 0.021
     assert 0.05 < t.worst() < 0.06 and 0.06 < np.max(np.abs(t.interpolated)) < 0.075
@@ -187,12 +184,8 @@ def test_held_back_ratio_3_at_a1_over_delta_4(blocks):
     own correction is within 2 % of the theory averaged over the positions (measured 1.8 %), as the table's blocks
     are; interpolated it is 3.0 % off (1.2 % added, at xi 0.07): measured on demand, not interpolated. Farther out
     than the ratio-3 pair at a1/Delta 3 (above the table's a*/Delta too), it does not bound the pairs that one does."""
-    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[4])
-    with open(path) as f:
-        data = json.load(f)
-    [s] = data["calibrations"]
+    s, t = held_back(blocks, 4)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 4.0, 3.0) and s["boxes"] == [18.0, 24.0]
-    [t] = subgridinterp.held_back_measurements(blocks, [path])
     assert t.u == pytest.approx(3.0) and t.distance()[2] == pytest.approx(math.log(3 / 1.4))
     assert t.distance()[1] == pytest.approx(math.log(3.0 / 2.92), abs=0.01)
     assert np.max(np.abs(t.direct)) < 0.0185
