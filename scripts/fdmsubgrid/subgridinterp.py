@@ -269,9 +269,11 @@ def error_bound(kind: str, distance: Sequence[float], tests: Sequence[HeldBack])
 
     def at_least(a: Sequence[float], b: Sequence[float]) -> bool:
         return all(x >= y - 1e-9 for x, y in zip(a, b))
-    farther = [t.distance() for t in same if at_least(t.distance(), distance)]
-    nearest = [t.worst() for t in same if at_least(t.distance(), distance)
-               and not any(at_least(t.distance(), f) and not at_least(f, t.distance()) for f in farther)]
+    farther = [t for t in same if at_least(t.distance(), distance)]
+    # those no other such test lies nearer to (at most as far in every direction, nearer in one)
+    nearest = [t.worst() for t in farther
+               if not any(at_least(t.distance(), f.distance()) and not at_least(f.distance(), t.distance())
+                          for f in farther)]
     if not nearest:
         return None
     return max(inside + nearest)
