@@ -35,6 +35,7 @@ What `analyse` measures (docs/profiles.md, "Pressure-driven flow"):
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 from dataclasses import dataclass
@@ -348,7 +349,6 @@ def earlier_series(segments: Sequence[dict], before: float) -> dict:
 
 def read_segments(folder: str) -> list[dict]:
     """The segment files (segment_<t0>_<t1>.json) of a folder, e.g. cases/poiseuille/ladder20/segments."""
-    import json
     names = sorted(n for n in os.listdir(folder) if n.startswith("segment_") and n.endswith(".json"))
     if not names:
         raise PoiseuilleRunError("%s holds no segment_<t0>_<t1>.json" % folder)
@@ -815,7 +815,6 @@ def migration_series(run_dir: str) -> dict:
 def write_segment(run_dir: str, folder: str) -> str:
     """migration_series of run_dir written to folder/segment_<first>_<last>.json (times rounded to the
     record); a segment file of the same first time is replaced (the run went on since)."""
-    import json
     series = migration_series(run_dir)
     first = series["time"][0]
     os.makedirs(folder, exist_ok=True)
@@ -846,7 +845,6 @@ def arrival(time: ArrayLike, phi_center: ArrayLike, levels: Sequence[float], at:
 
 def _series_of(path: str) -> dict:
     """The migration series of an analysed run (its results.json: data.series) or of a folder of segments."""
-    import json
     if os.path.isdir(path):
         joined = earlier_series(read_segments(path), math.inf)
         return dict(time=joined["time"], phi_center=joined["phi_center"])
