@@ -28,6 +28,9 @@
 
 namespace fdm {
 
+template <class History>
+class BasicAndersonMixing;  // fdm/anderson_mixing.h
+
 // The records of the sub-grid blocks, as pair_style fdm/subgrid builds them on every rank and
 // fix fdm/couple gathers them on rank 0. R already contains the viscosity (F = -R u).
 namespace subgrid {
@@ -282,7 +285,7 @@ class ParticleVelocitySystem {
   double lastCoulombResidual_ = 0;     // the largest change of a cap in the last round of this solve
   std::unique_ptr<Matrices> m_;
   static const int coulombMixingDepth = 10;              // differences kept: a solve takes 5-20 rounds
-  std::unique_ptr<class AndersonMixing> coulombMixing_;  // of the caps over the Coulomb rounds of one solve
+  std::unique_ptr<BasicAndersonMixing<double> > coulombMixing_;  // of the caps over the Coulomb rounds of one solve
 };
 
 }  // namespace fdm

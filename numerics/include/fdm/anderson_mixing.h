@@ -2,7 +2,7 @@
     fdm numerics: plain C++ shared by the fluid solver and the particle side
 
 Class
-    fdm::AndersonMixing
+    fdm::BasicAndersonMixing (fdm::AndersonMixing, fdm::AndersonMixingFloatHistory)
 
 Description
     The arithmetic of Anderson acceleration (Anderson, J. ACM 12, 1965;
@@ -29,6 +29,14 @@ Description
     not O(m^2 n): deep histories (m = 20-40, which the dense suspensions
     want) cost little more than short ones.
 
+    The differences are stored as History (BasicAndersonMixing<History>):
+    AndersonMixing keeps doubles; AndersonMixingFloatHistory keeps floats,
+    which halves the memory an iteration reads, the whole cost of a long
+    vector's mixing. Rounding a difference to float perturbs the next iterate
+    by 6e-8 of the step it mixes, not of the iterate (x_k and G(x_k) stay
+    double, the sums are double), so the fixed point and any tolerance above
+    that are unchanged: the fluid's inner iteration uses it.
+
 \*---------------------------------------------------------------------------*/
 
 #ifndef fdm_AndersonMixing_H
@@ -44,14 +52,15 @@ Description
 namespace fdm
 {
 
-class AndersonMixing
+template<class History>
+class BasicAndersonMixing
 {
 public:
 
     //- Sums a list of partial sums over the ranks, in place
     typedef std::function<void(std::vector<double>&)> Reduction;
 
-    explicit AndersonMixing(int depth, Reduction sumOverRanks = Reduction())
+    explicit BasicAndersonMixing(int depth, Reduction sumOverRanks = Reduction())
     :
         depth_(depth),
         sumOverRanks_(sumOverRanks),
@@ -63,8 +72,8 @@ public:
     void reset()
     {
         // the history's vectors are kept for the next step's
-        for (std::vector<double>& v : dG_) spare_.push_back(std::move(v));
-        for (std::vector<double>& v : dF_) spare_.push_back(std::move(v));
+        for (std::vector<History>& v : dG_) spare_.push_back(std::move(v));
+        for (std::vector<History>& v : dF_) spare_.push_back(std::move(v));
         dG_.clear();
         dF_.clear();
         gram_.clear();
@@ -91,18 +100,18 @@ public:
         // one pass over the vectors: f = G(x) - x, the new differences
         // dG = G - G_prev and df = f - f_prev, and G and f kept as the
         // previous ones (separate loops read g three times)
-        std::vector<double> dG = spareVector(n), dF = spareVector(n);
+        std::vector<History> dG = spareVector(n), dF = spareVector(n);
         {
             double* pG = previousG_.data();
             double* pF = previousF_.data();
-            double* dGi = dG.data();
-            double* dFi = dF.data();
+            History* dGi = dG.data();
+            History* dFi = dF.data();
             for (std::size_t i = 0; i < n; ++i)
             {
                 const double gi = g[i];
                 const double fi = gi - x[i];
-                dGi[i] = gi - pG[i];
-                dFi[i] = fi - pF[i];
+                dGi[i] = History(gi - pG[i]);
+                dFi[i] = History(fi - pF[i]);
                 pG[i] = gi;
                 pF[i] = fi;
             }
@@ -110,7 +119,7 @@ public:
         dG_.push_back(std::move(dG));
         dF_.push_back(std::move(dF));
         const std::vector<double>& f = previousF_;
-        const std::vector<double>& dFNew = dF_.back();
+        const std::vector<History>& dFNew = dF_.back();
 
         // the new row of the Gram matrix and the right-hand side, in blocks
         // of the vector so that dF and f are read from cache once per block
@@ -122,12 +131,13 @@ public:
             const std::size_t k1 = std::min(n, k0 + block_);
             for (int j = 0; j < m; ++j)
             {
-                const double* d = dF_[j].data();
+                const History* d = dF_[j].data();
                 double row = sums[j], rhs = sums[m + j];
                 for (std::size_t k = k0; k < k1; ++k)
                 {
-                    row += d[k]*dFNew[k];
-                    rhs += d[k]*f[k];
+                    const double dk = d[k];
+                    row += dk*double(dFNew[k]);
+                    rhs += dk*f[k];
                 }
                 sums[j] = row;
                 sums[m + j] = rhs;
@@ -160,11 +170,11 @@ public:
             const std::size_t i1 = std::min(n, i0 + block_);
             for (std::size_t j = 0; j < gamma.size(); ++j)
             {
-                const double* d = dG_[j].data();
+                const History* d = dG_[j].data();
                 const double c = gamma[j];
                 for (std::size_t i = i0; i < i1; ++i)
                 {
-                    g[i] -= c*d[i];
+                    g[i] -= c*double(d[i]);
                 }
             }
         }
@@ -182,9 +192,9 @@ private:
     //  its entry of the right-hand side)
     //- A vector of n from the recycled ones (allocating a vector of the
     //  whole state every iteration cost more than the arithmetic)
-    std::vector<double> spareVector(std::size_t n)
+    std::vector<History> spareVector(std::size_t n)
     {
-        std::vector<double> v;
+        std::vector<History> v;
         if (!spare_.empty())
         {
             v.swap(spare_.back());
@@ -283,19 +293,25 @@ private:
 
     const int depth_;
     const Reduction sumOverRanks_;
-    std::deque<std::vector<double> > dG_;
-    std::deque<std::vector<double> > dF_;
+    std::deque<std::vector<History> > dG_;
+    std::deque<std::vector<History> > dF_;
     //- gram_[i][j] = df_i . df_j (reduced over the ranks), i, j over dF_
     std::deque<std::vector<double> > gram_;
     std::vector<double> previousG_;
     std::vector<double> previousF_;
     //- Vectors of dropped differences, reused
-    std::vector<std::vector<double> > spare_;
+    std::vector<std::vector<History> > spare_;
     //- Entries per block of the blocked loops (fits the L1/L2 caches)
     static const std::size_t block_ = 2048;
     bool havePrevious_;
     int dropped_;
 };
+
+//- The Coulomb rounds of Eq. (31): short vectors, tolerances near round-off
+typedef BasicAndersonMixing<double> AndersonMixing;
+
+//- The fluid's inner iteration: long vectors read at every iteration
+typedef BasicAndersonMixing<float> AndersonMixingFloatHistory;
 
 } // End namespace fdm
 
