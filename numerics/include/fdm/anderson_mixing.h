@@ -31,8 +31,9 @@ Description
 
     The differences are stored as History (BasicAndersonMixing<History>):
     AndersonMixing keeps doubles; AndersonMixingFloatHistory keeps floats,
-    which halves the memory an iteration reads, the whole cost of a long
-    vector's mixing. Rounding a difference to float perturbs the next iterate
+    which halves the history's memory and what an iteration reads of it
+    (the fluid's mixing 13-15 % faster on the Table 8 scenes: packing the
+    fields and updating G stay). Rounding a difference to float perturbs the next iterate
     by 6e-8 of the step it mixes, not of the iterate (x_k and G(x_k) stay
     double, the sums are double), so the fixed point and any tolerance above
     that are unchanged: the fluid's inner iteration uses it.
