@@ -14,7 +14,6 @@ import pytest
 from conftest import PROJECT
 from fdmsubgrid import calibration, subgridinterp
 
-HELD_BACK = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[0])
 
 
 @pytest.fixture(scope="module")
@@ -84,17 +83,25 @@ def test_the_collapse_is_what_makes_it_work(blocks, loo):
         assert fixed[key] > 0.024 and collapsed[key] < fixed[key] - 0.008, key
 
 
+def held_back(blocks, index):
+    """The held-back calibration HELD_BACK_JSON[index]: its summary (one block), its interpolation from the
+    table (subgridinterp.held_back_measurements) and the core-seconds its direct calibration took."""
+    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[index])
+    with open(path) as f:
+        data = json.load(f)
+    [summary] = data["calibrations"]
+    [test] = subgridinterp.held_back_measurements(blocks, [path])
+    return summary, test, data["core_seconds"]
+
+
 def test_held_back_direct_calibration(blocks):
     """a2/a1 = 2 at a1/Delta 3, calibrated directly (boxes 12 and 16 a1, 4 positions) and kept out of the
     table, against its interpolation from the 6 shipped pair blocks, gap by gap (docs/data): the
     interpolation's error within 1.6 % at every gap (measured 1.5 %), near contact within 0.2 % of the theory;
     and the direct calibration's cost as the cost model estimates it, within a factor 1.6."""
-    with open(HELD_BACK) as f:
-        data = json.load(f)
-    s = data["calibrations"][0]
+    s, t, core_seconds = held_back(blocks, 0)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 3.0, 2.0)
     assert len(s["velocities"]["12"]) == 4 and len(s["gaps"]) == 15
-    t = subgridinterp.held_back_measurements(blocks, [HELD_BACK])[0]
     assert t.u == pytest.approx(2.0)     # a*/Delta inside the shipped pairs' 1.5 ... 2.92, a2/a1 beyond their 1.4
     assert t.worst() < HELD_BACK_BOUND, t.added()
     for g, e in zip(t.gaps, t.interpolated):
@@ -103,16 +110,7 @@ def test_held_back_direct_calibration(blocks):
     model = subgridinterp.cost_model([b.summary for b in blocks])
     estimate = subgridinterp.estimated_core_seconds("pair", 3.0, 2.0, model)
     assert subgridinterp.calibration_boxes(2.0) == tuple(float(L) for L in s["boxes"])
-    assert 1 / 1.6 < estimate / data["core_seconds"] < 1.6
-
-
-def held_back(blocks, index):
-    """The summary of the held-back calibration HELD_BACK_JSON[index] (one block) and its interpolation."""
-    path = os.path.join(PROJECT, subgridinterp.HELD_BACK_JSON[index])
-    with open(path) as f:
-        [summary] = json.load(f)["calibrations"]
-    [test] = subgridinterp.held_back_measurements(blocks, [path])
-    return summary, test
+    assert 1 / 1.6 < estimate / core_seconds < 1.6
 
 
 # measured 1.5 % (at xi 0.07; docs/resistance.md, "Sizes and resolutions outside the table")
@@ -124,7 +122,7 @@ def test_held_back_equal_pair_at_a1_over_delta_6(blocks):
     kept out of the table: a*/Delta 3, just above the shipped pairs (0.03 in ln u), interpolated from them within
     0.8 % of its own correction at every gap (measured 0.7 %, at xi 0.02), within 2 % of the theory averaged
     over the positions (measured 1.8 %, as its direct calibration), near contact within 0.2 %."""
-    s, t = held_back(blocks, 1)
+    s, t, _ = held_back(blocks, 1)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 6.0, 1.0) and s["boxes"] == [8.0, 12.0]
     assert all(len(v) == 4 for v in s["velocities"].values()) and len(s["gaps"]) == 15
     assert t.u == pytest.approx(3.0) and t.distance()[1] == pytest.approx(math.log(3.0 / 2.92), abs=0.01)
@@ -143,7 +141,7 @@ def test_held_back_ratio_2_at_a1_over_delta_4(blocks):
     3. The interpolation adds at most 1.3 % to its own calibration (measured 1.2 %, at xi 0.5), which is within
     2 % of the theory (1.8 %); interpolated it is within 2.6 % (measured 2.55 %, at xi 0.1: above the 2 %, as the
     scene writers' 3.0 % bound for pairs outside the table says), near contact within 0.2 %."""
-    s, t = held_back(blocks, 2)
+    s, t, _ = held_back(blocks, 2)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 4.0, 2.0) and s["boxes"] == [12.0, 16.0]
     assert t.u == pytest.approx(8.0 / 3.0) and t.distance() == pytest.approx((0, 0, math.log(2 / 1.4)))
     assert t.worst() < 0.013, t.added()
@@ -164,7 +162,7 @@ def test_held_back_ratio_3_at_a1_over_delta_3(blocks):
     correction is within 2.1 % of the theory averaged over the positions (measured 2.03 %: the logistic form fits
     this ratio less well); interpolated from the table it is 6.9 % off (5.6 % added, at xi 0.05). It bounds the
     pairs between a2/a1 2 and 3, not those up to 2, for which the nearer ratio-2 tests hold."""
-    s, t = held_back(blocks, 3)
+    s, t, _ = held_back(blocks, 3)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 3.0, 3.0) and s["boxes"] == [18.0, 24.0]
     assert t.u == pytest.approx(2.25) and t.distance() == pytest.approx((0, 0, math.log(3 / 1.4)))
     assert np.max(np.abs(t.direct)) < 0.021
@@ -184,7 +182,7 @@ def test_held_back_ratio_3_at_a1_over_delta_4(blocks):
     own correction is within 2 % of the theory averaged over the positions (measured 1.8 %), as the table's blocks
     are; interpolated it is 3.0 % off (1.2 % added, at xi 0.07): measured on demand, not interpolated. Farther out
     than the ratio-3 pair at a1/Delta 3 (above the table's a*/Delta too), it does not bound the pairs that one does."""
-    s, t = held_back(blocks, 4)
+    s, t, _ = held_back(blocks, 4)
     assert (s["kind"], s["a_over_delta"], s["ratio"]) == ("pair", 4.0, 3.0) and s["boxes"] == [18.0, 24.0]
     assert t.u == pytest.approx(3.0) and t.distance()[2] == pytest.approx(math.log(3 / 1.4))
     assert t.distance()[1] == pytest.approx(math.log(3.0 / 2.92), abs=0.01)
@@ -254,7 +252,7 @@ def test_coverage_of_scenes(blocks, loo):
     assert (one_two.a_over_delta, one_two.ratio) == (3.0, 2.0)
     # a2/a1 2 lies beyond the shipped ratios (ln(2/1.4) = 0.36 outside): only the held-back ratio-2
     # calibration measured that far, and the pairs inside their sources bound it from below
-    ratio2 = subgridinterp.held_back_measurements(blocks, [HELD_BACK])[0]
+    ratio2 = held_back(blocks, 0)[1]
     assert ratio2.distance() == pytest.approx((0, 0, math.log(2 / 1.4)))
     inside = max(t.worst() for t in loo.values() if t.kind == "pair" and not any(t.distance()))
     assert one_two.error == pytest.approx(max(inside, ratio2.worst()))
