@@ -15,7 +15,6 @@ from conftest import PROJECT
 from fdmsubgrid import calibration, subgridinterp
 
 
-
 @pytest.fixture(scope="module")
 def blocks():
     return subgridinterp.load_blocks(os.path.join(PROJECT, subgridinterp.SHIPPED_JSON))
