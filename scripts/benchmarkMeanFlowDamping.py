@@ -68,7 +68,8 @@ def run_scene(workdir: str, label: str, acceleration: str, damping: float, tol_l
         fluid.update(tol_u=tol_solve, tol_p=tol_solve)
         rel_tol = (0.0, 0.0, 0.0)
     if rel_tol is not None:
-        fluid.update(zip(("u_rel_tol", "p_rel_tol", "p_final_rel_tol"), rel_tol))
+        # the momentum predictor solved to its relTol, not the case's fixed sweep
+        fluid.update(zip(("u_rel_tol", "p_rel_tol", "p_final_rel_tol"), rel_tol), u_sweeps=None)
     scene = couettescene.write_case(run_dir, pack, springs, a_over_delta, dt, 2 * dt, 1, tol_lambda, acceleration,
                                n_max, fluid_options=fluid)
     try:

@@ -135,7 +135,7 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
                      pseudo_time_factor=1.0, pseudo_time_factor_outside=None, n_particles=-1, write_interval=100000,
                      n_correctors=2, extra_fdm="", acceleration="anderson", tol_velocity=0.0,
                      mean_flow_correction=True, mean_flow_damping=None, u_rel_tol=0.0, p_rel_tol=0.01,
-                     p_final_rel_tol=0.0, linear_solver=None, momentum_predictor=None):
+                     p_final_rel_tol=0.0, linear_solver=None, momentum_predictor=None, u_sweeps=None):
     """OpenFOAM case for fdmFoam in case_dir (system/, constant/, 0/). u_rel_tol, p_rel_tol,
     p_final_rel_tol: the relTol of the momentum predictor, of the first pressure corrector and of
     the last (pFinal) in every inner iteration (0: solved to tol_u, tol_p each time; the suspension
@@ -148,10 +148,22 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
     linear_solver: the solver of p and U, "FFTBox" (the direct solver for box meshes, GAMG and
     symGaussSeidel as its fallbacks) or "GAMG" (GAMG for p, symGaussSeidel for U); None:
     DEFAULT_LINEAR_SOLVER (docs/fluid.md, "Direct solver for box meshes"). momentum_predictor: PISO's
-    momentumPredictor (None: MOMENTUM_PREDICTOR of the linear solver)."""
+    momentumPredictor (None: MOMENTUM_PREDICTOR of the linear solver). u_sweeps: the momentum predictor as
+    that many symGaussSeidel sweeps per solve with no residual computed (OpenFOAM's smoothSolver with
+    nSweeps -u_sweeps; tol_u and u_rel_tol then unused); None: solved to u_rel_tol, tol_u. Not with
+    "FFTBox-all", whose U solve is exact."""
     linear_solver = DEFAULT_LINEAR_SOLVER if linear_solver is None else linear_solver
     if linear_solver not in LINEAR_SOLVERS:
         raise ValueError("write_fluid_case: linear_solver %r is not one of %s" % (linear_solver, ", ".join(LINEAR_SOLVERS)))
+    u_solver = LINEAR_SOLVERS[linear_solver][1]
+    if u_sweeps is not None:
+        if u_solver != _SYMMETRIC_GAUSS_SEIDEL or int(u_sweeps) != u_sweeps or u_sweeps < 1:
+            raise ValueError("write_fluid_case: u_sweeps %r needs a whole number >= 1 and U solved by symGaussSeidel "
+                             "(linear_solver %r solves it otherwise)" % (u_sweeps, linear_solver))
+        # the residuals a smoothSolver computes before and after its sweeps cost as much as one sweep
+        # (docs/benchmarks.md, "Direct solver for box meshes": the momentum solve halved)
+        u_solver += ("\n        nSweeps         %d;         // fixed sweeps, no residual: tolerance and relTol unused"
+                     % -int(u_sweeps))
     x0, y0, z0 = box.lo
     x1, y1, z1 = box.hi
     names = ("x", "y", "z")
@@ -238,7 +250,7 @@ PISO
     pRefValue       0;
 }
 """ % dict(tol_p=tol_p, tol_u=tol_u, u_rel_tol=u_rel_tol, p_rel_tol=p_rel_tol, p_final_rel_tol=p_final_rel_tol,
-           ncorr=n_correctors, p_solver=LINEAR_SOLVERS[linear_solver][0], u_solver=LINEAR_SOLVERS[linear_solver][1],
+           ncorr=n_correctors, p_solver=LINEAR_SOLVERS[linear_solver][0], u_solver=u_solver,
            predictor="yes" if (MOMENTUM_PREDICTOR[linear_solver] if momentum_predictor is None else momentum_predictor)
            else "no"))
 
