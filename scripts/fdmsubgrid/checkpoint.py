@@ -17,6 +17,12 @@ each code keeps its two newest.
     python3 -m fdmsubgrid.checkpoint until INPUT L STEP  the run resumed from STEP to end at step L: the
                                                  LIGGGHTS input's `run N upto` becomes `run L upto`
                                                  (prints N; fdmRun --resume --until L)
+    python3 -m fdmsubgrid.checkpoint processors CASE STEP  the fluid ranks STEP's checkpoint was written on and
+                                                 its time directory (prints "N TIME")
+    python3 -m fdmsubgrid.checkpoint set-processors CASE STEP N
+                                                 once fdmRun --resume on another -f has redistributed STEP's
+                                                 fields (reconstructPar, decomposePar -time): its marker
+                                                 says N ranks
     python3 -m fdmsubgrid.checkpoint stamp CASE INPUT    record which sub-grid calibration table the run
                                                  starts with (its path and SHA-256, CASE/.fdmRun-calibration)
     python3 -m fdmsubgrid.checkpoint check-stamp CASE INPUT [--new-calibration]
@@ -169,6 +175,25 @@ def fluid_problem(case_dir, step):
             if not os.path.isfile(os.path.join(d, field)) or os.path.getsize(os.path.join(d, field)) == 0:
                 return "its field %s is missing or empty in %s" % (field, os.path.relpath(d, case_dir))
     return None
+
+
+def marker_processors(case_dir, step) -> tuple[int, str]:
+    """(the number of fluid ranks, the time directory) of fdmFoam's checkpoint of step."""
+    m = read_fluid_marker(fluid_marker(case_dir, step))
+    return int(m["processors"]), m["timeName"]
+
+
+def set_marker_processors(case_dir, step, processors: int) -> None:
+    """Rewrite the marker of step for its fields redistributed to `processors` fluid ranks (fdmRun --resume with
+    another -f: the fields of its time directory reconstructed and/or decomposed before), the rest as it was."""
+    path = fluid_marker(case_dir, step)
+    before = read_fluid_marker(path)
+    with open(path) as f:
+        lines = f.read().splitlines()
+    out = ["processors %d" % processors if line.split()[:1] == ["processors"] else line for line in lines]
+    out.insert(0, "# fdmRun --resume: the fields of %s/ redistributed from %s to %d fluid ranks"
+               % (before["timeName"], before["processors"], processors))
+    write_atomically(path, "\n".join(out) + "\n")
 
 
 def _marker_problem(case_dir, step):
@@ -925,6 +950,20 @@ def main(argv):
         try:
             print(set_last_step(argv[1], int(argv[2]), int(argv[3])))
         except CheckpointError as e:
+            print(e, file=sys.stderr)
+            return 1
+        return 0
+    if len(argv) == 3 and argv[0] == "processors":
+        try:
+            print("%d %s" % marker_processors(argv[1], int(argv[2])))
+        except CheckpointError as e:
+            print(e, file=sys.stderr)
+            return 1
+        return 0
+    if len(argv) == 4 and argv[0] == "set-processors":
+        try:
+            set_marker_processors(argv[1], int(argv[2]), int(argv[3]))
+        except (CheckpointError, OSError) as e:
             print(e, file=sys.stderr)
             return 1
         return 0
