@@ -374,6 +374,23 @@ def test_set_last_step_rewrites_only_the_run_command(tmp_path):
         checkpoint.set_last_step(path, 900, 830)
 
 
+def test_marker_rewritten_for_redistributed_fields_keeps_the_rest(tmp_path):
+    """After fdmRun --resume -f N has redistributed a checkpoint's fields, its marker says N ranks and
+    nothing else changes (the time, the step count, the scene's cells and particles)."""
+    (tmp_path / "fluid" / "checkpoint").mkdir(parents=True)
+    marker = tmp_path / "fluid" / "checkpoint" / "fluid.20"
+    marker.write_text("# fdmFoam checkpoint: U p lambda phi of this step in 1/ (binary; processor*/1/ in parallel)\n"
+                      "step 20\ntime 1.0000000000000002\ntimeIndex 20\ntimeName 1\nstepsDone 20\ncells 2304\n"
+                      "processors 1\nparticles 3\nregularOutput 0\nfromRest 0\nend\n")
+    before = checkpoint.read_fluid_marker(str(marker))
+    assert checkpoint.marker_processors(str(tmp_path), 20) == (1, "1")
+    checkpoint.set_marker_processors(str(tmp_path), 20, 4)
+    after = checkpoint.read_fluid_marker(str(marker))
+    assert after == dict(before, processors="4")
+    assert checkpoint.marker_processors(str(tmp_path), 20) == (4, "1")
+    assert "redistributed from 1 to 4 fluid ranks" in marker.read_text()
+
+
 def test_calibration_table_the_input_reads(tmp_path, monkeypatch):
     """checkpoint.calibration_table on input text (no codes run): the shipped table by default, the input's
     own `calibration FILE` (relative to the input), none with the cut-off model or the lubrication off."""
