@@ -603,6 +603,26 @@ def reference_every2(tmp_path_factory, env):
     return root
 
 
+def test_step_records_hold_the_runs_time(reference_every2):
+    """steps.dat's seconds of each fluid step (fluid solve, particle forcing, exchange) sum to the run's: a
+    step's exchange holds the wait for its particles, the particle steps between fluid steps included, so
+    that a run's wall time and a budget can be read from the records (fdmsubgrid.shear.run_seconds,
+    poiseuille.budget). Against fdmFoam's own breakdown at the end of the run."""
+    steps = output.steps(os.path.join(reference_every2, "fluid"))
+    log = open(os.path.join(reference_every2, "log.fluid")).read()
+    wall = float(re.search(r"fdmFoam time breakdown \(\d+ steps, \d+ inner iterations, ([0-9.eE+-]+) s wall\)", log).group(1))
+    parts = {name: float(re.search(r"^ +%s +([0-9.eE+-]+) s" % name, log, re.M).group(1))
+             for name in ("fluid solve", "particle forcing", "exchange \\+ DEM", "output", "checkpoints")}
+    exchange = float(np.sum(steps["exchangeSeconds"]))
+    # every wait for the particle code but the last (its end of run) is some step's
+    assert abs(exchange - parts["exchange \\+ DEM"]) < 0.01 * wall + 0.02, (exchange, parts)
+    recorded = float(np.sum(steps["fluidSeconds"]) + np.sum(steps["particleSeconds"])) + exchange
+    unrecorded = parts["output"] + parts["checkpoints"]
+    print("wall %.3f s; steps.dat exchange %.3f s against the breakdown's %.3f s; recorded %.3f s + output and "
+          "checkpoints %.3f s" % (wall, exchange, parts["exchange \\+ DEM"], recorded, unrecorded))
+    assert recorded + unrecorded > 0.95 * wall, (recorded, unrecorded, wall)
+
+
 def test_fluid_every_solves_the_fluid_on_its_steps(reference_every2, reference):
     """The fluid solves step 1 (nothing to hold yet), every second step and the checkpoints' steps
     (multiples of 5, and the last): 30 of 50; the trajectory stays within 3e-2 a of the run that

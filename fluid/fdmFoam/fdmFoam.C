@@ -139,6 +139,12 @@ int main(int argc, char *argv[])
     const double runStart = wallClock();
     // waiting for the particle code to connect is not part of the run
     const scalar exchangeBeforeRun = coupling.exchangeTime();
+    // where the last step's exchange ended: a step's exchange (steps.dat)
+    // begins there, so that it holds the wait for this step's particles too,
+    // i.e. the particle steps between fluid steps (fix fdm/couple fluid_every
+    // K) and the particle code's own step, and the records' seconds sum to
+    // the run's time
+    scalar exchangeMark = exchangeBeforeRun;
     List<fdmParticle> stepParticles;
 
     // The function objects of system/controlDict. fdmDEM drives time, so
@@ -169,7 +175,7 @@ int main(int argc, char *argv[])
         {
             sessionFirstStep = coupling.step();
         }
-        const scalar exchangeAtStart = coupling.exchangeTime();
+        const scalar exchangeAtStart = exchangeMark;
         scalar stepFluidTime = 0, stepParticleTime = 0;
 
         // Step 1: particles moved by the DEM side
@@ -338,6 +344,7 @@ int main(int argc, char *argv[])
             innerIteration, residual, converged, hydroForces, stresslets
         );
         const scalar stepExchangeTime = coupling.exchangeTime() - exchangeAtStart;
+        exchangeMark = coupling.exchangeTime();
 
         const double tOut = wallClock();
         #include "writeStepOutput.H"

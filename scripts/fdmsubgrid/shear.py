@@ -139,8 +139,10 @@ def read_run(run_dir: str) -> ShearRun:
 
 def run_seconds(run_dir: str, steps: dict | None = None) -> tuple[float, int]:
     """(wall seconds, ranks) of a run from its step records (the sum over sessions of a resumed run:
-    fluid solve + particle work + exchange of every step), ranks: fluid processor folders (or 1)
-    plus one particle rank. steps: the records (output.steps) if already read."""
+    fluid solve + particle work + exchange of every step, the exchange with the particle steps between
+    fluid steps; records written before 2026-11-30 left those out: docs/fluid.md, steps.dat), ranks:
+    fluid processor folders (or 1) plus one particle rank. steps: the records (output.steps) if already
+    read."""
     if steps is None:
         steps = output.steps(os.path.join(run_dir, "fluid"))
     seconds = float(np.sum(steps["fluidSeconds"]) + np.sum(steps["particleSeconds"]) + np.sum(steps["exchangeSeconds"]))
