@@ -953,20 +953,6 @@ def main(argv):
             print(e, file=sys.stderr)
             return 1
         return 0
-    if len(argv) == 3 and argv[0] == "processors":
-        try:
-            print("%d %s" % marker_processors(argv[1], int(argv[2])))
-        except CheckpointError as e:
-            print(e, file=sys.stderr)
-            return 1
-        return 0
-    if len(argv) == 4 and argv[0] == "set-processors":
-        try:
-            set_marker_processors(argv[1], int(argv[2]), int(argv[3]))
-        except (CheckpointError, OSError) as e:
-            print(e, file=sys.stderr)
-            return 1
-        return 0
     if len(argv) >= 3 and argv[0] in ("stamp", "check-stamp"):
         try:
             if argv[0] == "stamp":
@@ -978,6 +964,12 @@ def main(argv):
             return 1
         return 0
     try:
+        if len(argv) == 3 and argv[0] == "processors":
+            print("%d %s" % marker_processors(argv[1], int(argv[2])))
+            return 0
+        if len(argv) == 4 and argv[0] == "set-processors":
+            set_marker_processors(argv[1], int(argv[2]), int(argv[3]))
+            return 0
         if len(argv) >= 3 and argv[0] == "snapshot":
             options = dict(zip(argv[3::2], argv[4::2]))
             unknown = set(options) - {"--scene", "--dem-input"}
