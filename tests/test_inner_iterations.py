@@ -165,7 +165,7 @@ def test_relative_linear_solves_keep_the_answer(dense_channel):
     # point, so the step converges in as many fluid solves to velocities as close to the answer (measured
     # 2026-11-27 over 3 seeds with relTol U 0.3: 11.3 against 11.7 solves, error median 1.4e-3 against
     # 1.1e-3 of the wall speed, at half the time per step; docs/benchmarks.md "Linear solves inside the
-    # inner iteration"; the single sweep: "Direct solver for box meshes")
+    # inner iteration"; the single sweep: "The momentum predictor as one sweep")
     relative, absolute = dense_channel["Anderson damped"], dense_channel["Anderson damped, solves to tol_u, tol_p"]
     assert relative["converged"] and absolute["converged"]
     assert relative["solves"] <= absolute["solves"] + 2, (relative["solves"], absolute["solves"])

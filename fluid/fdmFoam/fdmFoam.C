@@ -175,7 +175,6 @@ int main(int argc, char *argv[])
         {
             sessionFirstStep = coupling.step();
         }
-        const scalar exchangeAtStart = exchangeMark;
         scalar stepFluidTime = 0, stepParticleTime = 0;
 
         // Step 1: particles moved by the DEM side
@@ -343,7 +342,7 @@ int main(int argc, char *argv[])
         (
             innerIteration, residual, converged, hydroForces, stresslets
         );
-        const scalar stepExchangeTime = coupling.exchangeTime() - exchangeAtStart;
+        const scalar stepExchangeTime = coupling.exchangeTime() - exchangeMark;
         exchangeMark = coupling.exchangeTime();
 
         const double tOut = wallClock();

@@ -161,7 +161,7 @@ def write_fluid_case(case_dir, box, nu=1.0, rho=1.0, grad_p0=(0, 0, 0), indicato
             raise ValueError("write_fluid_case: u_sweeps %r needs a whole number >= 1 and U solved by symGaussSeidel "
                              "(linear_solver %r solves it otherwise)" % (u_sweeps, linear_solver))
         # the residuals a smoothSolver computes before and after its sweeps cost as much as one sweep
-        # (docs/benchmarks.md, "Direct solver for box meshes": the momentum solve halved)
+        # (docs/benchmarks.md, "The momentum predictor as one sweep": the momentum solve halved)
         u_solver += ("\n        nSweeps         %d;         // fixed sweeps, no residual: tolerance and relTol unused"
                      % -int(u_sweeps))
     x0, y0, z0 = box.lo

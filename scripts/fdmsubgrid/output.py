@@ -470,7 +470,8 @@ def read_vtp(path: str) -> dict:
 def fluid_time_breakdown(text):
     """fdmFoam's "time breakdown" at the end of log.fluid as a dict: steps, inner_iterations, wall,
     and the seconds of fluid_solve, particle_forcing, exchange_dem (exchange + DEM: the messages and
-    the whole particle side while fdmFoam waits), output. None if absent."""
+    the whole particle side while fdmFoam waits), output, checkpoints (0 for a run without them). None if
+    absent."""
     import re
     m = re.search(r"fdmFoam time breakdown \((\d+) steps, (\d+) inner iterations, ([0-9.eE+-]+) s wall\):\s*"
                   r"fluid solve\s+([0-9.eE+-]+) s.*?particle forcing\s+([0-9.eE+-]+) s.*?"
@@ -478,8 +479,10 @@ def fluid_time_breakdown(text):
     if not m:
         return None
     g = m.groups()
+    checkpoints = re.match(r"\s*checkpoints\s+([0-9.eE+-]+) s", text[m.end():].split("\n", 1)[-1])
     return dict(steps=int(g[0]), inner_iterations=int(g[1]), wall=float(g[2]), fluid_solve=float(g[3]),
-                particle_forcing=float(g[4]), exchange_dem=float(g[5]), output=float(g[6]))
+                particle_forcing=float(g[4]), exchange_dem=float(g[5]), output=float(g[6]),
+                checkpoints=float(checkpoints.group(1)) if checkpoints else 0.0)
 
 
 def fluid_inner_profile(text):

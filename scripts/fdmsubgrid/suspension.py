@@ -53,8 +53,8 @@ FRICTION = 0.5                # mu_s (section 6)
 # about half the time per step (docs/benchmarks.md, "Linear solves inside the inner iteration").
 # The momentum predictor is one symGaussSeidel sweep with no residual computed (u_sweeps 1): relTol 0.3 was
 # met by one sweep in 94 % of its solves, and the residuals it computed cost as much as the sweep; the same
-# inner iterations and errors at half the momentum solve's time (docs/benchmarks.md, "Direct solver for
-# box meshes")
+# inner iterations and errors at half the momentum solve's time (docs/benchmarks.md, "The momentum
+# predictor as one sweep")
 LINEAR_SOLVE_REL_TOL = dict(u_rel_tol=0.3, u_sweeps=1, p_rel_tol=0.05, p_final_rel_tol=0.05)
 
 
