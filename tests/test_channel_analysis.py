@@ -81,6 +81,22 @@ def test_steady_window_starts_three_migration_times_in_and_finds_the_plateau_fla
     assert abs(w.trend.slope) <= poiseuille.SLOPE_SIGMAS * w.trend.slope_err
 
 
+def test_steady_window_spans_a_migration_time_at_least():
+    """A flat window from 3 tau that is shorter than tau (+ its error bar) cannot tell a slow rise from the
+    centre's swings: not steady until the series holds one more migration time, then steady."""
+    rng = np.random.default_rng(11)   # the series of the test above
+    t = np.arange(1500) * 0.4
+    pc = 0.6 - 0.13 * np.exp(-t / 50.0) + ar1(t.size, 0.004, 0.9, rng)
+    rms = 0.015 + 0.09 * np.exp(-t / 50.0) + ar1(t.size, 0.003, 0.9, rng)
+    short = t <= 3.5 * 50
+    w = poiseuille.steady_window(t[short], pc[short], rms[short])
+    assert not w.steady and "less than 1 migration time" in w.reason and "run longer" in w.reason, w.reason
+    assert w.start_time == pytest.approx(3 * w.center.tau, abs=0.2)
+    assert w.end_time - w.start_time < w.center.tau + w.center.tau_err
+    w = poiseuille.steady_window(t, pc, rms)
+    assert w.steady and w.end_time - w.start_time >= poiseuille.STEADY_WINDOW_TAUS * (w.center.tau + w.center.tau_err)
+
+
 def test_steady_window_is_not_fooled_by_a_stall_before_a_rise():
     """phi_center rises to 0.55, stalls from t 100 to 200, rises again to 0.60 by the end (t 300): MSER
     puts the start in the stall; steady_window says not steady (the run too short for its migration time,

@@ -86,4 +86,18 @@ def test_bad_rung_and_options_are_refused(tmp_path, env):
     refused = run([LADDER, "L20", "--until", "100", "--workdir", str(tmp_path)], env)
     assert refused.returncode == 2 and "--until 100: the committed snapshot" in refused.stderr
     assert "already" in refused.stderr
+    # --until-steady continues a run; its chunks are a positive number of steps
+    refused = run([LADDER, "L12", "--until-steady", "--workdir", str(tmp_path)], env)
+    assert refused.returncode == 2 and "--until-steady continues a run" in refused.stderr
+    refused = run([LADDER, "L20", "--until-steady", "--check-every", "0", "--workdir", str(tmp_path)], env)
+    assert refused.returncode == 2 and "--check-every takes a positive number of steps, got '0'" in refused.stderr
+    assert not os.listdir(tmp_path)
+
+
+def test_until_steady_stops_at_its_end_without_running(tmp_path, env):
+    """ladderRun --until-steady goes on in chunks to the rung's T or to --until: from the committed snapshot of
+    L20 (step 40000) an end before it is reached already, said so, and nothing is run or written."""
+    out = run([LADDER, "L20", "--until-steady", "--until", "39000", "--workdir", str(tmp_path)], env)
+    assert out.returncode == 0, out.stderr
+    assert "step 40000, the end (39000), reached before the run was steady" in out.stdout
     assert not os.listdir(tmp_path)

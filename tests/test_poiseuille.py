@@ -135,6 +135,28 @@ def test_steady_state_keys_of_a_short_run(small_run):
     assert 0 <= r["sbm_table8_phi_rms_diff"] < 0.2
 
 
+def test_steady_check_of_a_run_is_the_analysis_window(small_run, tmp_path, env):
+    """python3 -m fdmsubgrid.poiseuille steady, what ladderRun --until-steady asks between its chunks: on the
+    real records of the short run it finds the analysis's own window and verdict (not steady, the same reason)
+    and says so with exit status 1; its kept segments before the folder's first record are taken in; a run
+    folder without records is an error (status 2) that names it."""
+    from fdmsubgrid import poiseuille
+    w = poiseuille.steady_check(small_run["run_dir"])
+    assert w.steady is False and w.reason == small_run["steady_reason"]
+    assert w.start_time == pytest.approx(small_run["steady_from"], abs=1e-6)
+    assert w.end_time == pytest.approx(small_run["time"], abs=1e-6)
+    out = subprocess.run([sys.executable, "-m", "fdmsubgrid.poiseuille", "steady", small_run["run_dir"]], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert out.returncode == 1 and "not steady: " + w.reason in out.stdout
+    # a kept segment of the same records: the folder's own are not counted twice
+    poiseuille.write_segment(small_run["run_dir"], str(tmp_path / "segments"))
+    again = poiseuille.steady_check(small_run["run_dir"], poiseuille.read_segments(str(tmp_path / "segments")))
+    assert again.start_time == w.start_time and again.reason == w.reason
+    out = subprocess.run([sys.executable, "-m", "fdmsubgrid.poiseuille", "steady", str(tmp_path / "none")], env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert out.returncode == 2 and str(tmp_path / "none") in out.stderr
+
+
 def test_fluid_shear_stress_of_the_newtonian_parabola():
     """The Newtonian channel u = 4 U_c y (L - y)/L^2 sampled at 36 cell centres: eta du/dy on the faces
     and averaged over bins of a1 equals the exact (dP0/dx)(y - L/2) (to O(Delta^2) at the walls,

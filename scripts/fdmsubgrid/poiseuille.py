@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import output, packing, profiles, rheology, sbm, shear, suspension, timeseries
 # the steady window (re-exported: the channel's analysis is where users meet them)
-from .steadystate import (MIN_SNAPSHOTS, STEADY_AFTER_TAUS, SLOPE_SIGMAS, Approach, SteadyWindow, Trend, fit_approach,  # noqa: F401
+from .steadystate import (MIN_SNAPSHOTS, STEADY_AFTER_TAUS, STEADY_WINDOW_TAUS, SLOPE_SIGMAS, Approach, SteadyWindow, Trend, fit_approach,  # noqa: F401
                           profile_change, steady_window, trend)
 
 CENTRAL_HALF_WIDTH = 1.0        # a1: the central slab of the migration series
@@ -792,10 +792,9 @@ def centre_and_wall_series(snapshots: list, channel: profiles.Channel) -> tuple[
     return centre, walls
 
 
-def migration_series(run_dir: str) -> dict:
-    """The migration as the run's records hold it, small enough to keep beside a compact snapshot when the
-    run folder may be lost (a long run in segments, cases/poiseuille/paperRun): per record its time (in
-    L_y/(2U_c)), phi in the central slab |y - mid| < a1 and in the wall layers, and phi(y) in bins of a1."""
+def _record_series(run_dir: str) -> dict:
+    """Per record of the run: its time (in L_y/(2U_c)), phi in the central slab and in the wall layers
+    (centre_and_wall_series), phi(y) in bins of a1 (arrays; y the bins' centres)."""
     run = shear.read_run(run_dir)
     sc = scales(run)
     channel = run.channel
@@ -804,12 +803,39 @@ def migration_series(run_dir: str) -> dict:
         raise PoiseuilleRunError("%s/dem/particles.records: no record yet" % run_dir)
     phi_center, phi_walls = centre_and_wall_series(snapshots, channel)
     phi_y = [profiles.profiles_in_bins(s, channel) for s in snapshots]
+    return dict(time=np.array([s.time for s in snapshots], dtype=float), phi_center=phi_center,
+                phi_wall_layer=phi_walls, y=phi_y[0].y, phi_profile=[p.phi for p in phi_y])
+
+
+def migration_series(run_dir: str) -> dict:
+    """The migration as the run's records hold it, small enough to keep beside a compact snapshot when the
+    run folder may be lost (a long run in segments, cases/poiseuille/paperRun): per record its time (in
+    L_y/(2U_c)), phi in the central slab |y - mid| < a1 and in the wall layers, and phi(y) in bins of a1."""
+    series = _record_series(run_dir)
     return dict(
-        time=[round(float(s.time), 6) for s in snapshots],
-        phi_center=[round(float(v), 5) for v in phi_center],
-        phi_wall_layer=[round(float(v), 5) for v in phi_walls],
-        y=[round(float(v), 6) for v in phi_y[0].y],
-        phi_profile=[[round(float(v), 5) for v in p.phi] for p in phi_y])
+        time=[round(float(v), 6) for v in series["time"]],
+        phi_center=[round(float(v), 5) for v in series["phi_center"]],
+        phi_wall_layer=[round(float(v), 5) for v in series["phi_wall_layer"]],
+        y=[round(float(v), 6) for v in series["y"]],
+        phi_profile=[[round(float(v), 5) for v in p] for p in series["phi_profile"]])
+
+
+def steady_check(run_dir: str, segments: Sequence[dict] = ()) -> SteadyWindow:
+    """The steady window of a run as it stands (steady_window on its migration series, the kept segments
+    before its first record included, as analyse() finds it) without the profiles' averages, the momentum
+    balance or the SBM: what a run that goes on until it is steady (cases/poiseuille/ladderRun --until-steady)
+    asks between its chunks."""
+    own = _record_series(run_dir)
+    before = earlier_series(segments, float(own["time"][0]))
+    if before["y"] is not None and len(before["y"]) != len(own["y"]):
+        raise PoiseuilleRunError("the kept segments have profiles in %d bins, %s in %d: not this channel"
+                                 % (len(before["y"]), run_dir, len(own["y"])))
+    times = np.concatenate([before["time"], own["time"]])
+    if len(times) < MIN_SNAPSHOTS:
+        raise PoiseuilleRunError("%s: %d records are too few for a steady window (%d at least): run longer"
+                                 % (run_dir, len(times), MIN_SNAPSHOTS))
+    rms_change, _ = profile_change(list(before["phi_profile"]) + own["phi_profile"])
+    return steady_window(times, np.concatenate([before["phi_center"], own["phi_center"]]), rms_change)
 
 
 def write_segment(run_dir: str, folder: str) -> str:
@@ -856,6 +882,9 @@ def _series_of(path: str) -> dict:
 
 USAGE = """usage: python3 -m fdmsubgrid.poiseuille series RUN_DIR FOLDER
   the migration series of the run's records into FOLDER/segment_<t0>_<t1>.json
+       python3 -m fdmsubgrid.poiseuille steady RUN_DIR [SEGMENTS]
+  whether the run as it stands is steady (steady_check; SEGMENTS: the folder of its kept segments): the
+  verdict on one line, exit status 0 if steady, 1 if not yet, 2 if it cannot say
        python3 -m fdmsubgrid.poiseuille arrival LEVELS TIMES SOURCE...
   per SOURCE (an analysed run's results.json, or a folder of segments) phi_center averaged over +-25 time units
   at the comma-separated TIMES and the first time it reaches each of the comma-separated LEVELS"""
@@ -865,6 +894,17 @@ if __name__ == "__main__":
     import sys
     if len(sys.argv) == 4 and sys.argv[1] == "series":
         print(write_segment(sys.argv[2], sys.argv[3]))
+    elif len(sys.argv) in (3, 4) and sys.argv[1] == "steady":
+        try:
+            w = steady_check(sys.argv[2], read_segments(sys.argv[3]) if len(sys.argv) == 4 else ())
+        except (PoiseuilleRunError, OSError) as e:
+            print("fdmsubgrid.poiseuille steady: %s" % e, file=sys.stderr)
+            sys.exit(2)
+        print("%s at t %.6g: migration time %.4g +- %.2g; %s" % (
+            sys.argv[2], w.end_time, w.center.tau, w.center.tau_err,
+            "steady from t %.6g (phi_center's slope %.3g +- %.3g per time unit over the window)"
+            % (w.start_time, w.trend.slope, w.trend.slope_err) if w.steady else "not steady: " + w.reason))
+        sys.exit(0 if w.steady else 1)
     elif len(sys.argv) >= 5 and sys.argv[1] == "arrival":
         try:
             levels = [float(v) for v in sys.argv[2].split(",")]

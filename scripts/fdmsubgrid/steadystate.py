@@ -17,6 +17,8 @@ from . import timeseries
 STEADY_AFTER_TAUS = 3.0   # the window starts 3 time constants after the first sample: e^-3 = 5 % of the rise left
 MIN_SNAPSHOTS = 8         # the fewest samples a fit or a window takes
 SLOPE_SIGMAS = 2.0        # a series has stopped rising when its slope over the window is below 2 error bars
+STEADY_WINDOW_TAUS = 1.0  # and the window spans one time constant (at its upper error bar) at least: a shorter
+                          # one cannot tell a slow rise from the centre's swings (L_y 12 a1: 73 time units at 3 tau)
 
 
 def _inefficiency(residuals: NDArray) -> float:
@@ -119,13 +121,15 @@ def trend(times: ArrayLike, x: ArrayLike) -> Trend:
 
 @dataclass(frozen=True)
 class SteadyWindow:
-    """The steady window of a channel run found from its data (steady_window): start index and time, the
-    approaches fitted to phi_center(t) and to the profile's rms change, the trend of phi_center over the
-    window; steady True when both fits succeeded, the window holds MIN_SNAPSHOTS and phi_center's slope
-    there is within SLOPE_SIGMAS error bars of zero. reason: why not, else ''."""
+    """The steady window of a channel run found from its data (steady_window): start index and time, its end,
+    the approaches fitted to phi_center(t) and to the profile's rms change, the trend of phi_center over the
+    window; steady True when both fits succeeded, the window holds MIN_SNAPSHOTS, spans STEADY_WINDOW_TAUS
+    time constants (tau + its error bar) and phi_center's slope there is within SLOPE_SIGMAS error bars of zero.
+    reason: why not, else ''."""
 
     start: int
     start_time: float
+    end_time: float
     center: Approach
     profile: Approach
     trend: Trend
@@ -141,8 +145,9 @@ def steady_window(times: ArrayLike, phi_center: ArrayLike, rms_change: ArrayLike
     beyond SLOPE_SIGMAS error bars). The approach of the profile's rms change to its floor (>= 0) is
     fitted too and reported. MSER's start (on phi_center) is reported beside it: it can stop at a stall
     before a further rise. Not steady (reason given) when the fit fails, when the run ends before
-    after_taus migration times with MIN_SNAPSHOTS to spare, or when the trend is significant; the window
-    is then the later of MSER's start and the run's second half (averages of the latest part)."""
+    after_taus migration times with MIN_SNAPSHOTS to spare (the window is then the later of MSER's start and
+    the run's second half: averages of the latest part), when the window from after_taus on spans less than
+    STEADY_WINDOW_TAUS migration times (tau + tau_err), or when the trend is significant."""
     t = np.asarray(times, dtype=float)
     pc = np.asarray(phi_center, dtype=float)
     center, prof = fit_approach(t, pc), fit_approach(t, rms_change, plateau_min=0.0)
@@ -158,10 +163,14 @@ def steady_window(times: ArrayLike, phi_center: ArrayLike, rms_change: ArrayLike
             reason = ("the run ends %.4g after its first snapshot, before %g migration times (%.4g +- %.2g): run longer"
                       % (t[-1] - t[0], after_taus, after_taus * center.tau, after_taus * center.tau_err))
             start = fallback
+        elif t[-1] - t[start] < STEADY_WINDOW_TAUS * (center.tau + center.tau_err):
+            reason = ("the window from %g migration times holds %.4g time units, less than %g migration time%s "
+                      "(%.4g + %.2g): run longer" % (after_taus, t[-1] - t[start], STEADY_WINDOW_TAUS,
+                                                   "" if STEADY_WINDOW_TAUS == 1 else "s", center.tau, center.tau_err))
     start = min(start, max(0, len(t) - MIN_SNAPSHOTS))
     tr = trend(t[start:], pc[start:])
     if not reason and abs(tr.slope) > SLOPE_SIGMAS * tr.slope_err:
         reason = ("phi_center %s over the window (slope %.3g +- %.3g per time unit, a change of %.3g): not steady"
                   % ("still rises" if tr.slope > 0 else "falls", tr.slope, tr.slope_err, tr.change))
-    return SteadyWindow(start=start, start_time=float(t[start]), center=center, profile=prof, trend=tr,
-                        mser_start_time=float(mser), steady=not reason, reason=reason)
+    return SteadyWindow(start=start, start_time=float(t[start]), end_time=float(t[-1]), center=center, profile=prof,
+                        trend=tr, mser_start_time=float(mser), steady=not reason, reason=reason)
