@@ -295,6 +295,8 @@ def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, re
     resumed run's setup, had it re-applied the contact law to the restored tangential spring, would
     have moved it by an ulp (the records then left the uninterrupted run's by 4e-13 of the positions)."""
     root = make_scene(str(tmp_path), steps=32)
+    env = dict(env, FDM_LOAD_EVERY="1")
+    started = time.time()
     r = fdm_run(root, env)
     assert r.returncode == 0, r.stdout
     assert steps_done(root) == 32
@@ -308,6 +310,21 @@ def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, re
     assert "run             %d upto" % STEPS in open(os.path.join(root, "dem", "in.couette")).read()
     assert "resume from step 32, to step 50 (--until; the input ran to 50)" in open(os.path.join(root, "log.fluid")).read()
     assert_same_run(root, reference)
+    # log.load: one segment per fdmRun, the refused resume one without steps, each sampled while it ran
+    segments = output.run_segments(root)
+    assert [(s.kind, s.first_step, s.last_step) for s in segments] == [("start", 0, 32), ("resume", 32, 32),
+                                                                       ("resume", 32, 50)]
+    assert all(started <= s.start <= s.end <= time.time() for s in segments)
+    assert sum(s.wall_seconds for s in segments) <= time.time() - started
+    assert segments[0].samples >= 2 and all(s.load_mean >= 0 for s in segments)
+    assert "3 segments, 50 particle steps" in output.segments_table(segments)
+
+
+def test_bad_load_sampling_interval_is_refused_before_anything_runs(tmp_path, env):
+    root = make_scene(str(tmp_path))
+    r = fdm_run(root, dict(env, FDM_LOAD_EVERY="0"))
+    assert r.returncode == 2 and "FDM_LOAD_EVERY takes a positive number of seconds, got '0'" in r.stdout, r.stdout
+    assert not os.path.exists(os.path.join(root, "log.fluid")) and not os.path.exists(os.path.join(root, "log.load"))
 
 
 def test_resumed_on_another_number_of_fluid_ranks_continues_the_run(tmp_path, env, reference):

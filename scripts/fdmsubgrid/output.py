@@ -523,3 +523,102 @@ def dem_time_breakdown(text):
     for name, seconds in re.findall(r"^(Pair|Neigh|Comm|Outpt|Modify|Other)\s+time \(%\) = ([0-9.eE+-]+)", text, re.M):
         out["sections"][name] = float(seconds)
     return out
+
+
+# ------------------------------------------------------------------------------------------------
+# The segments of a run and the machine's load while they ran (log.load, written by fdmRun)
+# ------------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Segment:
+    """One fdmRun of a run (a start, a resume or a continuation of a compact snapshot): its kind, the particle
+    steps it went from and to, its wall time from launch to its last sample (the end of a run that ended, within
+    one sample interval of the kill of one that did not) and the 1-minute load averages sampled while it ran
+    (mean and largest; nan where the machine has no /proc/loadavg)."""
+
+    kind: str
+    first_step: int
+    last_step: int
+    start: float
+    end: float
+    load_mean: float
+    load_max: float
+    samples: int
+
+    @property
+    def wall_seconds(self) -> float:
+        return self.end - self.start
+
+    @property
+    def steps(self) -> int:
+        return self.last_step - self.first_step
+
+
+def run_segments(case_dir: str) -> list[Segment]:
+    """The segments of the run in case_dir from its log.load (fdmRun: a '# segment KIND from step N' line per
+    fdmRun, then 'epoch load1 load5 load15 step' samples). A run of a build before log.load has none: ValueError
+    naming the file."""
+    path = os.path.join(case_dir, "log.load")
+    if not os.path.isfile(path):
+        raise ValueError("%s: no such file (fdmRun writes it since 2026-11-30; a run started before has its segments "
+                         "only in log.fluid's '==== fdmRun' lines)" % path)
+    segments: list[Segment] = []
+    kind, first, rows = "", 0, []
+
+    def close() -> None:
+        if kind and rows:
+            loads = np.array([r[1] for r in rows])
+            finite = loads[np.isfinite(loads)]
+            segments.append(Segment(kind=kind, first_step=first, last_step=int(max(r[2] for r in rows)),
+                                    start=rows[0][0], end=rows[-1][0],
+                                    load_mean=float(finite.mean()) if finite.size else float("nan"),
+                                    load_max=float(finite.max()) if finite.size else float("nan"), samples=len(rows)))
+
+    with open(path) as f:
+        for number, line in enumerate(f, 1):
+            words = line.split()
+            if not words:
+                continue
+            if words[0] == "#":
+                if len(words) != 6 or words[1] != "segment" or words[3:5] != ["from", "step"]:
+                    raise ValueError("%s:%d: not a segment line: %r" % (path, number, line.strip()))
+                close()
+                kind, first, rows = words[2], int(words[5]), []
+            else:
+                if len(words) != 5 or not kind:
+                    raise ValueError("%s:%d: not a sample 'epoch load1 load5 load15 step': %r" % (path, number, line.strip()))
+                rows.append((float(words[0]), float(words[1]), int(words[4])))
+    close()
+    return segments
+
+
+def segments_table(segments: list[Segment]) -> str:
+    """The segments as a table, with the total wall time and the mean load weighted by the segments' wall times."""
+    import time
+    lines = ["%-8s %-19s %9s %9s %10s %6s %6s" % ("segment", "started (UTC)", "from step", "to step", "wall / h",
+                                                 "load", "max")]
+    for s in segments:
+        lines.append("%-8s %-19s %9d %9d %10.3f %6.2f %6.2f" % (
+            s.kind, time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime(s.start)), s.first_step, s.last_step,
+            s.wall_seconds / 3600, s.load_mean, s.load_max))
+    wall = sum(s.wall_seconds for s in segments)
+    # a killed segment's steps after its last checkpoint are run again by the next one: the run's steps
+    # are from the first segment's start to the last one's end
+    steps = segments[-1].last_step - segments[0].first_step if segments else 0
+    weights = [(s.load_mean, s.wall_seconds) for s in segments if np.isfinite(s.load_mean) and s.wall_seconds > 0]
+    load = sum(a * w for a, w in weights) / sum(w for _, w in weights) if weights else float("nan")
+    lines.append("total: %d segments, %d particle steps, %.3f h of wall time at a mean load of %.2f"
+                 % (len(segments), steps, wall / 3600, load))
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    import sys
+    if len(sys.argv) == 3 and sys.argv[1] == "segments":
+        try:
+            print(segments_table(run_segments(sys.argv[2])))
+        except ValueError as e:
+            sys.exit("fdmsubgrid.output segments: %s" % e)
+    else:
+        sys.exit("usage: python3 -m fdmsubgrid.output segments CASE_DIR\n"
+                 "  the run's segments (fdmRun's log.load): when each ran, its steps, wall time and load")
