@@ -293,6 +293,26 @@ def test_required_duration_scales_the_ladders_migration_time(case_module, capsys
     assert "a channel of L_y = 40 a1 needs about" in capsys.readouterr().out
 
 
+def test_ladder_sets_the_rungs_side_by_side(case_module, tmp_path, capsys):
+    """--ladder: the analysed rungs (docs/data) sorted by L_y, each as its results say it (phi_center, the
+    plateau, the migration time with their error bars), the run started near the SBM's profile told apart by
+    its folder's name; the figure written beside --out; a results file without the ladder's keys refused."""
+    data = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "docs", "data")
+    paths = [os.path.join(data, "validation_poiseuille_%s.json" % n) for n in ("ladder20_startSbm", "ladder20", "ladder12")]
+    out = case_module.main(["--ladder"] + paths + ["--out", str(tmp_path / "results.json")])
+    rows = out["rows"]
+    assert [(r["width"], r["start"]) for r in rows] == [(12.0, "uniform"), (20.0, "sbm"), (20.0, "uniform")]
+    for row, path in zip(rows, [paths[2], paths[0], paths[1]]):
+        r = json.load(open(path))["data"]
+        assert row["phi_center"] == r["phi_center"] and row["phi_center_err"] == r["phi_center_err"]
+        assert row["plateau_width"] == r["plateau_width_over_a1"] and row["migration_time"] == r["migration_time"]
+        assert row["steady"] == r["steady_detected"] and row["time"] == r["time"]
+    assert os.path.getsize(out["figure"]) > 10000 and os.path.dirname(out["figure"]) == str(tmp_path)
+    assert "20x20x10   sbm" in capsys.readouterr().out
+    with pytest.raises(poiseuille.PoiseuilleRunError, match="lack migration_time"):
+        poiseuille.ladder_table([dict(L=[12, 12, 8], phi_center=0.5, plateau_width_over_a1=0, time=10)])
+
+
 def test_budget_predicts_the_run_it_was_measured_on(case_module, small_run):
     """--budget: the fluid steps a duration needs at the run's own fluid step, and its wall time from the
     median step after the cold first one; predicted for the small run's own duration, it is that run's

@@ -115,6 +115,10 @@ def main(argv: list[str] | None = None) -> dict:
                         "and a window as long again, from the migration times of analysed ladder runs (their "
                         "results.json; tau grows as L_y^2: poiseuille.required_duration), and exit; with --budget "
                         "RUN_DIR also its wall time")
+    p.add_argument("--ladder", metavar="RESULTS", nargs="+", default=None,
+                   help="the ladder of channel sizes side by side from analysed runs (their results.json): a table "
+                        "of phi_center, the central plateau and the migration time against L_y with their error "
+                        "bars, and its figure (ladder_poiseuille.png beside --out), and exit")
     p.add_argument("--start", choices=START_PROFILES, default=START_PROFILES[0],
                    help="how the spheres are spread across the channel at the start: uniform (the paper's), or "
                         "near a steady state to shorten the migration: sbm, the Suspension Balance Model's steady "
@@ -143,6 +147,26 @@ def main(argv: list[str] | None = None) -> dict:
     material = sbm.from_couette_results(args.couette) if args.couette else None
     table8 = table8_material(args.table8)
 
+    if args.ladder:
+        try:
+            rows = poiseuille.ladder_table([read_data(path) for path in args.ladder])
+        except (OSError, KeyError, ValueError) as e:
+            p.error("--ladder: %s" % e)
+        print("%-10s %-8s %7s %-17s %-15s %-17s %-15s %s" % ("L / a1", "start", "T", "phi_center", "plateau / a1",
+                                                            "plateau phi", "tau", "steady"))
+        for r in rows:
+            print("%-10s %-8s %7.0f %-17s %-15s %-17s %-15s %s" % (
+                "x".join("%g" % v for v in r["L"]), r["start"], r["time"],
+                "%.3f +- %.3f" % (r["phi_center"], r["phi_center_err"]),
+                "%.1f +- %.1f" % (r["plateau_width"], r["plateau_width_err"]),
+                "%.3f +- %.3f" % (r["plateau_phi"], r["plateau_phi_err"]),
+                "%.0f +- %.0f" % (r["migration_time"], r["migration_time_err"]),
+                "from %.0f" % r["steady_from"] if r["steady"] else "no"))
+        folder = os.path.dirname(os.path.abspath(args.out))
+        os.makedirs(folder, exist_ok=True)
+        figure = poiseuille.plot_ladder(os.path.join(folder, "ladder_poiseuille.png"), rows)
+        print("wrote %s" % figure)
+        return dict(rows=rows, figure=figure)
     if args.required_duration:
         try:
             rungs = [read_data(path) for path in args.required_duration]

@@ -226,6 +226,84 @@ def required_duration(rungs: Sequence[dict], width: float, window_taus: float = 
                 duration=taus * c * width ** 2, duration_err=taus * c_err * width ** 2)
 
 
+# The paper's central plateau in its 40 x 40 x 20 a1 channel (section 6.2, Fig. 23): phi about 0.63 over about 6 a1
+PAPER_PLATEAU_PHI = 0.63
+PAPER_PLATEAU_WIDTH = 6.0
+
+
+def ladder_table(rungs: Sequence[dict]) -> list[dict]:
+    """The ladder of channel sizes side by side: per analysed run (the `data` of its results.json), sorted by
+    L_y, what the size changes, each with its error bar: phi_center, the central plateau (its width above the
+    run's plateau threshold and its phi), the migration time, u_p* at the centre, whether and from when it is
+    steady, how far it ran and its wall time. `start` is 'sbm' for a run started near the SBM's profile
+    (poiseuille.py --start sbm: its run folder's name holds 'startSbm'), whose migration time is that of the
+    last approach, not of the migration from a uniform start, else 'uniform'."""
+    rows = []
+    for r in rungs:
+        missing = [k for k in ("L", "phi_center", "migration_time", "plateau_width_over_a1", "time") if k not in r]
+        if missing:
+            raise PoiseuilleRunError("a ladder rung's results lack %s (%s): analyse the run again"
+                                     % (", ".join(missing), r.get("run_dir", "?")))
+        rows.append(dict(
+            width=float(r["L"][1]), L=[float(v) for v in r["L"]], n_particles=r.get("n_particles"),
+            start="sbm" if "startSbm" in os.path.basename(str(r.get("run_dir", "")).rstrip("/")) else "uniform",
+            time=float(r["time"]), steady=bool(r.get("steady_detected")), steady_from=r.get("steady_from"),
+            phi_center=float(r["phi_center"]), phi_center_err=_number(r.get("phi_center_err")),
+            plateau_threshold=float(r.get("plateau_threshold", PLATEAU_THRESHOLD)),
+            plateau_width=float(r["plateau_width_over_a1"]), plateau_width_err=_number(r.get("plateau_width_over_a1_err")),
+            plateau_phi=_number(r.get("plateau_phi")), plateau_phi_err=_number(r.get("plateau_phi_err")),
+            migration_time=_number(r["migration_time"]), migration_time_err=_number(r.get("migration_time_err")),
+            u_center_star=_number(r.get("u_center_star")), wall_seconds=_number(r.get("wall_seconds")),
+            core_seconds=_number(r.get("core_seconds"))))
+    return sorted(rows, key=lambda row: (row["width"], row["start"]))
+
+
+def _number(value) -> float:
+    return math.nan if value is None else float(value)
+
+
+def plot_ladder(path: str, rows: Sequence[dict]) -> str:
+    """The ladder's figure: phi_center, the central plateau's width and the migration time against L_y, with
+    their error bars; the paper's plateau (phi 0.63 over about 6 a1) marked; tau = c L_y^2 fitted through the
+    uniform starts (required_duration); runs started near the SBM's profile drawn open."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(13, 4))
+    axes = fig.subplots(1, 3)
+    thresholds = sorted({r["plateau_threshold"] for r in rows})
+    panels = (("phi_center", "phi at the centre (|y| < a1)", PAPER_PLATEAU_PHI),
+              ("plateau_width", "central plateau width / a1 (phi >= %s)" % " or ".join("%g" % v for v in thresholds),
+               PAPER_PLATEAU_WIDTH),
+              ("migration_time", "migration time tau (L_y/(2U_c))", None))
+    for ax, (key, label, paper) in zip(axes, panels):
+        for start, marker, face in (("uniform", "o", None), ("sbm", "s", "none")):
+            sel = [r for r in rows if r["start"] == start and math.isfinite(r[key])]
+            if sel:
+                ax.errorbar([r["width"] for r in sel], [r[key] for r in sel],
+                            yerr=[0 if not math.isfinite(r[key + "_err"]) else r[key + "_err"] for r in sel],
+                            fmt=marker, mfc=face, capsize=3,
+                            label="uniform start" if start == "uniform" else "started near the SBM profile")
+        if paper is not None:
+            ax.axhline(paper, color="k", lw=0.8, ls=":", label="the paper's 40 a1 channel")
+        ax.set_xlabel("L_y / a1")
+        ax.set_ylabel(label)
+        ax.legend(fontsize=7)
+    uniform = [dict(L=r["L"], migration_time=r["migration_time"], migration_time_err=r["migration_time_err"])
+               for r in rows if r["start"] == "uniform" and math.isfinite(r["migration_time"])
+               and math.isfinite(r["migration_time_err"]) and r["migration_time_err"] > 0]
+    if uniform:
+        fit = required_duration(uniform, 1.0)
+        widths = np.linspace(0, 1.05 * max(r["width"] for r in rows), 50)
+        axes[2].plot(widths, fit["c"] * widths ** 2, "k-", lw=0.8,
+                     label="tau = %.3g L_y^2 (uniform starts)" % fit["c"])
+        axes[2].legend(fontsize=7)
+    fig.suptitle("The ladder of channel sizes (phi_bulk 0.45)")
+    fig.tight_layout(rect=(0, 0, 1, 0.94))
+    fig.savefig(path, dpi=110)
+    return path
+
+
 def flow_rate(run_dir: str) -> tuple[NDArray, NDArray]:
     """The bulk velocity of the channel at every fluid step: times (in L_y/(2 U_c)) and the mean of U_x
     over the whole box (fluid and particle interiors, fdmFoam's steps.dat) over 2 U_c, the Newtonian
