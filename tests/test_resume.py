@@ -318,6 +318,19 @@ def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, re
     assert sum(s.wall_seconds for s in segments) <= time.time() - started
     assert segments[0].samples >= 2 and all(s.load_mean >= 0 for s in segments)
     assert "3 segments, 50 particle steps" in output.segments_table(segments)
+    # the same segments from log.fluid's ETA alone (a run made before log.load): the same steps, each wall
+    # time within its start-up and last sample of log.load's
+    from_eta = output.segments_from_fluid_log(root, 32)
+    assert [(s.kind, s.first_step, s.last_step) for s in from_eta] == [(s.kind, s.first_step, s.last_step)
+                                                                      for s in segments]
+    for eta, load in zip(from_eta, segments):
+        assert eta.from_eta and 0 <= eta.wall_seconds <= load.wall_seconds + 1.0
+    assert from_eta[0].wall_seconds > 0.3 * segments[0].wall_seconds and from_eta[1].wall_seconds == 0
+    os.remove(os.path.join(root, "log.load"))
+    older = output.measured_segments(root, 32)
+    assert [(s.first_step, s.last_step, s.wall_seconds) for s in older] == [(s.first_step, s.last_step, s.wall_seconds)
+                                                                            for s in from_eta]
+    assert "(*: 3 segments made before log.load" in output.segments_table(older)
 
 
 def test_bad_load_sampling_interval_is_refused_before_anything_runs(tmp_path, env):

@@ -544,6 +544,7 @@ class Segment:
     load_mean: float
     load_max: float
     samples: int
+    from_eta: bool = False    # its wall time from fdmFoam's ETA (segments_from_fluid_log), not from log.load
 
     @property
     def wall_seconds(self) -> float:
@@ -592,6 +593,68 @@ def run_segments(case_dir: str) -> list[Segment]:
     return segments
 
 
+def segments_from_fluid_log(case_dir: str, planned_last_step: int) -> list[Segment]:
+    """The segments of a run as its log.fluid holds them, for a run made (in part) before log.load: one per
+    fdmRun ('==== fdmRun --resume from step N[, to step L ...]' lines; the first, a start, has none), its wall
+    time from the last progress line's ETA, which fdmFoam computes as remaining x elapsed / steps done in the
+    segment (elapsed = ETA x (step - first + 1) / (last - step), fdmFoam.C), so it leaves out the segment's
+    start-up before fdmFoam's first step and what ran after its last progress line. planned_last_step: where the
+    run was to end when a segment without 'to step L' ran (its input's 'run N upto'). No load is known (nan);
+    start and end are seconds from the segment's own start; a segment that reached no progress line (refused)
+    has none."""
+    import re
+    path = os.path.join(case_dir, "log.fluid")
+    segments: list[Segment] = []
+    current: dict | None = None
+
+    def close() -> None:
+        if current:
+            segments.append(Segment(kind=current["kind"], first_step=current["first"],
+                                    last_step=current["first"] if current["step"] is None else current["step"],
+                                    start=0.0, end=current["elapsed"], load_mean=float("nan"),
+                                    load_max=float("nan"), samples=0, from_eta=True))
+
+    with open(path, errors="replace") as f:
+        for line in f:
+            if line.startswith("===="):
+                m = re.match(r"==== fdmRun --(resume|from-snapshot) (?:\S+: )?(?:from )?step (\d+)(?:,? to (?:step )?(\d+))?",
+                             line)
+                if m:
+                    close()
+                    current = dict(kind="resume" if m.group(1) == "resume" else "snapshot", first=int(m.group(2)),
+                                   last=int(m.group(3)) if m.group(3) else planned_last_step, first_fluid=None,
+                                   step=None, elapsed=0.0)
+                continue
+            if line.startswith("Step "):
+                m = re.match(r"Step (\d+) .*\| ETA ([0-9.eE+-]+) s", line)
+                if not m:
+                    continue
+                if current is None:
+                    current = dict(kind="start", first=0, last=planned_last_step, first_fluid=None, step=None,
+                                   elapsed=0.0)
+                step, eta = int(m.group(1)), float(m.group(2))
+                if current["first_fluid"] is None:
+                    current["first_fluid"] = step
+                remaining = current["last"] - step
+                if remaining > 0:
+                    current["elapsed"] = eta * (step - current["first_fluid"] + 1) / remaining
+                current["step"] = step
+    close()
+    return segments
+
+
+def measured_segments(case_dir: str, planned_last_step: int | None = None) -> list[Segment]:
+    """Every segment of a run: those log.load holds (run_segments) and, before them, those of a run made in
+    part before log.load, from log.fluid's ETA (segments_from_fluid_log; planned_last_step needed then)."""
+    load = run_segments(case_dir) if os.path.isfile(os.path.join(case_dir, "log.load")) else []
+    if planned_last_step is None:
+        return load if load else run_segments(case_dir)
+    older = segments_from_fluid_log(case_dir, planned_last_step)
+    if len(older) < len(load):
+        raise ValueError("%s: log.load holds %d segments, log.fluid %d: not one run's logs" % (case_dir, len(load), len(older)))
+    return older[:len(older) - len(load)] + load
+
+
 def segments_table(segments: list[Segment]) -> str:
     """The segments as a table, with the total wall time and the mean load weighted by the segments' wall times."""
     import time
@@ -599,8 +662,9 @@ def segments_table(segments: list[Segment]) -> str:
                                                  "load", "max")]
     for s in segments:
         lines.append("%-8s %-19s %9d %9d %10.3f %6.2f %6.2f" % (
-            s.kind, time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime(s.start)), s.first_step, s.last_step,
-            s.wall_seconds / 3600, s.load_mean, s.load_max))
+            s.kind + ("*" if s.from_eta else ""),
+            "(from the ETA)" if s.from_eta else time.strftime("%Y-%m-%d %H:%M:%S", time.gmtime(s.start)),
+            s.first_step, s.last_step, s.wall_seconds / 3600, s.load_mean, s.load_max))
     wall = sum(s.wall_seconds for s in segments)
     # a killed segment's steps after its last checkpoint are run again by the next one: the run's steps
     # are from the first segment's start to the last one's end
@@ -609,16 +673,22 @@ def segments_table(segments: list[Segment]) -> str:
     load = sum(a * w for a, w in weights) / sum(w for _, w in weights) if weights else float("nan")
     lines.append("total: %d segments, %d particle steps, %.3f h of wall time at a mean load of %.2f"
                  % (len(segments), steps, wall / 3600, load))
+    eta = [s for s in segments if s.from_eta]
+    if eta:
+        lines.append("(*: %d segments made before log.load, %.3f h of the total from fdmFoam's ETA, without their "
+                     "start-up; the load is that of the others)" % (len(eta), sum(s.wall_seconds for s in eta) / 3600))
     return "\n".join(lines)
 
 
 if __name__ == "__main__":
     import sys
-    if len(sys.argv) == 3 and sys.argv[1] == "segments":
+    if len(sys.argv) in (3, 4) and sys.argv[1] == "segments":
         try:
-            print(segments_table(run_segments(sys.argv[2])))
+            print(segments_table(measured_segments(sys.argv[2], int(sys.argv[3]) if len(sys.argv) == 4 else None)))
         except ValueError as e:
             sys.exit("fdmsubgrid.output segments: %s" % e)
     else:
-        sys.exit("usage: python3 -m fdmsubgrid.output segments CASE_DIR\n"
-                 "  the run's segments (fdmRun's log.load): when each ran, its steps, wall time and load")
+        sys.exit("usage: python3 -m fdmsubgrid.output segments CASE_DIR [PLANNED_LAST_STEP]\n"
+                 "  the run's segments (fdmRun's log.load): when each ran, its steps, wall time and load; with\n"
+                 "  PLANNED_LAST_STEP (where the run was to end) also the segments made before log.load, from\n"
+                 "  log.fluid's ETA")
