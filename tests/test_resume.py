@@ -318,6 +318,11 @@ def test_finished_run_extended_with_until_gives_the_longer_run(tmp_path, env, re
     assert sum(s.wall_seconds for s in segments) <= time.time() - started
     assert segments[0].samples >= 2 and all(s.load_mean >= 0 for s in segments)
     assert "3 segments, 50 particle steps" in output.segments_table(segments)
+    kept = output.keep_segments(segments, str(tmp_path / "kept"))
+    assert os.path.basename(kept) == "wall_0.json"
+    record = json.load(open(kept))
+    assert record["wall_seconds"] == pytest.approx(sum(s.wall_seconds for s in segments))
+    assert [(r["first_step"], r["last_step"]) for r in record["segments"]] == [(0, 32), (32, 32), (32, 50)]
     # the same segments from log.fluid's ETA alone (a run made before log.load): the same steps, each wall
     # time within its start-up and last sample of log.load's
     from_eta = output.segments_from_fluid_log(root, 32)

@@ -680,15 +680,52 @@ def segments_table(segments: list[Segment]) -> str:
     return "\n".join(lines)
 
 
+def keep_segments(segments: list[Segment], folder: str) -> str:
+    """The segments of a run folder as JSON in folder/wall_<its first step>.json (one object per segment: its
+    fields and wall_seconds; the total), replacing the file of the same run folder written before: a run folder
+    lost with its logs keeps its measured wall time beside its compact snapshot (cases/poiseuille/ladderRun
+    --save)."""
+    import json
+    from dataclasses import asdict
+    if not segments:
+        raise ValueError("no segments to keep")
+    def plain(row: dict) -> dict:   # strict JSON: an unknown load is null
+        return {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in row.items()}
+
+    data = dict(segments=[plain(dict(asdict(s), wall_seconds=s.wall_seconds)) for s in segments],
+                wall_seconds=sum(s.wall_seconds for s in segments), first_step=segments[0].first_step,
+                last_step=segments[-1].last_step)
+    os.makedirs(folder, exist_ok=True)
+    path = os.path.join(folder, "wall_%d.json" % segments[0].first_step)
+    with open(path + ".tmp", "w") as f:
+        json.dump(data, f, indent=1)
+    os.replace(path + ".tmp", path)
+    return path
+
+
+USAGE = """usage: python3 -m fdmsubgrid.output segments CASE_DIR [PLANNED_LAST_STEP] [--keep FOLDER]
+  the run's segments (fdmRun's log.load): when each ran, its steps, wall time and load; with PLANNED_LAST_STEP
+  (where the run was to end) also the segments made before log.load, from log.fluid's ETA; --keep FOLDER: them
+  also as FOLDER/wall_<first step>.json (keep_segments)"""
+
+
 if __name__ == "__main__":
     import sys
-    if len(sys.argv) in (3, 4) and sys.argv[1] == "segments":
+    args = sys.argv[1:]
+    keep = None
+    if "--keep" in args:
+        k = args.index("--keep")
+        if k + 1 >= len(args):
+            sys.exit(USAGE)
+        keep = args[k + 1]
+        del args[k:k + 2]
+    if len(args) in (2, 3) and args[0] == "segments":
         try:
-            print(segments_table(measured_segments(sys.argv[2], int(sys.argv[3]) if len(sys.argv) == 4 else None)))
+            found = measured_segments(args[1], int(args[2]) if len(args) == 3 else None)
         except ValueError as e:
             sys.exit("fdmsubgrid.output segments: %s" % e)
+        print(segments_table(found))
+        if keep:
+            print("wrote %s" % keep_segments(found, keep))
     else:
-        sys.exit("usage: python3 -m fdmsubgrid.output segments CASE_DIR [PLANNED_LAST_STEP]\n"
-                 "  the run's segments (fdmRun's log.load): when each ran, its steps, wall time and load; with\n"
-                 "  PLANNED_LAST_STEP (where the run was to end) also the segments made before log.load, from\n"
-                 "  log.fluid's ETA")
+        sys.exit(USAGE)
