@@ -89,8 +89,10 @@ def test_bad_rung_and_options_are_refused(tmp_path, env):
     # --until-steady continues a run; its chunks are a positive number of steps
     refused = run([LADDER, "L12", "--until-steady", "--workdir", str(tmp_path)], env)
     assert refused.returncode == 2 and "--until-steady continues a run" in refused.stderr
-    refused = run([LADDER, "L20", "--until-steady", "--check-every", "0", "--workdir", str(tmp_path)], env)
-    assert refused.returncode == 2 and "--check-every takes a positive number of steps, got '0'" in refused.stderr
+    for bad in ("0", "100", "x"):
+        refused = run([LADDER, "L20", "--until-steady", "--check-every", bad, "--workdir", str(tmp_path)], env)
+        assert refused.returncode == 2 and "--check-every takes at least 200 steps" in refused.stderr
+        assert "got '%s'" % bad in refused.stderr
     assert not os.listdir(tmp_path)
 
 

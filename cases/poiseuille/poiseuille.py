@@ -437,4 +437,7 @@ def report(run_dir: str, out: str, material=None, from_time=None, argv: Optional
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except poiseuille.PoiseuilleRunError as e:   # the run (if any) is whole: only its analysis could not be made
+        sys.exit("poiseuille.py: %s" % e)
