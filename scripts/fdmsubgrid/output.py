@@ -550,10 +550,6 @@ class Segment:
     def wall_seconds(self) -> float:
         return self.end - self.start
 
-    @property
-    def steps(self) -> int:
-        return self.last_step - self.first_step
-
 
 def run_segments(case_dir: str) -> list[Segment]:
     """The segments of the run in case_dir from its log.load (fdmRun: a '# segment KIND from step N' line per
@@ -646,9 +642,9 @@ def segments_from_fluid_log(case_dir: str, planned_last_step: int) -> list[Segme
 def measured_segments(case_dir: str, planned_last_step: int | None = None) -> list[Segment]:
     """Every segment of a run: those log.load holds (run_segments) and, before them, those of a run made in
     part before log.load, from log.fluid's ETA (segments_from_fluid_log; planned_last_step needed then)."""
-    load = run_segments(case_dir) if os.path.isfile(os.path.join(case_dir, "log.load")) else []
     if planned_last_step is None:
-        return load if load else run_segments(case_dir)
+        return run_segments(case_dir)
+    load = run_segments(case_dir) if os.path.isfile(os.path.join(case_dir, "log.load")) else []
     older = segments_from_fluid_log(case_dir, planned_last_step)
     if len(older) < len(load):
         raise ValueError("%s: log.load holds %d segments, log.fluid %d: not one run's logs" % (case_dir, len(load), len(older)))

@@ -460,23 +460,14 @@ def analyse(run_dir: str, material: sbm.MaterialFunctions | None = None, from_ti
     if len(snapshots) < MIN_SNAPSHOTS:
         raise PoiseuilleRunError("%s: %d particle snapshots are too few for time averages (%d at least): run longer"
                          % (run_dir, len(snapshots), MIN_SNAPSHOTS))
-    own_times = np.array([s.time for s in snapshots])
     mid = channel.y_mid
-    own_centre, own_walls = centre_and_wall_series(snapshots, channel)
     phi_integral = np.array([profiles.volume_fraction(s, channel) for s in snapshots])
-    own_profiles = [profiles.profiles_in_bins(s, channel).phi for s in snapshots]
     # the run's history before this folder (a compact snapshot's continuation): the kept segments, if any
-    before = earlier_series(segments, float(own_times[0]))
-    if before["y"] is not None and len(before["y"]) != len(own_profiles[0]):
-        raise PoiseuilleRunError("the kept segments have profiles in %d bins, %s in %d: not this channel"
-                                 % (len(before["y"]), run_dir, len(own_profiles[0])))
-    n_before = len(before["time"])
-    times = np.concatenate([before["time"], own_times])
-    phi_center = np.concatenate([before["phi_center"], own_centre])
-    phi_walls = np.concatenate([before["phi_wall_layer"], own_walls])
+    whole = _with_earlier_series(snapshot_series(snapshots, channel), segments, run_dir)
+    n_before, times = whole["n_before"], whole["time"]
+    phi_center, phi_walls, rms_change = whole["phi_center"], whole["phi_wall_layer"], whole["rms_change"]
     # the steady window from the data (steady_window: the migration's approach fitted, phi_center's trend
     # over the window checked), unless a start is given
-    rms_change, _ = profile_change(before["phi_profile"] + own_profiles)
     window = steady_window(times, phi_center, rms_change)
     if from_time is not None:
         start = int(np.searchsorted(times, from_time - 1e-9))
@@ -870,19 +861,39 @@ def centre_and_wall_series(snapshots: list, channel: profiles.Channel) -> tuple[
     return centre, walls
 
 
-def _record_series(run_dir: str) -> dict:
-    """Per record of the run: its time (in L_y/(2U_c)), phi in the central slab and in the wall layers
+def snapshot_series(snapshots: list, channel: profiles.Channel) -> dict:
+    """Per snapshot: its time (in L_y/(2U_c)), phi in the central slab and in the wall layers
     (centre_and_wall_series), phi(y) in bins of a1 (arrays; y the bins' centres)."""
-    run = shear.read_run(run_dir)
-    sc = scales(run)
-    channel = run.channel
-    snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"), 1.0 / sc.time_unit)
-    if not snapshots:
-        raise PoiseuilleRunError("%s/dem/particles.records: no record yet" % run_dir)
     phi_center, phi_walls = centre_and_wall_series(snapshots, channel)
     phi_y = [profiles.profiles_in_bins(s, channel) for s in snapshots]
     return dict(time=np.array([s.time for s in snapshots], dtype=float), phi_center=phi_center,
                 phi_wall_layer=phi_walls, y=phi_y[0].y, phi_profile=[p.phi for p in phi_y])
+
+
+def _record_series(run_dir: str) -> dict:
+    """snapshot_series of the run's records."""
+    run = shear.read_run(run_dir)
+    snapshots, _ = output.record_snapshots(os.path.join(run_dir, "dem", "particles.records"),
+                                           1.0 / scales(run).time_unit)
+    if not snapshots:
+        raise PoiseuilleRunError("%s/dem/particles.records: no record yet" % run_dir)
+    return snapshot_series(snapshots, run.channel)
+
+
+def _with_earlier_series(own: dict, segments: Sequence[dict], run_dir: str) -> dict:
+    """A run folder's series (snapshot_series) after the kept segments before its first record
+    (earlier_series), joined: time, phi_center, phi_wall_layer, the profile's rms change against its final
+    profile (profile_change) and n_before, the records from the segments. Segments of another channel (profiles
+    in other bins) are refused by name."""
+    before = earlier_series(segments, float(own["time"][0]))
+    if before["y"] is not None and len(before["y"]) != len(own["y"]):
+        raise PoiseuilleRunError("the kept segments have profiles in %d bins, %s in %d: not this channel"
+                                 % (len(before["y"]), run_dir, len(own["y"])))
+    rms_change, _ = profile_change(list(before["phi_profile"]) + list(own["phi_profile"]))
+    return dict(n_before=len(before["time"]), time=np.concatenate([before["time"], own["time"]]),
+                phi_center=np.concatenate([before["phi_center"], own["phi_center"]]),
+                phi_wall_layer=np.concatenate([before["phi_wall_layer"], own["phi_wall_layer"]]),
+                rms_change=rms_change)
 
 
 def migration_series(run_dir: str) -> dict:
@@ -903,17 +914,11 @@ def steady_check(run_dir: str, segments: Sequence[dict] = ()) -> SteadyWindow:
     before its first record included, as analyse() finds it) without the profiles' averages, the momentum
     balance or the SBM: what a run that goes on until it is steady (cases/poiseuille/ladderRun --until-steady)
     asks between its chunks."""
-    own = _record_series(run_dir)
-    before = earlier_series(segments, float(own["time"][0]))
-    if before["y"] is not None and len(before["y"]) != len(own["y"]):
-        raise PoiseuilleRunError("the kept segments have profiles in %d bins, %s in %d: not this channel"
-                                 % (len(before["y"]), run_dir, len(own["y"])))
-    times = np.concatenate([before["time"], own["time"]])
-    if len(times) < MIN_SNAPSHOTS:
+    whole = _with_earlier_series(_record_series(run_dir), segments, run_dir)
+    if len(whole["time"]) < MIN_SNAPSHOTS:
         raise PoiseuilleRunError("%s: %d records are too few for a steady window (%d at least): run longer"
-                                 % (run_dir, len(times), MIN_SNAPSHOTS))
-    rms_change, _ = profile_change(list(before["phi_profile"]) + own["phi_profile"])
-    return steady_window(times, np.concatenate([before["phi_center"], own["phi_center"]]), rms_change)
+                                 % (run_dir, len(whole["time"]), MIN_SNAPSHOTS))
+    return steady_window(whole["time"], whole["phi_center"], whole["rms_change"])
 
 
 def write_segment(run_dir: str, folder: str) -> str:
