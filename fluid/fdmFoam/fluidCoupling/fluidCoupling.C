@@ -1,9 +1,13 @@
 #include "fluidCoupling.H"
 #include "Pstream.H"
 #include "OSspecific.H"
+#include "UIPstream.H"
+#include "UOPstream.H"
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <thread>
 
 namespace cpl = fdm::coupler;
 
@@ -13,6 +17,53 @@ namespace
     {
         using namespace std::chrono;
         return duration<double>(steady_clock::now().time_since_epoch()).count();
+    }
+
+    // The master's wake-up call to the other ranks (waitAsleepForMaster),
+    // on a tag of its own: OpenFOAM's messages use msgType() and nearby
+    const int wakeUpTag = 32123;
+
+    // The longest nap between two tests of the wake-up call: the latency it
+    // adds to an exchange, against the 0.1-10 s a dense scene's particle
+    // code takes between two
+    const std::chrono::microseconds longestNap(1000);
+
+    // Every rank but the master waits for the master's word asleep, not in
+    // MPI's busy poll. While the particle code works (the Eq. 31 solves:
+    // most of a dense scene's step) the master waits on the coupler's socket
+    // without using its core, but a rank waiting in Pstream::scatter polls
+    // (Open MPI, even when yielding): on the paper channel's 2 cores, it held
+    // the core the particle code leaves free, a third of the run's CPU
+    // (docs/benchmarks.md, "Parallel runs": the fluid ranks' wait).
+    void waitAsleepForMaster()
+    {
+        using namespace Foam;
+        char token = 1;
+        if (Pstream::master())
+        {
+            for (int proc = Pstream::firstSlave(); proc <= Pstream::lastSlave(); ++proc)
+            {
+                UOPstream::write
+                (
+                    UPstream::commsTypes::scheduled, proc, &token, 1,
+                    wakeUpTag, UPstream::worldComm
+                );
+            }
+            return;
+        }
+        const label request = UPstream::nRequests();
+        UIPstream::read
+        (
+            UPstream::commsTypes::nonBlocking, UPstream::masterNo(), &token, 1,
+            wakeUpTag, UPstream::worldComm
+        );
+        std::chrono::microseconds nap(10);
+        while (!UPstream::finishedRequest(request))
+        {
+            std::this_thread::sleep_for(nap);
+            nap = std::min(2*nap, longestNap);
+        }
+        UPstream::waitRequests(request);
     }
 
     const char* boxFaceName[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
@@ -422,6 +473,7 @@ void Foam::fluidCoupling::broadcast(cpl::Message& m)
         bytes.setSize(label(wire.size()));
         forAll(bytes, i) { bytes[i] = char(wire[i]); }
     }
+    waitAsleepForMaster();
     Pstream::scatter(bytes);
     if (!Pstream::master())
     {
