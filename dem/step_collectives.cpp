@@ -1,13 +1,34 @@
 // The collectives of fix fdm/couple's step (step_collectives.h).
 #include "step_collectives.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <thread>
 
 namespace fdm {
+
+void waitAsleepForRoot(MPI_Comm comm)
+{
+  // Open MPI polls in a blocking collective, even when it yields: a rank waiting in MPI_Bcast through
+  // rank 0's coupled solve would hold a core the fluid's ranks need. A non-blocking barrier, tested
+  // between naps of 10 us doubling to 1 ms (the latency added to a wait of 0.1-10 s).
+  MPI_Request request;
+  MPI_Ibarrier(comm, &request);
+  std::chrono::microseconds nap(10);
+  const std::chrono::microseconds longestNap(1000);
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(nap);
+    nap = std::min(2 * nap, longestNap);
+  }
+}
 
 void broadcastStep(MovePlan &plan, bool move, CoupledVelocitySolve &solve, BlockCounts &counts, int n, bool stresslets,
                    MPI_Comm comm)
 {
+  waitAsleepForRoot(comm);
   if (move) {
     int planned = plan.planned ? 1 : 0;
     MPI_Bcast(&planned, 1, MPI_INT, 0, comm);

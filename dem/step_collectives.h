@@ -22,10 +22,15 @@ struct BlockCounts {
   long pairBlocks = 0, wallBlocks = 0, contacts = 0;
 };
 
+// Returns on every rank once every rank has called it; the ranks that wait sleep between tests instead of
+// polling (rank 0's coupled solve, the fluid's included, takes the step: the other ranks wait through it).
+void waitAsleepForRoot(MPI_Comm comm);
+
 // Rank 0's plan (with move: whether it is planned and its rates), Eq. (31)'s results for n particles
 // (solution, hydro, subgrid, springs, and stress with stresslets), the solver's counters and counts, on
-// every rank; the solution becomes the plan's current velocities (MovePlan::solved) on every rank. The
-// results must be sized for n (CoupledVelocitySolve::resize) on every rank.
+// every rank, which waits for them asleep (waitAsleepForRoot); the solution becomes the plan's current
+// velocities (MovePlan::solved) on every rank. The results must be sized for n
+// (CoupledVelocitySolve::resize) on every rank.
 void broadcastStep(MovePlan &plan, bool move, CoupledVelocitySolve &solve, BlockCounts &counts, int n, bool stresslets,
                    MPI_Comm comm);
 

@@ -1,11 +1,15 @@
 // The collectives of fix fdm/couple's step (dem/step_collectives.h) on two MPI ranks (mpirun -np 2, CTest
 // dem.StepCollectives), without LIGGGHTS: rank 0's plan, results and counters reach every rank bit for bit,
 // the deepest overlap of whichever rank holds it is named on every rank, and the wall contact loads are
-// summed on rank 0.
+// summed on rank 0; the ranks waiting for rank 0 sleep.
 #include "step_collectives.h"
 
 #include <gtest/gtest.h>
 #include <mpi.h>
+#include <time.h>
+
+#include <chrono>
+#include <thread>
 
 namespace {
 
@@ -14,6 +18,13 @@ int size() { int s = 1; MPI_Comm_size(MPI_COMM_WORLD, &s); return s; }
 
 // a value only rank 0 knows: distinct per index, never a round number
 double value(size_t k, double scale) { return scale * (1.0 + 1.0 / 3.0 * double(k)); }
+
+double threadCpuSeconds()
+{
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 }  // namespace
 
@@ -115,6 +126,24 @@ TEST(StepCollectives, WallContactLoadsAreSummedOnRankZero)
   const std::vector<double> expected =
       rank() == 0 ? std::vector<double>{2, -1, 0.5, 3, 4, 5} : std::vector<double>(6, 0.0);
   EXPECT_EQ(sum, expected);
+}
+
+// While rank 0 works (here it sleeps 0.6 s, so that the test takes no core from the other rank), the other
+// rank waits for it under a fifth of a core: a blocking MPI_Bcast or MPI_Barrier polls, about a whole core
+// where one is free (measured: 0.6 s of CPU in 0.6 s). Nor does it return before rank 0 has called.
+TEST(StepCollectives, TheRanksWaitingForRankZeroSleep)
+{
+  const double work = 0.6;
+  MPI_Barrier(MPI_COMM_WORLD);
+  const auto start = std::chrono::steady_clock::now();
+  const double cpuStart = threadCpuSeconds();
+  if (rank() == 0) std::this_thread::sleep_for(std::chrono::duration<double>(work));
+  fdm::waitAsleepForRoot(MPI_COMM_WORLD);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double cpu = threadCpuSeconds() - cpuStart;
+  if (rank() == 0) return;
+  EXPECT_GE(wall, 0.9 * work) << "returned before rank 0 called";
+  EXPECT_LT(cpu, 0.2 * wall) << "waited " << wall << " s using " << cpu << " s of CPU";
 }
 
 int main(int argc, char **argv)
