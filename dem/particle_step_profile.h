@@ -3,8 +3,10 @@
 
      sub-grid blocks        pair_style fdm/subgrid building R^SG of its pairs and wall gaps (collectBlocks)
      Eq. 31 assembly        the matrix R^SG + springs from the gathered records
-     Eq. 31 factorisation   the rigid-body blocks from the fluid's volumes, and the factorisation
+     Eq. 31 factorisation   the rigid-body blocks from the fluid's volumes, and every factorisation: the
+                            step's and those the Coulomb rounds fall back to (past the downdates' room)
      Eq. 31 solves          the back-substitutions (or CG) of every inner iteration, with their Coulomb rounds
+                            and their downdates (the columns' solves)
      Eq. 31 results         after the last solve: sub-grid and spring forces, stresslets
      contact                the pair style's contact forces (compute) and the implicit spring blocks
      position update        the move (initial_integrate) and the plan of the next one

@@ -13,6 +13,7 @@
 #include <Eigen/SparseCholesky>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -348,6 +349,7 @@ const char *ParticleVelocitySystem::solverName(Solver solver)
 
 void ParticleVelocitySystem::factorise(const std::string &when)
 {
+  const std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   Matrices &m = *m_;
   m.downdate.resize(6 * n_, 0);
   m.solvedDowndate.resize(6 * n_, 0);
@@ -357,6 +359,7 @@ void ParticleVelocitySystem::factorise(const std::string &when)
     const bool factorised = settings_.solver == cholmod ? factoriseDirect(m.cholmod, m.matrix, m.analysed)
                                                         : factoriseDirect(m.ldlt, m.matrix, m.analysed);
     factorisations_++;
+    factorisationSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!factorised)
       throw Error(Error::notSolved, -1, std::string("the particle velocity system (Eq. 31) could not be factorised (") +
                                             solverName(settings_.solver) + ")" + when);
@@ -364,6 +367,7 @@ void ParticleVelocitySystem::factorise(const std::string &when)
     m.cg.setTolerance(settings_.tolerance);
     m.cg.setMaxIterations(std::max(1000, 6 * n_));
     m.cg.compute(m.matrix);
+    factorisationSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 }
 

@@ -163,6 +163,9 @@ class ParticleVelocitySystem {
   std::vector<int> closePairs() const;
   long lastIterations() const { return iterations_; }   // CG's, of the last solve (the most of its Coulomb rounds; 1 for LDLT)
   long factorisations() const { return factorisations_; }
+  // The wall seconds of every factorisation (or CG preconditioner) since construction: the step's
+  // (setVolumes) and those its Coulomb rounds fall back to when the downdates grow too large (in solve())
+  double factorisationSeconds() const { return factorisationSeconds_; }
   // Contacts that began to slide handled by a low-rank downdate of the step's factorisation instead
   // of a new one (Woodbury; CHOLMOD and LDLT): the number of such downdates since construction.
   long downdates() const { return downdates_; }
@@ -282,6 +285,7 @@ class ParticleVelocitySystem {
   std::vector<RigidVolume> volumes_;   // of this step, for the messages
   std::vector<double> u_;              // the last solution: warm start of the next solve
   long iterations_, factorisations_, downdates_, backSubstitutions_ = 0, rounds_ = 0;
+  double factorisationSeconds_ = 0;
   double lastCoulombResidual_ = 0;     // the largest change of a cap in the last round of this solve
   std::unique_ptr<Matrices> m_;
   static const int coulombMixingDepth = 10;              // differences kept: a solve takes 5-20 rounds
