@@ -1,10 +1,13 @@
 """cases/poiseuille/ladderRun, the ladder of channel sizes run in segments (and cases/poiseuille/paperRun, its
 paper rung): each rung's scene writes the run folder the script continues and saves from, paperRun is the
-ladder's paper rung with its own command line, and bad input is refused by name. Only scenes are written
-(poiseuille.py --write-only, a few seconds): nothing is run."""
+ladder's paper rung with its own command line, and bad input is refused by name. Scenes are written
+(poiseuille.py --write-only, a few seconds); one test runs --until-steady's loop on L20 for two short chunks
+(about a minute)."""
 import os
+import re
 import subprocess
 
+import numpy as np
 import pytest
 
 from conftest import PROJECT, load_case_module
@@ -103,3 +106,28 @@ def test_until_steady_stops_at_its_end_without_running(tmp_path, env):
     assert out.returncode == 0, out.stderr
     assert "step 40000, the end (39000), reached before the run was steady" in out.stdout
     assert not os.listdir(tmp_path)
+
+
+def test_until_steady_runs_chunks_from_the_snapshot_then_its_own_checkpoint(tmp_path, env):
+    """--until-steady's loop end to end on L20, two chunks of 200 steps: the first continues the committed
+    snapshot (step 40000), the steady check answers 'not yet' (L20's centre falls over its window) and the
+    progress line names the step, the chunk's time and the time to the end; the second continues the run
+    folder's own checkpoint and the run stops at --until. The records run on without a step twice or a gap
+    between the chunks."""
+    from fdmsubgrid import output
+    out = run([LADDER, "L20", "--until-steady", "--until", "40400", "--check-every", "200",
+               "--workdir", str(tmp_path)], env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = [line for line in out.stdout.splitlines() if line.startswith("ladderRun L20:")]
+    assert "continuing from the snapshot" in lines[0]
+    assert re.match(r"ladderRun L20: step 40200 of at most 40400; the chunk took \d+ (s|min) for 200 steps: "
+                    r"the end in about \d+ (s|min) at this rate", lines[1]), lines[1]
+    assert "from its own checkpoint to step 40400" in lines[2]
+    assert lines[3] == "ladderRun L20: step 40400, the end (40400), reached before the run was steady"
+    _, folder = scene(LADDER, "L20", tmp_path, env)
+    records = output.read_particle_records(os.path.join(folder, "dem", "particles.records"))
+    every = int(records.header["every"])
+    assert records.steps[0] == 40000 + every and records.steps[-1] == 40400
+    assert np.all(np.diff(records.steps) == every)
+    for code, prefix in (("dem", "dem."), ("fluid", "fluid.")):
+        assert prefix + "40400" in os.listdir(os.path.join(folder, code, "checkpoint"))
