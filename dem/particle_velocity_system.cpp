@@ -355,20 +355,20 @@ void ParticleVelocitySystem::factorise(const std::string &when)
   m.solvedDowndate.resize(6 * n_, 0);
   m.downdateSign.clear();
   m.signedUpdate = false;
+  bool factorised = true;
   if (settings_.solver != cg) {
-    const bool factorised = settings_.solver == cholmod ? factoriseDirect(m.cholmod, m.matrix, m.analysed)
-                                                        : factoriseDirect(m.ldlt, m.matrix, m.analysed);
+    factorised = settings_.solver == cholmod ? factoriseDirect(m.cholmod, m.matrix, m.analysed)
+                                             : factoriseDirect(m.ldlt, m.matrix, m.analysed);
     factorisations_++;
-    factorisationSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!factorised)
-      throw Error(Error::notSolved, -1, std::string("the particle velocity system (Eq. 31) could not be factorised (") +
-                                            solverName(settings_.solver) + ")" + when);
   } else {
     m.cg.setTolerance(settings_.tolerance);
     m.cg.setMaxIterations(std::max(1000, 6 * n_));
     m.cg.compute(m.matrix);
-    factorisationSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+  factorisationSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!factorised)
+    throw Error(Error::notSolved, -1, std::string("the particle velocity system (Eq. 31) could not be factorised (") +
+                                          solverName(settings_.solver) + ")" + when);
 }
 
 const std::vector<double> &ParticleVelocitySystem::solve(const std::vector<double> &fluidForces)

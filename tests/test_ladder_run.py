@@ -89,7 +89,7 @@ def test_bad_rung_and_options_are_refused(tmp_path, env):
     refused = run([LADDER, "L20", "--until", "100", "--workdir", str(tmp_path)], env)
     assert refused.returncode == 2 and "--until 100: the committed snapshot" in refused.stderr
     assert "already" in refused.stderr
-    # --until-steady continues a run; its chunks are a positive number of steps
+    # --until-steady continues a run; its chunks are 200 steps at least (the 8 records of an analysis)
     refused = run([LADDER, "L12", "--until-steady", "--workdir", str(tmp_path)], env)
     assert refused.returncode == 2 and "--until-steady continues a run" in refused.stderr
     for bad in ("0", "100", "x"):
