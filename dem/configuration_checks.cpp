@@ -155,13 +155,13 @@ std::string periodicBalanceProblem(const std::vector<GatheredParticle> &particle
     mismatch = std::max(mismatch, std::fabs(sum[d] - imposed[d]));
   }
   if (mismatch <= 1e-6 * scale || scale == 0) return "";
-  char text[600];
+  char text[800];
   std::snprintf(text, sizeof text,
                 "in a box periodic in every direction the loads on the free particles (forces beside contacts, "
                 "buoyant weights) sum to (%g %g %g) N but the fluid's imposed pressure gradient gradP0 = (%g %g %g) "
                 "Pa/m needs V0 gradP0 = (%g %g %g) N (Eq. 43; V0 = %g m3) at step %lld: no steady Stokes flow exists. "
                 "Set gradP0 in the fluid's constant/fdmProperties, give the particles that external force (fix "
-                "addforce), hold them (move no), or bound the flow with walls",
+                "addforce; move no fixes their places, not their velocities), or bound the flow with walls",
                 sum[0], sum[1], sum[2], gradP0[0], gradP0[1], gradP0[2], imposed[0], imposed[1], imposed[2], volume,
                 step);
   return text;

@@ -269,7 +269,8 @@ void FixFdmCouple::assembleSystem(const Particles &particles)
   MPI_Reduce(&contacts, &blocks_.contacts, 1, MPI_LONG, MPI_SUM, 0, world);
   if (comm->me != 0) return;
 
-  if (options_.move && session_.hasFluid() && domain->xperiodic && domain->yperiodic && domain->zperiodic) {
+  // whatever `move`: move no fixes the places, not the velocities, which are solved force-free as ever
+  if (session_.hasFluid() && domain->xperiodic && domain->yperiodic && domain->zperiodic) {
     const std::string problem = fdm::periodicBalanceProblem(particles, box(), session_.gradP0(), session_.rhoFluid(),
                                                             options_.gravity, update->ntimestep);
     if (!problem.empty()) fail(problem);

@@ -17,23 +17,34 @@ PROJECT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FDMRUN = os.path.join(PROJECT, "scripts", "fdmRun")
 
 
+GRAD_P0 = (-0.01, 0, 0)
+
+
 def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None, n_particles=-1,
-              fdm_edit=None, fix_options="move no", runs=("run 2",), pair_style="none", dt=1.0, connect_timeout=20):
+              fdm_edit=None, fix_options="move no", runs=("run 2",), pair_style="none", dt=1.0, connect_timeout=20,
+              held=True):
     # connect_timeout: short, so that a case where one code never starts fails quickly, but not so short
-    # that a loaded machine's start-up of the other code exceeds it (5 s did, beside two other jobs)
+    # that a loaded machine's start-up of the other code exceeds it (5 s did, beside two other jobs).
+    # held: the particles carry V0 grad P0 (fix addforce), which balances the mean pressure gradient
+    # (Eq. 43): the fully periodic box then has a steady flow (move no fixes places, not velocities)
     box = box or case.Box((0, 0, 0), (4, 4, 4), 0.5)
     root = str(tmp_path / "case")
     fluid = os.path.join(root, "fluid")
-    case.write_fluid_case(fluid, box, grad_p0=(-0.01, 0, 0), tol_lambda=1e-3, n_max=50,
+    case.write_fluid_case(fluid, box, grad_p0=GRAD_P0, tol_lambda=1e-3, n_max=50,
                           n_particles=n_particles)
     props = os.path.join(fluid, "constant", "fdmProperties")
     text = open(props).read().replace("connectTimeout 60", "connectTimeout %d" % connect_timeout)
     if fdm_edit:
         text = fdm_edit(text)
     open(props, "w").write(text)
+    volume = 1.0
+    for lo, hi in zip(box.lo, box.hi):
+        volume *= hi - lo
+    load = " ".join(repr(g * volume / max(len(spheres), 1)) for g in GRAD_P0)
     case.write_dem_input(os.path.join(root, "dem"), dem_box or box, list(spheres),
                          fix_options="connect_timeout %d " % connect_timeout + fix_options, runs=runs,
-                         pair_style=pair_style, dt=dt)
+                         pair_style=pair_style, dt=dt,
+                         before_run="fix             hold all addforce %s" % load if held else "")
     return root
 
 
@@ -67,12 +78,14 @@ def test_particle_crossing_a_wall(tmp_path, env):
     assert wall < 30
 
 
-def test_pressure_gradient_in_a_fully_periodic_box_with_free_particles(tmp_path, env):
+@pytest.mark.parametrize("fix_options", ["", "move no"])
+def test_pressure_gradient_in_a_fully_periodic_box_with_free_particles(tmp_path, env, fix_options):
     """gradP0 in a box periodic in every direction, the sphere force-free: no steady Stokes flow
     exists (Eq. 43; the mean flow grew to 2e12 m/s within the first step before this check).
-    fix fdm/couple stops before the first fluid solve, naming the loads, gradP0 and the remedies;
-    the held sphere of the reference run (test_reference_run_succeeds) carries the force and passes."""
-    root = make_case(tmp_path, fix_options="", runs=("run 3",))
+    fix fdm/couple stops before the first fluid solve, naming the loads, gradP0 and the remedies,
+    whether the particles move or stay in place (move no fixes places, not velocities); the held sphere
+    of the reference run (test_reference_run_succeeds) carries the force and passes."""
+    root = make_case(tmp_path, fix_options=fix_options, runs=("run 3",), held=False)
     status, out, wall = run_fdm(root, env)
     assert status != 0
     text = logs(root)
@@ -82,6 +95,29 @@ def test_pressure_gradient_in_a_fully_periodic_box_with_free_particles(tmp_path,
     assert "constant/fdmProperties" in text and "fix addforce" in text and "move no" in text
     steps = os.path.join(root, "fluid", "postProcessing", "fdm", "steps.dat")
     assert not os.path.exists(steps) or all(line.startswith("#") for line in open(steps))
+    assert wall < 30
+
+
+def test_pressure_gradient_between_slip_walls_with_free_particles(tmp_path, env):
+    """Slip walls take no force along gradP0: the box has no steady flow unless the particles carry
+    V0 gradP0 (Eq. 43), which fdmFoam checks at a converged step (the particle side does not know the
+    walls slip). The plain iteration with a loose velocity tolerance declares the growing mean flow
+    converged at its fourth inner iteration: the check stops the run there, naming the remedy."""
+    box = case.Box((0, 0, 0), (4, 4, 4), 0.5, faces=("cyclic", "slip", "cyclic"))
+
+    def loose_plain_iteration(text):
+        text = re.sub(r"tolLambda\s+[^;]+;", "tolLambda 0;", text)
+        text = re.sub(r"tolVelocity\s+[^;]+;", "tolVelocity 0.5;", text)
+        return re.sub(r"acceleration\s+\w+;", "acceleration none;", text)
+
+    root = make_case(tmp_path, box=box, held=False, fdm_edit=loose_plain_iteration)
+    status, out, wall = run_fdm(root, env)
+    assert status != 0
+    text = logs(root)
+    assert re.search(r"gradP0 \(-0.01 0 0\) Pa/m in a box whose faces are periodic or slip \(no wall holds the "
+                     r"fluid\) has no steady Stokes flow unless the particles carry its force, V0 gradP0 = "
+                     r"\(-0.64 0 0\) N \(Eq. 43\); at time step 1", text), text[-2000:]
+    assert "fix addforce" in text
     assert wall < 30
 
 

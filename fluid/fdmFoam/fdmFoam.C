@@ -33,6 +33,7 @@ Usage
 #include "OStringStream.H"
 #include "emptyFvPatch.H"
 #include "fixedValueFvPatchFields.H"
+#include "slipFvPatchFields.H"
 #include "uniformCartesianMesh.H"
 #include "particleForcing.H"
 #include "fluidCoupling.H"
@@ -150,18 +151,27 @@ int main(int argc, char *argv[])
     // The function objects of system/controlDict. fdmDEM drives time, so
     // instead of runTime.run() the loop calls what it would: start() before
     // the first step, execute() after each step, end() after the last.
-    // A box periodic in every direction (no wall patch) has a steady Stokes
-    // flow under gradP0 only if the particles carry its force, V0 gradP0
-    // (Eq. 43; held particles, or an external force): checked every step
-    bool fullyPeriodic = true;
+    // In a box whose faces are all periodic or slip no wall holds the fluid
+    // along the periodic directions (a slip wall takes no tangential force):
+    // a steady Stokes flow under gradP0 exists only if the particles carry
+    // its force, V0 gradP0 along them (Eq. 43; an external force: move no
+    // fixes the places, not the velocities). Checked at converged steps;
+    // otherwise the mean flow grows by gradP0 alpha_lambda/rho per inner
+    // iteration, which the divergence message then names
+    bool noWallHolds = true;
     forAll(mesh.boundary(), patchi)
     {
         const fvPatch& patch = mesh.boundary()[patchi];
-        if (!patch.coupled() && !isA<emptyFvPatch>(patch))
+        if
+        (
+            !patch.coupled() && !isA<emptyFvPatch>(patch)
+         && !isA<slipFvPatchVectorField>(U.boundaryField()[patchi])
+        )
         {
-            fullyPeriodic = false;
+            noWallHolds = false;
         }
     }
+    const bool unheldGradient = noWallHolds && mag(gradP0.value()) > 0;
     const scalar boxVolume = gSum(mesh.V());
 
     runTime.functionObjects().start();
@@ -267,18 +277,27 @@ int main(int argc, char *argv[])
                 convergence.diverging(innerIteration, residual, forcing.lambdaNorm());
             if (!divergence.empty())
             {
-                coupling.fatal
-                (
-                    "the lambda iteration at time step " + name(coupling.step())
-                  + " " + divergence
-                );
+                OStringStream msg;
+                msg << "the lambda iteration at time step " << coupling.step()
+                    << " " << divergence.c_str();
+                if (unheldGradient)
+                {
+                    msg << ". No wall holds the fluid in this box (its faces"
+                        << " are periodic or slip): under gradP0 "
+                        << gradP0.value() << " Pa/m a steady flow exists only"
+                        << " if the particles carry V0 gradP0 = "
+                        << boxVolume*gradP0.value() << " N (Eq. 43; fix"
+                        << " addforce)";
+                }
+                coupling.fatal(msg.str());
             }
             convergence.endIteration(U, velocities, radii, residual);
             profile.lap("convergence test");
             if (reportIterations)
             {
                 Info<< "    inner " << innerIteration << " residual lambda "
-                    << residual << " flow change "
+                    << residual << " |lambda| " << forcing.lambdaNorm()
+                    << " flow change "
                     << convergence.flowChange() << " particle change "
                     << convergence.particleChange() << " velocity error "
                     << convergence.errorEstimate() << " mean-flow change "
@@ -304,26 +323,35 @@ int main(int argc, char *argv[])
             }
         }
 
-        if (converged && fullyPeriodic && mag(gradP0.value()) > 0)
+        if (converged && unheldGradient)
         {
             // Eq. (43) at a converged step, before anything of it is written
-            // (fix fdm/couple checks the particles' forces before the step;
-            // this catches what it cannot see)
+            // (fix fdm/couple checks the particles' forces before the step
+            // in a periodic box; this also sees slip walls), along the
+            // periodic directions (slip walls take the normal force)
             const vector lambdaForce =
                 -rho.value()*gSum(lambda.primitiveField()*mesh.V());
             const vector imposed = boxVolume*gradP0.value();
-            if (mag(lambdaForce + imposed) > 0.1*mag(imposed))
+            vector mismatch = lambdaForce + imposed;
+            for (direction d = 0; d < vector::nComponents; ++d)
+            {
+                if (!grid.periodic()[d])
+                {
+                    mismatch[d] = 0;
+                }
+            }
+            if (mag(mismatch) > 0.1*mag(imposed))
             {
                 OStringStream msg;
                 msg << "constant/fdmProperties: gradP0 " << gradP0.value()
-                    << " Pa/m in a box periodic in every direction (no wall"
-                    << " patch) has no steady Stokes flow unless the particles"
-                    << " carry its force, V0 gradP0 = " << imposed
-                    << " N (Eq. 43); at time step " << coupling.step()
-                    << " the lambda force on the liquid is " << lambdaForce
-                    << " N. Hold the particles (fix fdm/couple ... move no),"
-                    << " give them that external force (fix addforce), or"
-                    << " bound the flow with walls";
+                    << " Pa/m in a box whose faces are periodic or slip (no"
+                    << " wall holds the fluid) has no steady Stokes flow"
+                    << " unless the particles carry its force, V0 gradP0 = "
+                    << imposed << " N (Eq. 43); at time step "
+                    << coupling.step() << " the lambda force on the liquid is "
+                    << lambdaForce << " N. Give the particles that external"
+                    << " force (fix addforce; move no fixes their places, not"
+                    << " their velocities), or bound the flow with walls";
                 coupling.fatal(msg.str());
             }
         }
