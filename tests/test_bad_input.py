@@ -55,6 +55,16 @@ def run_fdm(root, env, timeout=60):
     return proc.returncode, proc.stdout, time.time() - t0
 
 
+def run_refused(root, env, pattern):
+    """Runs the case, which must stop with a message matching the regular expression pattern;
+    returns the logs and the wall time"""
+    status, out, wall = run_fdm(root, env)
+    assert status != 0
+    text = logs(root)
+    assert re.search(pattern, text), text[-2000:]
+    return text, wall
+
+
 def logs(root):
     return "".join(open(os.path.join(root, f), errors="replace").read() for f in ("log.fluid", "log.dem")
                    if os.path.exists(os.path.join(root, f)))
@@ -86,12 +96,9 @@ def test_pressure_gradient_in_a_fully_periodic_box_with_free_particles(tmp_path,
     whether the particles move or stay in place (move no fixes places, not velocities); the held sphere
     of the reference run (test_reference_run_succeeds) carries the force and passes."""
     root = make_case(tmp_path, fix_options=fix_options, runs=("run 3",), held=False)
-    status, out, wall = run_fdm(root, env)
-    assert status != 0
-    text = logs(root)
-    assert re.search(r"in a box periodic in every direction the loads on the free particles .* sum to \(0 0 0\) N "
-                     r"but the fluid's imposed pressure gradient gradP0 = \(-0.01 0 0\) Pa/m needs "
-                     r"V0 gradP0 = \(-0.64 0 0\) N", text), text[-2000:]
+    text, wall = run_refused(root, env, r"in a box periodic in every direction the loads on the free particles .* "
+                             r"sum to \(0 0 0\) N but the fluid's imposed pressure gradient gradP0 = \(-0.01 0 0\) "
+                             r"Pa/m needs V0 gradP0 = \(-0.64 0 0\) N")
     assert "constant/fdmProperties" in text and "fix addforce" in text and "move no" in text
     steps = os.path.join(root, "fluid", "postProcessing", "fdm", "steps.dat")
     assert not os.path.exists(steps) or all(line.startswith("#") for line in open(steps))
@@ -111,12 +118,9 @@ def test_pressure_gradient_between_slip_walls_with_free_particles(tmp_path, env)
         return re.sub(r"acceleration\s+\w+;", "acceleration none;", text)
 
     root = make_case(tmp_path, box=box, held=False, fdm_edit=loose_plain_iteration)
-    status, out, wall = run_fdm(root, env)
-    assert status != 0
-    text = logs(root)
-    assert re.search(r"gradP0 \(-0.01 0 0\) Pa/m in a box whose faces are periodic or slip \(no wall holds the "
-                     r"fluid\) has no steady Stokes flow unless the particles carry its force, V0 gradP0 = "
-                     r"\(-0.64 0 0\) N \(Eq. 43\); at time step 1", text), text[-2000:]
+    text, wall = run_refused(root, env, r"gradP0 \(-0.01 0 0\) Pa/m in a box whose faces are periodic or slip \(no "
+                             r"wall holds the fluid\) has no steady Stokes flow unless the particles carry its force, "
+                             r"V0 gradP0 = \(-0.64 0 0\) N \(Eq. 43\); at time step 1")
     assert "fix addforce" in text
     assert wall < 30
 
