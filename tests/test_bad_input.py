@@ -37,14 +37,10 @@ def make_case(tmp_path, spheres=((2.0, 2.0, 2.0, 0.5),), box=None, dem_box=None,
     if fdm_edit:
         text = fdm_edit(text)
     open(props, "w").write(text)
-    volume = 1.0
-    for lo, hi in zip(box.lo, box.hi):
-        volume *= hi - lo
-    load = " ".join(repr(g * volume / max(len(spheres), 1)) for g in GRAD_P0)
     case.write_dem_input(os.path.join(root, "dem"), dem_box or box, list(spheres),
                          fix_options="connect_timeout %d " % connect_timeout + fix_options, runs=runs,
                          pair_style=pair_style, dt=dt,
-                         before_run="fix             hold all addforce %s" % load if held else "")
+                         before_run=case.balancing_force_line(box, GRAD_P0, max(len(spheres), 1)) if held else "")
     return root
 
 

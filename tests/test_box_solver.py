@@ -42,10 +42,8 @@ def run_free_sphere(tmp_path, name, faces, linear_solver, np_fluid=1, tol_lambda
     case.write_fluid_case(os.path.join(root, "fluid"), box, grad_p0=GRAD_P0, tol_lambda=tol_lambda, n_max=300,
                           n_particles=1, tol_u=1e-10, tol_p=1e-10, linear_solver=linear_solver,
                           momentum_predictor=True)
-    volume = float(np.prod(np.subtract(box.hi, box.lo)))
-    hold = "fix             hold all addforce %s" % " ".join(repr(g * volume) for g in GRAD_P0) if held else ""
     case.write_dem_input(os.path.join(root, "dem"), box, [(1.9, 2.1, 2.05, 1.0)], fix_options="move no",
-                         before_run=hold)
+                         before_run=case.balancing_force_line(box, GRAD_P0) if held else "")
     if edit:
         path = os.path.join(root, "fluid", "system", "fvSolution")
         with open(path) as f:

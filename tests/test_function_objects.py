@@ -25,12 +25,13 @@ functions
 def write_case(root, steps):
     box = case.Box((0, 0, 0), (4, 4, 4), 0.5)
     fluid = os.path.join(root, "fluid")
-    case.write_fluid_case(fluid, box, grad_p0=(-0.01, 0, 0), tol_lambda=1e-3, n_max=20)
+    grad_p0 = (-0.01, 0, 0)
+    case.write_fluid_case(fluid, box, grad_p0=grad_p0, tol_lambda=1e-3, n_max=20)
     with open(os.path.join(fluid, "system", "controlDict"), "a") as f:
         f.write(FUNCTIONS)
     # the sphere carries V0 grad P0 (Eq. 43): the fully periodic box has a steady flow
     case.write_dem_input(os.path.join(root, "dem"), box, [(2.0, 2.0, 2.0, 0.5)], fix_options="move no",
-                         before_run="fix             hold all addforce -0.64 0 0", runs=("run %d" % steps,))
+                         before_run=case.balancing_force_line(box, grad_p0), runs=("run %d" % steps,))
     return fluid
 
 

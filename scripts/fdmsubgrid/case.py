@@ -15,13 +15,15 @@ The names of the modules that do each job, gathered in one namespace for the cas
 """
 from .cellpositions import halton_points, symmetric_cell_offsets
 from .cli import add_run_options, add_size_options, boxes_and_offsets, size_distribution
-from .deminput import (RECORD_EVERY_STEP, SceneCalibration, UncalibratedScene, held_step_runs, records_line, refusal,
+from .deminput import (RECORD_EVERY_STEP, SceneCalibration, UncalibratedScene, balancing_force_line, held_step_runs,
+                       records_line, refusal,
                        scene_calibration, subgrid_pair_style, uncalibrated, write_dem_input)
 from .foamcase import (DEFAULT_LINEAR_SOLVER, HEADER, LINEAR_SOLVERS, Box, foam_file, foam_vector,
                        write_control_dict, write_fluid_case, write_initial_velocity)
 from .runner import delete_fields, last_error, read_held_steps, records_finite, run, run_and_read
 
 __all__ = ["Box", "DEFAULT_LINEAR_SOLVER", "HEADER", "LINEAR_SOLVERS", "RECORD_EVERY_STEP", "add_run_options",
+           "balancing_force_line",
            "add_size_options", "size_distribution",
            "boxes_and_offsets", "delete_fields", "foam_file", "foam_vector", "halton_points", "held_step_runs",
            "last_error", "read_held_steps", "records_finite", "records_line", "refusal", "run", "run_and_read", "SceneCalibration", "scene_calibration",

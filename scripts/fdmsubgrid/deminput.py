@@ -51,6 +51,16 @@ def records_line(every: int) -> str:
 RECORD_EVERY_STEP = records_line(1)
 
 
+def balancing_force_line(box, grad_p0, n_particles: int = 1) -> str:
+    """The LIGGGHTS line by which the particles carry V0 grad P0 in equal shares (fix addforce): in a box
+    whose faces are periodic or slip nothing else holds the fluid, and the steady Stokes flow under the
+    imposed gradient exists only with this balance (Eq. 43; move no fixes places, not velocities)."""
+    volume = 1.0
+    for lo, hi in zip(box.lo, box.hi):
+        volume *= hi - lo
+    return "fix             hold all addforce %s" % " ".join(repr(g * volume / n_particles) for g in grad_p0)
+
+
 # the cut-off model's known error, what a scene outside the table gives up (docs/validation.md, "Squeeze
 # calibration": closing velocities at a position the calibration did not use, a/Delta 3-5)
 CUTOFF_MODEL_ERROR = "squeeze up to 16 % off for pairs, 24 % for walls: docs/validation.md"

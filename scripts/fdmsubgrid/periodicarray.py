@@ -7,7 +7,7 @@ import math
 import os
 import shutil
 
-from . import foamcase, output, runner
+from . import deminput, foamcase, output, runner
 
 
 def hasimoto_K(phi: float) -> float:
@@ -50,7 +50,7 @@ pair_style      none
 neighbor        {skin!r} bin
 timestep        {dt!r}
 # external force F_ext = V0 grad P0 (Eq. 43)
-fix             hold all addforce {fext}
+{hold}
 fix             couple all fdm/couple portfile ../fluid/coupling.port move no
 {positions}
 """
@@ -99,7 +99,8 @@ def run_configuration(workdir: str, L_over_a: float, a_over_delta: float, n_posi
     os.makedirs(os.path.join(run_dir, "dem"))
     with open(os.path.join(run_dir, "dem", "in.periodicArray"), "w") as f:
         f.write(DEM_INPUT.format(n=len(pts), L=L, x0=pts[0][0], y0=pts[0][1], z0=pts[0][2], d=2 * a,
-                                 skin=0.1 * a, dt=1.0, fext=" ".join(repr(g * V0) for g in gradient), positions="\n".join(lines)))
+                                 skin=0.1 * a, dt=1.0, hold=deminput.balancing_force_line(box, gradient),
+                                 positions="\n".join(lines)))
 
     wall = runner.run(run_dir, np_fluid=np_fluid)
 
